@@ -1,0 +1,37 @@
+// An ordered list of force modules evaluated as one.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "fields/ForceModule.h"
+
+namespace tickfx {
+
+/// Owns the force modules of a system and evaluates them in insertion order.
+class ForceSet {
+ public:
+  ForceSet() = default;
+  ForceSet(ForceSet&&) noexcept = default;
+  ForceSet& operator=(ForceSet&&) noexcept = default;
+
+  /// Appends `module` (taking ownership); returns it for further configuration.
+  ForceModule& add(std::unique_ptr<ForceModule> module);
+
+  std::size_t size() const { return modules_.size(); }
+  const ForceModule& module(std::size_t i) const { return *modules_[i]; }
+  ForceModule& module(std::size_t i) { return *modules_[i]; }
+
+  /// True when every module is local (see ForceModule::isLocal).
+  bool isLocal() const;
+
+  void beginTick(const ParticlePool& pool, std::int64_t tick);
+
+  /// Writes the total acceleration at `in` into rows `rows` of `acceleration` (overwrites).
+  void evaluate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const;
+
+ private:
+  std::vector<std::unique_ptr<ForceModule>> modules_;
+};
+
+}  // namespace tickfx

@@ -1,0 +1,22 @@
+// Linear drag toward the velocity of the surrounding air.
+#pragma once
+
+#include "fields/ForceModule.h"
+
+namespace tickfx {
+
+/// a = k · (v_air − v): relaxes each particle's velocity toward `airVelocity` (m/s) at rate `k`
+/// (1/s). Mass-independent, like Houdini's POP drag with its default "ignore mass".
+class LinearDrag final : public ForceModule {
+ public:
+  LinearDrag(float k, const Eigen::Vector3f& airVelocity = Eigen::Vector3f::Zero())
+      : k_(k), air_(airVelocity) {}
+  std::string_view typeName() const override { return "drag"; }
+  void accumulate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const override;
+
+ private:
+  float k_;
+  Eigen::Vector3f air_;
+};
+
+}  // namespace tickfx

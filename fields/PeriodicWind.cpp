@@ -1,0 +1,31 @@
+#include "fields/PeriodicWind.h"
+
+#include <stdexcept>
+
+#include "particles/DetMath.h"
+
+namespace tickfx {
+
+PeriodicWind::PeriodicWind(const Settings& settings) : s_(settings) {
+  const float norm = s_.direction.norm();
+  if (!(norm > 0.0f)) throw std::invalid_argument("wind direction must not be zero");
+  s_.direction /= norm;
+}
+
+float PeriodicWind::strength(double t) const {
+  // Reduce f·t to a fraction of a period first: 2π·f·t for large t would lose the phase.
+  const double cycles = s_.frequency * t;
+  const double fraction = cycles - static_cast<double>(static_cast<long long>(cycles));
+  const double angle = 2.0 * det::kPi * fraction + s_.phase;
+  return static_cast<float>(s_.base + s_.amplitude * det::sin(angle));
+}
+
+void PeriodicWind::accumulate(const ForceInput& in, RowRange rows, Vec3Column& a) const {
+  const float w = strength(in.time);
+  const Eigen::Index b = rows.offset(), n = rows.count();
+  a.x.segment(b, n) += s_.direction.x() * w;
+  a.y.segment(b, n) += s_.direction.y() * w;
+  a.z.segment(b, n) += s_.direction.z() * w;
+}
+
+}  // namespace tickfx

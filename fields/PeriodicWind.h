@@ -1,0 +1,33 @@
+// A gusting wind that is the same everywhere and periodic in time.
+#pragma once
+
+#include "fields/ForceModule.h"
+
+namespace tickfx {
+
+/// a = direction · (base + amplitude · sin(2π · frequency · t + phase)), in m/s².
+///
+/// The sine is det::sin in double, evaluated once per call and rounded to float once, so every
+/// build gives the same bits. Sampling: a frequency above half the step rate aliases (the effect
+/// linter warns); integrators that evaluate at t + dt/2 see the wind there too.
+class PeriodicWind final : public ForceModule {
+ public:
+  struct Settings {
+    Eigen::Vector3f direction = Eigen::Vector3f(1.0f, 0.0f, 0.0f);  // normalised on construction
+    float base = 0.0f;                                                // m/s²
+    float amplitude = 1.0f;                                           // m/s²
+    double frequency = 1.0;                                           // Hz
+    double phase = 0.0;                                               // radians
+  };
+
+  explicit PeriodicWind(const Settings& settings);
+  std::string_view typeName() const override { return "wind"; }
+  void accumulate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const override;
+  /// The scalar strength (m/s²) at time `t` seconds.
+  float strength(double t) const;
+
+ private:
+  Settings s_;
+};
+
+}  // namespace tickfx

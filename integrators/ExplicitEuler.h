@@ -1,0 +1,21 @@
+// Explicit (forward) Euler: first order, gains energy on oscillators.
+#pragma once
+
+#include "integrators/Integrator.h"
+
+namespace tickfx {
+
+/// p ← p + v·dt, then v ← v + a(p, v, t)·dt, both from the state at the start of the tick.
+/// First order; on an undamped oscillator each step multiplies the energy by (1 + ω²dt²).
+class ExplicitEuler final : public Integrator {
+ public:
+  std::string_view name() const override { return "explicit_euler"; }
+  int order() const override { return 1; }
+  int evaluationsPerStep() const override { return 1; }
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+
+ private:
+  Vec3Column accel_;
+};
+
+}  // namespace tickfx

@@ -1,0 +1,52 @@
+// The interface every time-stepping scheme implements.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fields/ForceSet.h"
+#include "particles/ParticlePool.h"
+
+namespace tickfx {
+
+/// The tick being integrated: from t = tick/rate to (tick+1)/rate seconds.
+struct StepTime {
+  std::int64_t tick = 0;
+  std::int64_t stepRateHz = 60;
+
+  /// The step length in seconds, rounded to float once.
+  float dt() const { return static_cast<float>(1.0 / static_cast<double>(stepRateHz)); }
+  /// Seconds at `fraction` of the way through the tick (0, 1/2, 1), from integers.
+  double at(double fraction) const {
+    return (static_cast<double>(tick) + fraction) / static_cast<double>(stepRateHz);
+  }
+};
+
+/// A time-stepping scheme. An integrator advances rows [0, pool.size()) by one tick, asking the
+/// forces for accelerations at the states and times its scheme needs, and stores the position it
+/// started from in pool.previousPosition() (for interpolation). Rows from pool.firstUnstepped()
+/// on were spawned this tick: schemes with history start them on their own.
+///
+/// Implementations keep scratch columns between calls, so one instance serves one pool.
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  /// The name used in effect files ("semi_implicit_euler", ...).
+  virtual std::string_view name() const = 0;
+  /// Order of the global position error for smooth forces: 1, 2 or 4.
+  virtual int order() const = 0;
+  /// Force evaluations per tick (RK4: 4).
+  virtual int evaluationsPerStep() const = 0;
+  virtual void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) = 0;
+};
+
+/// The integrator called `name`; throws std::invalid_argument for an unknown name.
+std::unique_ptr<Integrator> makeIntegrator(std::string_view name);
+
+/// Every name makeIntegrator accepts, in the order of the integrator study.
+const std::vector<std::string>& integratorNames();
+
+}  // namespace tickfx

@@ -1,0 +1,21 @@
+// The midpoint (modified Euler) method: second order.
+#pragma once
+
+#include "integrators/Integrator.h"
+
+namespace tickfx {
+
+/// v_mid = v + a(p, v, t)·dt/2; p ← p + v_mid·dt; v ← v + a(p_new, v_mid, t + dt/2)·dt.
+/// Second order and exact for constant acceleration; not symplectic (loses oscillator energy).
+class Midpoint final : public Integrator {
+ public:
+  std::string_view name() const override { return "midpoint"; }
+  int order() const override { return 2; }
+  int evaluationsPerStep() const override { return 2; }
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+
+ private:
+  Vec3Column accel_, midVelocity_;
+};
+
+}  // namespace tickfx

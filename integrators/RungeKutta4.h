@@ -1,0 +1,21 @@
+// The classic fourth-order Runge–Kutta method.
+#pragma once
+
+#include "integrators/Integrator.h"
+
+namespace tickfx {
+
+/// Four evaluations per tick, at t, t + dt/2 (twice) and t + dt, combined with weights
+/// 1/6, 1/3, 1/3, 1/6. Fourth order; slowly loses oscillator energy (not symplectic).
+class RungeKutta4 final : public Integrator {
+ public:
+  std::string_view name() const override { return "rk4"; }
+  int order() const override { return 4; }
+  int evaluationsPerStep() const override { return 4; }
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+
+ private:
+  Vec3Column k1_, k2_, k3_, k4_, p2_, v2_, p3_, v3_, p4_, v4_;
+};
+
+}  // namespace tickfx

@@ -1,0 +1,23 @@
+// Velocity Verlet: second order, symplectic, keeps the acceleration between ticks.
+#pragma once
+
+#include "integrators/Integrator.h"
+
+namespace tickfx {
+
+/// p ← p + v·dt + a·dt²/2; a_new = a(p_new, v + a·dt, t + dt); v ← v + (a + a_new)·dt/2.
+/// The acceleration is stored in pool.acceleration() for the next tick, so a step costs one force
+/// evaluation (two in a particle's first tick). Velocity-dependent forces see the predicted
+/// velocity v + a·dt at the end of the step.
+class VelocityVerlet final : public Integrator {
+ public:
+  std::string_view name() const override { return "velocity_verlet"; }
+  int order() const override { return 2; }
+  int evaluationsPerStep() const override { return 1; }
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+
+ private:
+  Vec3Column predictedVelocity_, newAccel_;
+};
+
+}  // namespace tickfx

@@ -1,0 +1,21 @@
+// Transcendental functions that give the same bits with every compiler, flag and libm.
+#pragma once
+
+namespace tickfx::det {
+
+/// π to double precision.
+inline constexpr double kPi = 3.141592653589793238462643383279502884;
+
+/// Sine of `x` radians. Built only from +, −, × and exact range reduction, so with
+/// -ffp-contract=off it is bitwise reproducible across gcc and clang at any optimisation level,
+/// unlike std::sin whose result depends on the libm and on constant folding. Accurate to a few
+/// units in the last place of a double for |x| < 1e5; still deterministic (not accurate) beyond.
+double sin(double x);
+
+/// Cosine of `x` radians; same guarantees as det::sin.
+double cos(double x);
+
+/// Cube root of `x` >= 0 by Newton's method from an exact power-of-two start; deterministic.
+double cbrt(double x);
+
+}  // namespace tickfx::det

@@ -1,0 +1,24 @@
+#include "particles/ParallelFor.h"
+
+#include <algorithm>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace tickfx {
+
+void parallelForRows(std::size_t rows, const std::function<void(std::size_t, std::size_t)>& body) {
+  const std::size_t blocks = (rows + kParallelBlockRows - 1) / kParallelBlockRows;
+  if (blocks <= 1) {
+    if (rows > 0) body(0, rows);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                        const std::size_t begin = b * kParallelBlockRows;
+                        body(begin, std::min(rows, begin + kParallelBlockRows));
+                      }
+                    });
+}
+
+}  // namespace tickfx

@@ -1,0 +1,18 @@
+// Per-particle parallel loops whose results cannot depend on the thread count.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+
+namespace tickfx {
+
+/// Rows per block. Blocks are fixed by the row count alone, never by the number of threads, so
+/// a kernel that writes only its own rows gives the same bits under any schedule.
+inline constexpr std::size_t kParallelBlockRows = 8192;
+
+/// Calls `body(begin, end)` for consecutive blocks of [0, rows), in parallel with TBB when there
+/// is more than one block. `body` must write only rows [begin, end) of its outputs; reading any
+/// row of inputs that no block writes during the loop is fine (a gather).
+void parallelForRows(std::size_t rows, const std::function<void(std::size_t, std::size_t)>& body);
+
+}  // namespace tickfx

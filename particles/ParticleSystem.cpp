@@ -1,0 +1,89 @@
+#include "particles/ParticleSystem.h"
+
+#include <stdexcept>
+#include <tbb/task_arena.h>
+
+#include "particles/ParallelFor.h"
+
+namespace tickfx {
+
+class ParticleSystem::ThreadArena {
+ public:
+  explicit ThreadArena(int threads)
+      : arena_(threads > 0 ? threads : tbb::task_arena::automatic) {}
+  template <typename F>
+  void execute(F&& f) {
+    arena_.execute(std::forward<F>(f));
+  }
+
+ private:
+  tbb::task_arena arena_;
+};
+
+namespace {
+
+std::vector<Emitter> makeEmitters(const std::vector<EmitterSettings>& settings, std::int64_t rate) {
+  std::vector<Emitter> emitters;
+  emitters.reserve(settings.size());
+  for (std::size_t i = 0; i < settings.size(); ++i) {
+    emitters.emplace_back(settings[i], static_cast<std::uint32_t>(i), rate);
+  }
+  return emitters;
+}
+
+}  // namespace
+
+ParticleSystem::ParticleSystem(const SystemSettings& settings,
+                               const std::vector<EmitterSettings>& emitters, ForceSet forces)
+    : settings_(settings),
+      pool_(settings.maxParticles),
+      emitters_(makeEmitters(emitters, settings.stepRateHz)),
+      forces_(std::move(forces)),
+      integrator_(makeIntegrator(settings.integrator)),
+      driver_(settings.stepRateHz, settings.maxTicksPerFrame, settings.overrunPolicy),
+      arena_(std::make_unique<ThreadArena>(settings.threads)) {
+  if (settings.threads < 0) throw std::invalid_argument("threads must be >= 0");
+}
+
+ParticleSystem::~ParticleSystem() = default;
+
+AdvanceResult ParticleSystem::advance(Flicks frame) {
+  const AdvanceResult result = driver_.advance(frame);
+  stepTicks(result.ticks);
+  alpha_ = result.alpha;
+  return result;
+}
+
+void ParticleSystem::step() { stepTicks(1); }
+
+void ParticleSystem::stepTicks(std::int64_t ticks) {
+  if (ticks <= 0) return;
+  arena_->execute([&] {
+    for (std::int64_t i = 0; i < ticks; ++i) runTick();
+  });
+}
+
+void ParticleSystem::runTick() {
+  for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, tick_);
+  forces_.beginTick(pool_, tick_);
+  integrator_->step(pool_, forces_, StepTime{tick_, settings_.stepRateHz});
+  pool_.markAllStepped();
+  ++tick_;
+  pool_.updateAges(tick_, settings_.stepRateHz);
+  pool_.removeDead();
+}
+
+void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
+  const std::size_t n = pool_.size();
+  out.resize(static_cast<Eigen::Index>(n));
+  const Vec3Column& p = pool_.position();
+  const Vec3Column& prev = pool_.previousPosition();
+  parallelForRows(n, [&](std::size_t b, std::size_t e) {
+    const auto i = static_cast<Eigen::Index>(b), m = static_cast<Eigen::Index>(e - b);
+    for (int c = 0; c < 3; ++c) {
+      out[c].segment(i, m) = prev[c].segment(i, m) + (p[c].segment(i, m) - prev[c].segment(i, m)) * alpha;
+    }
+  });
+}
+
+}  // namespace tickfx

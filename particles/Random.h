@@ -1,0 +1,42 @@
+// Counter-based random numbers: a value is a pure function of its coordinates.
+#pragma once
+
+#include <cstdint>
+
+namespace tickfx {
+
+/// What a random number is for. Each purpose draws from its own stream, so adding a draw for one
+/// purpose never shifts the values of another.
+enum class RandomPurpose : std::uint32_t {
+  PositionU = 1,
+  PositionV = 2,
+  PositionW = 3,
+  DirectionU = 4,
+  DirectionV = 5,
+  Speed = 6,
+  Lifetime = 7,
+  Mass = 8,
+  Custom = 64,  // Custom + k for user-defined draws
+};
+
+/// The coordinates of one random number. Nothing here depends on the frame, the thread or the
+/// order of calls, which is what lets a particle's birth look the same under any schedule.
+struct RandomKey {
+  std::uint64_t seed = 0;     // the effect's seed
+  std::uint32_t emitter = 0;  // index of the emitter in the effect
+  std::uint64_t serial = 0;   // the emitter's count of particles before this one
+  std::uint32_t purpose = 0;  // a RandomPurpose
+};
+
+/// 64 well-mixed bits for `key` (a keyed SplitMix64-style finaliser over the four coordinates).
+std::uint64_t randomBits(const RandomKey& key);
+
+/// Uniform in [0, 1) with 53 random bits; pure function of `key`.
+double randomUniform(const RandomKey& key);
+
+/// Uniform in [0, 1) with 53 random bits.
+inline double uniformFromBits(std::uint64_t bits) {
+  return static_cast<double>(bits >> 11) * 0x1.0p-53;
+}
+
+}  // namespace tickfx
