@@ -17,23 +17,69 @@ struct RowRange {
   Eigen::Index count() const { return static_cast<Eigen::Index>(end - begin); }
 };
 
-/// The state at which an integrator asks for accelerations. `position` and `velocity` may be the
-/// pool's own columns or an integrator's stage columns (RK4's midpoints); both hold at least
-/// pool.size() rows. Everything else (mass, ids, attributes) comes from `pool`.
+/// Writable values of three components for the rows of one RowRange: element j of each map
+/// belongs to pool row range.begin + j.
+struct Vec3Rows {
+  Eigen::Map<FloatColumn> x, y, z;
+
+  Vec3Rows(float* px, float* py, float* pz, Eigen::Index n) : x(px, n), y(py, n), z(pz, n) {}
+  /// Rows `r` of a pool-sized column.
+  static Vec3Rows of(Vec3Column& c, RowRange r) {
+    return {c.x.data() + r.begin, c.y.data() + r.begin, c.z.data() + r.begin, r.count()};
+  }
+  Eigen::Map<FloatColumn>& operator[](int c) { return c == 0 ? x : (c == 1 ? y : z); }
+};
+
+/// Read-only values of three components for the rows of one RowRange.
+struct ConstVec3Rows {
+  Eigen::Map<const FloatColumn> x, y, z;
+
+  ConstVec3Rows(const float* px, const float* py, const float* pz, Eigen::Index n)
+      : x(px, n), y(py, n), z(pz, n) {}
+  const Eigen::Map<const FloatColumn>& operator[](int c) const { return c == 0 ? x : (c == 1 ? y : z); }
+};
+
+/// A vector quantity an integrator hands to the forces: row r is at index r − base of each
+/// component. The pool's own columns have base 0 and hold every row; an integrator's scratch in a
+/// fused pass holds only the rows of the current tile (base = the tile's first row), which is
+/// enough because a fused pass only ever runs local modules.
+struct Vec3View {
+  const float* x = nullptr;
+  const float* y = nullptr;
+  const float* z = nullptr;
+  std::size_t base = 0;
+
+  static Vec3View of(const Vec3Column& c) { return {c.x.data(), c.y.data(), c.z.data(), 0}; }
+  /// The values of rows `r`.
+  ConstVec3Rows rows(RowRange r) const {
+    const std::size_t i = r.begin - base;
+    return {x + i, y + i, z + i, r.count()};
+  }
+  /// The value of one row (non-local modules: any row of a base-0 view).
+  Eigen::Vector3f at(std::size_t row) const {
+    const std::size_t i = row - base;
+    return {x[i], y[i], z[i]};
+  }
+};
+
+/// The state at which an integrator asks for accelerations: the pool's own columns or an
+/// integrator's stage values (RK4's midpoints). Everything else (mass, ids, attributes) comes
+/// from `pool`, indexed by pool row.
 struct ForceInput {
   const ParticlePool& pool;
-  const Vec3Column& position;  // metres
-  const Vec3Column& velocity;  // metres per second
-  double time = 0.0;           // seconds since tick 0, exact to double for the stage asked
-  std::int64_t tick = 0;       // the tick being integrated
+  Vec3View position;    // metres
+  Vec3View velocity;    // metres per second
+  double time = 0.0;    // seconds since tick 0, for the stage asked (t, t + dt/2, t + dt)
+  std::int64_t tick = 0;  // the tick being integrated
 };
 
 /// A force module adds acceleration (m/s²) to particles. Modules are composed in an ordered list
 /// (ForceSet) and evaluated in that order, so the floating-point sum is the same on every run.
 ///
 /// Threading: accumulate() is called concurrently for disjoint row ranges and must write only
-/// the rows it is given (gather, never scatter). It may read any row of the input. Per-thread
-/// caches (an OpenVDB value accessor, say) belong inside accumulate(), built per call.
+/// the rows it is given (gather, never scatter). A local module reads only those rows of the
+/// input; a non-local one (springs) may read any row. Per-thread caches (an OpenVDB value
+/// accessor, say) belong inside accumulate(), built per call.
 class ForceModule {
  public:
   virtual ~ForceModule() = default;
@@ -41,15 +87,23 @@ class ForceModule {
   /// The module's type as written in effect files ("gravity", "drag", ...).
   virtual std::string_view typeName() const = 0;
 
-  /// True when a particle's acceleration depends on its own row only. Integrators then fuse the
-  /// evaluation with the update in one pass; a module reading other rows (springs) must say false.
+  /// True when a particle's acceleration depends on its own row only. Integrators then fuse all
+  /// their passes over a small tile of rows; a module reading other rows must say false.
   virtual bool isLocal() const { return true; }
+
+  /// When the acceleration at `in` is the same for every particle, stores it in `a` and returns
+  /// true. ForceSet then adds a leading run of such modules once per evaluation instead of once
+  /// per particle; the per-particle sum keeps the same order, so the bits do not change.
+  virtual bool uniformAcceleration(const ForceInput& /*in*/, Eigen::Vector3f& /*a*/) const {
+    return false;
+  }
 
   /// Called once per tick, on one thread, before any accumulate(): rebuild per-tick tables.
   virtual void beginTick(const ParticlePool& /*pool*/, std::int64_t /*tick*/) {}
 
-  /// Adds this module's acceleration at `in` to rows `rows` of `acceleration`.
-  virtual void accumulate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const = 0;
+  /// Adds this module's acceleration at `in` to `acceleration`, whose element j is row
+  /// rows.begin + j.
+  virtual void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const = 0;
 };
 
 }  // namespace tickfx

@@ -17,11 +17,20 @@ void ForceSet::beginTick(const ParticlePool& pool, std::int64_t tick) {
   for (auto& m : modules_) m->beginTick(pool, tick);
 }
 
-void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const {
-  acceleration.x.segment(rows.offset(), rows.count()).setZero();
-  acceleration.y.segment(rows.offset(), rows.count()).setZero();
-  acceleration.z.segment(rows.offset(), rows.count()).setZero();
-  for (const auto& m : modules_) m->accumulate(in, rows, acceleration);
+void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
+  // Only a leading run of uniform modules is folded: (0 + g) + w is then the very sum each row
+  // would have formed, while folding a uniform module after a per-row one would reorder it.
+  Eigen::Vector3f uniform = Eigen::Vector3f::Zero();
+  std::size_t next = 0;
+  for (Eigen::Vector3f a; next < modules_.size() && modules_[next]->uniformAcceleration(in, a); ++next) {
+    uniform.x() += a.x();
+    uniform.y() += a.y();
+    uniform.z() += a.z();
+  }
+  acceleration.x.setConstant(uniform.x());
+  acceleration.y.setConstant(uniform.y());
+  acceleration.z.setConstant(uniform.z());
+  for (; next < modules_.size(); ++next) modules_[next]->accumulate(in, rows, acceleration);
 }
 
 }  // namespace tickfx

@@ -27,8 +27,9 @@ class ForceSet {
 
   void beginTick(const ParticlePool& pool, std::int64_t tick);
 
-  /// Writes the total acceleration at `in` into rows `rows` of `acceleration` (overwrites).
-  void evaluate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const;
+  /// Writes the total acceleration at `in` for rows `rows` into `acceleration` (overwrites):
+  /// 0 + a_1 + a_2 + ... in module order, for every row.
+  void evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const;
 
  private:
   std::vector<std::unique_ptr<ForceModule>> modules_;

@@ -2,10 +2,15 @@
 
 namespace tickfx {
 
-void Gravity::accumulate(const ForceInput& /*in*/, RowRange rows, Vec3Column& a) const {
-  a.x.segment(rows.offset(), rows.count()) += g_.x();
-  a.y.segment(rows.offset(), rows.count()) += g_.y();
-  a.z.segment(rows.offset(), rows.count()) += g_.z();
+bool Gravity::uniformAcceleration(const ForceInput& /*in*/, Eigen::Vector3f& a) const {
+  a = g_;
+  return true;
+}
+
+void Gravity::accumulate(const ForceInput& /*in*/, RowRange /*rows*/, Vec3Rows& a) const {
+  a.x += g_.x();
+  a.y += g_.y();
+  a.z += g_.z();
 }
 
 }  // namespace tickfx

@@ -2,11 +2,11 @@
 
 namespace tickfx {
 
-void LinearDrag::accumulate(const ForceInput& in, RowRange rows, Vec3Column& a) const {
-  const Eigen::Index b = rows.offset(), n = rows.count();
-  a.x.segment(b, n) += k_ * (air_.x() - in.velocity.x.segment(b, n));
-  a.y.segment(b, n) += k_ * (air_.y() - in.velocity.y.segment(b, n));
-  a.z.segment(b, n) += k_ * (air_.z() - in.velocity.z.segment(b, n));
+void LinearDrag::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& a) const {
+  const ConstVec3Rows v = in.velocity.rows(rows);
+  a.x += k_ * (air_.x() - v.x);
+  a.y += k_ * (air_.y() - v.y);
+  a.z += k_ * (air_.z() - v.z);
 }
 
 }  // namespace tickfx

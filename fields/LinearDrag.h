@@ -12,7 +12,7 @@ class LinearDrag final : public ForceModule {
   LinearDrag(float k, const Eigen::Vector3f& airVelocity = Eigen::Vector3f::Zero())
       : k_(k), air_(airVelocity) {}
   std::string_view typeName() const override { return "drag"; }
-  void accumulate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const override;
+  void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
 
  private:
   float k_;

@@ -20,12 +20,17 @@ float PeriodicWind::strength(double t) const {
   return static_cast<float>(s_.base + s_.amplitude * det::sin(angle));
 }
 
-void PeriodicWind::accumulate(const ForceInput& in, RowRange rows, Vec3Column& a) const {
+bool PeriodicWind::uniformAcceleration(const ForceInput& in, Eigen::Vector3f& a) const {
   const float w = strength(in.time);
-  const Eigen::Index b = rows.offset(), n = rows.count();
-  a.x.segment(b, n) += s_.direction.x() * w;
-  a.y.segment(b, n) += s_.direction.y() * w;
-  a.z.segment(b, n) += s_.direction.z() * w;
+  a = Eigen::Vector3f(s_.direction.x() * w, s_.direction.y() * w, s_.direction.z() * w);
+  return true;
+}
+
+void PeriodicWind::accumulate(const ForceInput& in, RowRange /*rows*/, Vec3Rows& a) const {
+  const float w = strength(in.time);
+  a.x += s_.direction.x() * w;
+  a.y += s_.direction.y() * w;
+  a.z += s_.direction.z() * w;
 }
 
 }  // namespace tickfx

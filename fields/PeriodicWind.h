@@ -22,7 +22,8 @@ class PeriodicWind final : public ForceModule {
 
   explicit PeriodicWind(const Settings& settings);
   std::string_view typeName() const override { return "wind"; }
-  void accumulate(const ForceInput& in, RowRange rows, Vec3Column& acceleration) const override;
+  bool uniformAcceleration(const ForceInput& in, Eigen::Vector3f& a) const override;
+  void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   /// The scalar strength (m/s²) at time `t` seconds.
   float strength(double t) const;
 

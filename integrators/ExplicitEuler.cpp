@@ -1,23 +1,25 @@
 #include "integrators/ExplicitEuler.h"
 
-#include "integrators/StagePasses.h"
-
 namespace tickfx {
 
 void ExplicitEuler::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
-  ensureRows(accel_, pool.storageRows());
   const float dt = time.dt();
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  const ForceInput in{pool, p, v, time.at(0.0), time.tick};
-  runPasses(pool.size(), forces.isLocal(),
-            {[&](RowRange r) { forces.evaluate(in, r, accel_); },
-             [&](RowRange r) {
+  const double t0 = time.at(0.0);
+  runPasses(pool.size(), forces.isLocal(), scratch_,
+            {[&](const Tile& tile) {
+               Vec3Rows a = tile.stage(0);
+               forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, tile.rows(), a);
+             },
+             [&](const Tile& tile) {
+               Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                        old = rowsOf(prev, tile.rows());
                for (int c = 0; c < 3; ++c) {
-                 rowsOf(prev[c], r) = rowsOf(p[c], r);
-                 rowsOf(p[c], r) += rowsOf(v[c], r) * dt;
-                 rowsOf(v[c], r) += rowsOf(accel_[c], r) * dt;
+                 old[c] = pr[c];
+                 pr[c] += vr[c] * dt;
+                 vr[c] += a[c] * dt;
                }
              }});
 }

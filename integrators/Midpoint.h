@@ -2,6 +2,7 @@
 #pragma once
 
 #include "integrators/Integrator.h"
+#include "integrators/StagePasses.h"
 
 namespace tickfx {
 
@@ -15,7 +16,7 @@ class Midpoint final : public Integrator {
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
-  Vec3Column accel_, midVelocity_;
+  StageScratch scratch_{2};  // acceleration, midpoint velocity
 };
 
 }  // namespace tickfx

@@ -1,35 +1,42 @@
 #include "integrators/PositionVerlet.h"
 
-#include "integrators/StagePasses.h"
-
 namespace tickfx {
 
 void PositionVerlet::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
-  ensureRows(accel_, pool.storageRows());
   const float dt = time.dt();
   const float dt2 = dt * dt;
   const float halfDt2 = 0.5f * dt2;
-  const float invDt = static_cast<float>(static_cast<double>(time.stepRateHz));
+  const float invDt = static_cast<float>(time.stepRateHz);
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = pool.firstUnstepped();
-  const ForceInput in{pool, p, v, time.at(0.0), time.tick};
-  runPasses(pool.size(), forces.isLocal(),
-            {[&](RowRange r) { forces.evaluate(in, r, accel_); },
-             [&](RowRange r) {
-               // A new particle has no history: synthesise the position it would have had.
-               const RowRange started = intersect(r, fresh, pool.size());
-               for (int c = 0; c < 3; ++c) {
-                 rowsOf(prev[c], started) = rowsOf(p[c], started) - rowsOf(v[c], started) * dt +
-                                            rowsOf(accel_[c], started) * halfDt2;
+  const std::size_t n = pool.size();
+  const double t0 = time.at(0.0);
+  runPasses(n, forces.isLocal(), scratch_,
+            {[&](const Tile& tile) {
+               Vec3Rows a = tile.stage(0);
+               forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, tile.rows(), a);
+             },
+             [&](const Tile& tile) {
+               const RowRange r = tile.rows();
+               // A new particle has no history: give it the position it would have had a step ago.
+               const RowRange started = intersect(r, fresh, n);
+               if (started.count() > 0) {
+                 const std::size_t i = started.begin - r.begin;
+                 Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started), vr = rowsOf(v, started);
+                 Vec3Rows a = tile.stage(0);
+                 for (int c = 0; c < 3; ++c) {
+                   old[c] = pr[c] - vr[c] * dt + a[c].segment(static_cast<Eigen::Index>(i), started.count()) * halfDt2;
+                 }
                }
+               Vec3Rows a = tile.stage(0), next = tile.stage(1), pr = rowsOf(p, r), vr = rowsOf(v, r),
+                        old = rowsOf(prev, r);
                for (int c = 0; c < 3; ++c) {
-                 // v temporarily holds p_new so the update needs no extra column.
-                 rowsOf(v[c], r) = (rowsOf(p[c], r) * 2.0f - rowsOf(prev[c], r)) + rowsOf(accel_[c], r) * dt2;
-                 rowsOf(prev[c], r) = rowsOf(p[c], r);
-                 rowsOf(p[c], r) = rowsOf(v[c], r);
-                 rowsOf(v[c], r) = (rowsOf(p[c], r) - rowsOf(prev[c], r)) * invDt;
+                 next[c] = (pr[c] * 2.0f - old[c]) + a[c] * dt2;
+                 old[c] = pr[c];
+                 pr[c] = next[c];
+                 vr[c] = (pr[c] - old[c]) * invDt;
                }
              }});
 }

@@ -1,53 +1,59 @@
 #include "integrators/RungeKutta4.h"
 
-#include "integrators/StagePasses.h"
-
 namespace tickfx {
+namespace {
+
+// Slots of the stage scratch; kState stands for the pool's own columns (the state at t).
+enum Slot : int { kState = -1, K1 = 0, K2, K3, K4, P2, V2, P3, V3, P4, V4 };
+
+}  // namespace
 
 void RungeKutta4::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
-  for (Vec3Column* c : {&k1_, &k2_, &k3_, &k4_, &p2_, &v2_, &p3_, &v3_, &p4_, &v4_}) {
-    ensureRows(*c, pool.storageRows());
-  }
   const float h = time.dt();
   const float halfH = 0.5f * h;
   const float sixthH = h / 6.0f;
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  const ForceInput s1{pool, p, v, time.at(0.0), time.tick};
-  const ForceInput s2{pool, p2_, v2_, time.at(0.5), time.tick};
-  const ForceInput s3{pool, p3_, v3_, time.at(0.5), time.tick};
-  const ForceInput s4{pool, p4_, v4_, time.at(1.0), time.tick};
-  runPasses(pool.size(), forces.isLocal(),
-            {[&](RowRange r) { forces.evaluate(s1, r, k1_); },
-             [&](RowRange r) {
+  const double t0 = time.at(0.0), tHalf = time.at(0.5), t1 = time.at(1.0);
+
+  auto velocityRows = [&](const Tile& tile, int slot) {
+    return slot == kState ? rowsOf(v, tile.rows()) : tile.stage(slot);
+  };
+  // k_out = a(P_in, V_in, t)
+  auto evaluate = [&](int pIn, int vIn, double t, int out) {
+    return [&, pIn, vIn, t, out](const Tile& tile) {
+      Vec3Rows k = tile.stage(out);
+      const Vec3View pos = pIn == kState ? Vec3View::of(p) : tile.view(pIn);
+      const Vec3View vel = vIn == kState ? Vec3View::of(v) : tile.view(vIn);
+      forces.evaluate({pool, pos, vel, t, time.tick}, tile.rows(), k);
+    };
+  };
+  // (P_out, V_out) = (p + V_in · step, v + K_in · step)
+  auto advance = [&](int vIn, int kIn, int pOut, int vOut, float step) {
+    return [&, vIn, kIn, pOut, vOut, step](const Tile& tile) {
+      Vec3Rows vi = velocityRows(tile, vIn), k = tile.stage(kIn), po = tile.stage(pOut),
+               vo = tile.stage(vOut), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows());
+      for (int c = 0; c < 3; ++c) {
+        po[c] = pr[c] + vi[c] * step;
+        vo[c] = vr[c] + k[c] * step;
+      }
+    };
+  };
+  runPasses(pool.size(), forces.isLocal(), scratch_,
+            {evaluate(kState, kState, t0, K1), advance(kState, K1, P2, V2, halfH),
+             evaluate(P2, V2, tHalf, K2), advance(V2, K2, P3, V3, halfH),
+             evaluate(P3, V3, tHalf, K3), advance(V3, K3, P4, V4, h),
+             evaluate(P4, V4, t1, K4),
+             [&](const Tile& tile) {
+               Vec3Rows k1 = tile.stage(K1), k2 = tile.stage(K2), k3 = tile.stage(K3), k4 = tile.stage(K4);
+               Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
+               Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                        old = rowsOf(prev, tile.rows());
                for (int c = 0; c < 3; ++c) {
-                 rowsOf(p2_[c], r) = rowsOf(p[c], r) + rowsOf(v[c], r) * halfH;
-                 rowsOf(v2_[c], r) = rowsOf(v[c], r) + rowsOf(k1_[c], r) * halfH;
-               }
-             },
-             [&](RowRange r) { forces.evaluate(s2, r, k2_); },
-             [&](RowRange r) {
-               for (int c = 0; c < 3; ++c) {
-                 rowsOf(p3_[c], r) = rowsOf(p[c], r) + rowsOf(v2_[c], r) * halfH;
-                 rowsOf(v3_[c], r) = rowsOf(v[c], r) + rowsOf(k2_[c], r) * halfH;
-               }
-             },
-             [&](RowRange r) { forces.evaluate(s3, r, k3_); },
-             [&](RowRange r) {
-               for (int c = 0; c < 3; ++c) {
-                 rowsOf(p4_[c], r) = rowsOf(p[c], r) + rowsOf(v3_[c], r) * h;
-                 rowsOf(v4_[c], r) = rowsOf(v[c], r) + rowsOf(k3_[c], r) * h;
-               }
-             },
-             [&](RowRange r) { forces.evaluate(s4, r, k4_); },
-             [&](RowRange r) {
-               for (int c = 0; c < 3; ++c) {
-                 rowsOf(prev[c], r) = rowsOf(p[c], r);
-                 rowsOf(p[c], r) += ((rowsOf(v[c], r) + rowsOf(v2_[c], r) * 2.0f) +
-                                     (rowsOf(v3_[c], r) * 2.0f + rowsOf(v4_[c], r))) * sixthH;
-                 rowsOf(v[c], r) += ((rowsOf(k1_[c], r) + rowsOf(k2_[c], r) * 2.0f) +
-                                     (rowsOf(k3_[c], r) * 2.0f + rowsOf(k4_[c], r))) * sixthH;
+                 old[c] = pr[c];
+                 pr[c] += ((vr[c] + v2[c] * 2.0f) + (v3[c] * 2.0f + v4[c])) * sixthH;
+                 vr[c] += ((k1[c] + k2[c] * 2.0f) + (k3[c] * 2.0f + k4[c])) * sixthH;
                }
              }});
 }

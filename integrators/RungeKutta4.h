@@ -2,6 +2,7 @@
 #pragma once
 
 #include "integrators/Integrator.h"
+#include "integrators/StagePasses.h"
 
 namespace tickfx {
 
@@ -15,7 +16,7 @@ class RungeKutta4 final : public Integrator {
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
-  Vec3Column k1_, k2_, k3_, k4_, p2_, v2_, p3_, v3_, p4_, v4_;
+  StageScratch scratch_{10};  // k1..k4, then the stage states p2 v2 p3 v3 p4 v4
 };
 
 }  // namespace tickfx

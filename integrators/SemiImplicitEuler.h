@@ -2,6 +2,7 @@
 #pragma once
 
 #include "integrators/Integrator.h"
+#include "integrators/StagePasses.h"
 
 namespace tickfx {
 
@@ -15,7 +16,7 @@ class SemiImplicitEuler final : public Integrator {
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
-  Vec3Column accel_;
+  StageScratch scratch_{1};  // acceleration
 };
 
 }  // namespace tickfx

@@ -1,21 +1,47 @@
 #include "integrators/StagePasses.h"
 
 #include <algorithm>
-#include <vector>
+#include <array>
+#include <stdexcept>
 
 #include "particles/ParallelFor.h"
 
 namespace tickfx {
 
-void runPasses(std::size_t rows, bool fused, std::initializer_list<RowPass> passes) {
+StageScratch::StageScratch(int count) : count_(count), columns_(static_cast<std::size_t>(count)) {
+  if (count < 0 || count > kMaxColumns) throw std::invalid_argument("too many stage columns");
+}
+
+void StageScratch::ensureRows(std::size_t rows) {
+  for (Vec3Column& c : columns_) {
+    if (static_cast<std::size_t>(c.x.size()) < rows) c.resize(static_cast<Eigen::Index>(rows));
+  }
+}
+
+void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
+               std::initializer_list<RowPass> passes) {
+  const int count = scratch.count();
   if (fused) {
     parallelForRows(rows, [&](std::size_t b, std::size_t e) {
-      for (const RowPass& pass : passes) pass(RowRange{b, e});
+      alignas(64) float buffer[StageScratch::kMaxColumns * 3 * Tile::kRows];
+      float* stage[StageScratch::kMaxColumns][3];
+      for (std::size_t t = b; t < e; t += Tile::kRows) {
+        for (int k = 0; k < count; ++k) {
+          for (int c = 0; c < 3; ++c) stage[k][c] = buffer + (k * 3 + c) * Tile::kRows;
+        }
+        const Tile tile(RowRange{t, std::min(e, t + Tile::kRows)}, stage, count, t);
+        for (const RowPass& pass : passes) pass(tile);
+      }
     });
     return;
   }
+  scratch.ensureRows(rows);
+  float* stage[StageScratch::kMaxColumns][3];
+  for (int k = 0; k < count; ++k) {
+    for (int c = 0; c < 3; ++c) stage[k][c] = scratch.column(k)[c].data();
+  }
   for (const RowPass& pass : passes) {
-    parallelForRows(rows, [&](std::size_t b, std::size_t e) { pass(RowRange{b, e}); });
+    parallelForRows(rows, [&](std::size_t b, std::size_t e) { pass(Tile(RowRange{b, e}, stage, count, 0)); });
   }
 }
 
@@ -23,10 +49,6 @@ RowRange intersect(RowRange r, std::size_t begin, std::size_t end) {
   const std::size_t b = std::max(r.begin, begin);
   const std::size_t e = std::min(r.end, end);
   return b < e ? RowRange{b, e} : RowRange{b, b};
-}
-
-void ensureRows(Vec3Column& c, std::size_t rows) {
-  if (static_cast<std::size_t>(c.x.size()) < rows) c.resize(static_cast<Eigen::Index>(rows));
 }
 
 }  // namespace tickfx

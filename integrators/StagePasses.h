@@ -1,30 +1,74 @@
-// How an integrator's passes are scheduled over the rows.
+// How an integrator's passes are scheduled over the rows, and where its stage values live.
 #pragma once
 
 #include <functional>
 #include <initializer_list>
+#include <vector>
 
 #include "fields/ForceModule.h"
 
 namespace tickfx {
 
-/// One pass of an integrator over a row range: a force evaluation or a state update.
-using RowPass = std::function<void(RowRange)>;
+/// Stage values an integrator keeps during one tick (accelerations, RK4 midpoints, ...): `count`
+/// vector quantities per row. In a split run they are pool-sized columns owned here (kept between
+/// ticks so the steady state allocates nothing); in a fused run each tile uses a small buffer on
+/// its thread's stack and these columns are not touched.
+class StageScratch {
+ public:
+  static constexpr int kMaxColumns = 10;
+  explicit StageScratch(int count);
+  int count() const { return count_; }
+  Vec3Column& column(int k) { return columns_[static_cast<std::size_t>(k)]; }
+  /// Grows the pool-sized columns to `rows` (split runs only).
+  void ensureRows(std::size_t rows);
 
-/// Runs `passes` over rows [0, rows). With `fused` (all forces local) every block runs all
-/// passes in turn while its rows are in cache; otherwise each pass finishes for all rows before
-/// the next starts, because a non-local force reads rows that other blocks are updating.
-/// Either way each row sees exactly the same arithmetic, so the bits do not depend on the mode.
-void runPasses(std::size_t rows, bool fused, std::initializer_list<RowPass> passes);
+ private:
+  int count_;
+  std::vector<Vec3Column> columns_;
+};
+
+/// What one pass sees: a range of rows and the stage values for exactly those rows.
+class Tile {
+ public:
+  static constexpr std::size_t kRows = 512;
+
+  /// `stage[k][c]` points at the value of row `base` for stage value k, component c.
+  Tile(RowRange rows, float* const (*stage)[3], int count, std::size_t base)
+      : rows_(rows), stage_(stage), count_(count), base_(base) {}
+
+  RowRange rows() const { return rows_; }
+  /// Stage value `k` for this tile's rows, writable.
+  Vec3Rows stage(int k) const {
+    const std::size_t i = rows_.begin - base_;
+    return {stage_[k][0] + i, stage_[k][1] + i, stage_[k][2] + i, rows_.count()};
+  }
+  /// Stage value `k` as forces read it (ForceInput::position or velocity).
+  Vec3View view(int k) const { return {stage_[k][0], stage_[k][1], stage_[k][2], base_}; }
+  int count() const { return count_; }
+
+ private:
+  RowRange rows_;
+  float* const (*stage_)[3];
+  int count_;
+  std::size_t base_;
+};
+
+/// One pass of an integrator over a tile: a force evaluation or a state update.
+using RowPass = std::function<void(const Tile&)>;
+
+/// Runs `passes` over rows [0, rows). With `fused` (every force local) each tile of Tile::kRows
+/// rows runs all passes in turn while its rows and stage values are in L1/L2 cache; otherwise
+/// each pass finishes for all rows before the next starts, because a non-local force reads rows
+/// that other blocks are updating. Each row sees exactly the same arithmetic either way, so the
+/// bits do not depend on the mode, the tile size or the thread count.
+void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
+               std::initializer_list<RowPass> passes);
 
 /// Rows of `r` that are also in [begin, end).
 RowRange intersect(RowRange r, std::size_t begin, std::size_t end);
 
-/// A column segment for rows `r`.
+/// Rows `r` of a pool column, writable or read-only.
+inline Vec3Rows rowsOf(Vec3Column& c, RowRange r) { return Vec3Rows::of(c, r); }
 inline auto rowsOf(FloatColumn& c, RowRange r) { return c.segment(r.offset(), r.count()); }
-inline auto rowsOf(const FloatColumn& c, RowRange r) { return c.segment(r.offset(), r.count()); }
-
-/// Grows scratch columns to the pool's storage (never shrinks, so steady state allocates nothing).
-void ensureRows(Vec3Column& c, std::size_t rows);
 
 }  // namespace tickfx

@@ -1,12 +1,8 @@
 #include "integrators/VelocityVerlet.h"
 
-#include "integrators/StagePasses.h"
-
 namespace tickfx {
 
 void VelocityVerlet::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
-  ensureRows(predictedVelocity_, pool.storageRows());
-  ensureRows(newAccel_, pool.storageRows());
   const float dt = time.dt();
   const float halfDt = 0.5f * dt;
   const float halfDt2 = 0.5f * dt * dt;
@@ -15,26 +11,34 @@ void VelocityVerlet::step(ParticlePool& pool, const ForceSet& forces, const Step
   Vec3Column& a = pool.acceleration();
   Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = pool.firstUnstepped();
-  const ForceInput start{pool, p, v, time.at(0.0), time.tick};
-  const ForceInput end{pool, p, predictedVelocity_, time.at(1.0), time.tick};
-  runPasses(pool.size(), forces.isLocal(),
-            {[&](RowRange r) {
+  const std::size_t n = pool.size();
+  const double t0 = time.at(0.0), t1 = time.at(1.0);
+  runPasses(n, forces.isLocal(), scratch_,
+            {[&](const Tile& tile) {
                // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
-               const RowRange started = intersect(r, fresh, pool.size());
-               if (started.count() > 0) forces.evaluate(start, started, a);
+               const RowRange started = intersect(tile.rows(), fresh, n);
+               if (started.count() == 0) return;
+               Vec3Rows out = rowsOf(a, started);
+               forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, started, out);
              },
-             [&](RowRange r) {
+             [&](const Tile& tile) {
+               Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                        ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
                for (int c = 0; c < 3; ++c) {
-                 rowsOf(prev[c], r) = rowsOf(p[c], r);
-                 rowsOf(p[c], r) += rowsOf(v[c], r) * dt + rowsOf(a[c], r) * halfDt2;
-                 rowsOf(predictedVelocity_[c], r) = rowsOf(v[c], r) + rowsOf(a[c], r) * dt;
+                 old[c] = pr[c];
+                 pr[c] += vr[c] * dt + ar[c] * halfDt2;
+                 vPred[c] = vr[c] + ar[c] * dt;
                }
              },
-             [&](RowRange r) { forces.evaluate(end, r, newAccel_); },
-             [&](RowRange r) {
+             [&](const Tile& tile) {
+               Vec3Rows aNew = tile.stage(1);
+               forces.evaluate({pool, Vec3View::of(p), tile.view(0), t1, time.tick}, tile.rows(), aNew);
+             },
+             [&](const Tile& tile) {
+               Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
                for (int c = 0; c < 3; ++c) {
-                 rowsOf(v[c], r) += (rowsOf(a[c], r) + rowsOf(newAccel_[c], r)) * halfDt;
-                 rowsOf(a[c], r) = rowsOf(newAccel_[c], r);
+                 vr[c] += (ar[c] + aNew[c]) * halfDt;
+                 ar[c] = aNew[c];
                }
              }});
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "integrators/Integrator.h"
+#include "integrators/StagePasses.h"
 
 namespace tickfx {
 
@@ -17,7 +18,7 @@ class VelocityVerlet final : public Integrator {
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
-  Vec3Column predictedVelocity_, newAccel_;
+  StageScratch scratch_{2};  // predicted velocity, new acceleration
 };
 
 }  // namespace tickfx

@@ -66,10 +66,12 @@ class ParticlePool {
   std::size_t firstUnstepped() const { return firstUnstepped_; }
   void markAllStepped() { firstUnstepped_ = size_; }
 
-  /// Recomputes every age from the integer tick count (never accumulated): age = (tick − birth) / rate.
+  /// Recomputes every age from the integer tick count (never accumulated),
+  /// age = float((tick − birth) · (1/rate)) with the product in double, and flags the particles
+  /// whose age reached their lifetime as dead.
   void updateAges(std::int64_t tick, std::int64_t stepRateHz);
-  /// Removes particles flagged dead or whose age reached their lifetime, keeping the order.
-  /// Returns how many were removed.
+  /// Removes the particles flagged dead (by a module, or by updateAges at the end of their
+  /// life), keeping the order of the rest. Returns how many were removed.
   std::size_t removeDead();
 
   // Columns. Storage may be longer than size(); only rows [0, size()) are meaningful.

@@ -6,7 +6,7 @@ add_test(NAME embed.find_package
     -DWORK_DIR=${PROJECT_BINARY_DIR}/embed-test
     -DGENERATOR=${CMAKE_GENERATOR}
     -DCXX_COMPILER=${CMAKE_CXX_COMPILER}
-    -P ${CMAKE_CURRENT_SOURCE_DIR}/EmbedTest.cmake)
+    -P ${CMAKE_CURRENT_SOURCE_DIR}/scripts/EmbedTest.cmake)
 set_tests_properties(embed.find_package PROPERTIES
   PASS_REGULAR_EXPRESSION "y after 1 s: -4\\.9050 m"
   TIMEOUT 600)
