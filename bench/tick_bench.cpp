@@ -1,0 +1,479 @@
+// One tick of gravity + periodic wind + linear drag with semi-implicit Euler: tickfx against the
+// array-of-structs loop a user would write by hand, measured in the same run so that the ratio
+// holds even on a machine whose absolute speed drifts.
+//
+//   tick_bench                    sizes 10⁴, 10⁶ and 10⁷ (under a minute on 2 cores)
+//   tick_bench --quick            smoke run: sizes 10⁴ and 10⁵, short timings
+//   tick_bench --sizes=1e4,1e6    only these particle counts
+//   tick_bench --min-time=0.5 --reps=9
+//
+// Cases, each starting from the same N particles (varied positions and velocities, infinite
+// lifetime, so the count never changes):
+//   AoS loop          std::vector<{Vector3f position, velocity}>, one thread: what a user writes.
+//   tickfx integrate  SemiImplicitEuler::step on the pool: force evaluation and state update
+//                     only, the part of a tick that does the physics.
+//   tickfx step()     ParticleSystem::step(): the above plus emitters, ForceSet::beginTick, age
+//                     recomputation and removal of the dead, i.e. what a tick costs a user.
+// Each tickfx case runs with 1 thread and with all threads, so the table separates the gain of
+// the layout from the gain of threading.
+//
+// Timing: each case runs in batches of ticks sized to take min-time/reps seconds; the cases of
+// one size take turns batch by batch (so a burst of outside load hits them all alike) until each
+// has at least `reps` batches and `min-time` seconds. A case's figure is the median over its
+// batches of the time per tick.
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "fields/ForceSet.h"
+#include "fields/Gravity.h"
+#include "fields/LinearDrag.h"
+#include "fields/PeriodicWind.h"
+#include "integrators/SemiImplicitEuler.h"
+#include "particles/ParticleSystem.h"
+
+#ifndef TICKFX_BENCH_CONFIG
+#define TICKFX_BENCH_CONFIG "unknown"
+#endif
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// ---- the scene, shared by both sides ----------------------------------------------------------
+
+constexpr std::int64_t kStepRateHz = 60;
+const Eigen::Vector3f kGravity(0.0f, -9.81f, 0.0f);
+// Not unit length on purpose: the baseline then has to normalise it the way PeriodicWind does,
+// and the check below shows that it did.
+const Eigen::Vector3f kWindDirection(1.0f, 0.0f, 0.5f);
+constexpr float kWindAmplitude = 3.0f;    // m/s²
+constexpr double kWindFrequencyHz = 4.0;  // well below the 30 Hz Nyquist limit of 60 Hz steps
+constexpr float kDragRate = 0.5f;         // 1/s
+const Eigen::Vector3f kAirVelocity(2.0f, 0.0f, -1.0f);
+
+tickfx::PeriodicWind::Settings windSettings() {
+  tickfx::PeriodicWind::Settings s;
+  s.direction = kWindDirection;
+  s.amplitude = kWindAmplitude;
+  s.frequency = kWindFrequencyHz;
+  return s;
+}
+
+// The order matters for the check: the sum gravity + wind + drag is rounded in this order on
+// both sides.
+tickfx::ForceSet makeForces() {
+  tickfx::ForceSet forces;
+  forces.add(std::make_unique<tickfx::Gravity>(kGravity));
+  forces.add(std::make_unique<tickfx::PeriodicWind>(windSettings()));
+  forces.add(std::make_unique<tickfx::LinearDrag>(kDragRate, kAirVelocity));
+  return forces;
+}
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// Uniform in [-1, 1), from the top 24 bits so that every value is an exact float.
+float symmetricUnit(std::uint64_t key) {
+  return static_cast<float>(splitmix64(key) >> 40) * 0x1p-23f - 1.0f;
+}
+
+struct Particle {
+  Eigen::Vector3f position, velocity;
+};
+
+// A pure function of the index, so both sides get the same state without a shared copy of it
+// (which at 10⁷ particles would be another 240 MB).
+Particle initialParticle(std::size_t i) {
+  const std::uint64_t k = 6 * static_cast<std::uint64_t>(i);
+  return {Eigen::Vector3f(10.0f * symmetricUnit(k), 10.0f * symmetricUnit(k + 1),
+                          10.0f * symmetricUnit(k + 2)),
+          Eigen::Vector3f(5.0f * symmetricUnit(k + 3), 5.0f * symmetricUnit(k + 4),
+                          5.0f * symmetricUnit(k + 5))};
+}
+
+// Keeps the compiler from treating stores that nothing reads inside the timed loop as dead.
+inline void escape(const void* p) {
+#if defined(__GNUC__) || defined(__clang__)
+  asm volatile("" : : "g"(p) : "memory");
+#else
+  static const void* volatile sink;
+  sink = p;
+#endif
+}
+
+// ---- the hand-written baseline ---------------------------------------------------------------
+
+class HandWrittenLoop {
+ public:
+  explicit HandWrittenLoop(std::size_t n) : wind_(windSettings()) {
+    particles_.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) particles_.push_back(initialParticle(i));
+    windDirection_ = kWindDirection;
+    windDirection_ /= windDirection_.norm();
+  }
+
+  void tick() {
+    const float dt = static_cast<float>(1.0 / static_cast<double>(kStepRateHz));
+    const double t = static_cast<double>(tick_) / static_cast<double>(kStepRateHz);
+    // The strength goes through PeriodicWind rather than std::sin so that both sides use the
+    // same bits of the sine: the check can then expect agreement to the last bit. It is one call
+    // per tick, nothing next to the particle loop.
+    const Eigen::Vector3f wind = windDirection_ * wind_.strength(t);
+    const Eigen::Vector3f g = kGravity, air = kAirVelocity;
+    const float k = kDragRate;
+    for (Particle& q : particles_) {
+      const Eigen::Vector3f a = g + wind + k * (air - q.velocity);
+      q.velocity += a * dt;
+      q.position += q.velocity * dt;
+    }
+    ++tick_;
+    escape(particles_.data());
+  }
+
+  const std::vector<Particle>& particles() const { return particles_; }
+
+ private:
+  std::vector<Particle> particles_;
+  tickfx::PeriodicWind wind_;
+  Eigen::Vector3f windDirection_;
+  std::int64_t tick_ = 0;
+};
+
+// ---- tickfx side -----------------------------------------------------------------------------
+
+std::unique_ptr<tickfx::ParticleSystem> makeSystem(std::size_t n, int threads) {
+  tickfx::SystemSettings settings;
+  settings.stepRateHz = kStepRateHz;
+  settings.integrator = "semi_implicit_euler";
+  settings.maxParticles = n;
+  settings.threads = threads;
+  auto system = std::make_unique<tickfx::ParticleSystem>(
+      settings, std::vector<tickfx::EmitterSettings>{}, makeForces());
+  tickfx::ParticlePool& pool = system->pool();
+  pool.reserve(n);  // one allocation instead of the doubling growth
+  for (std::size_t i = 0; i < n; ++i) {
+    const Particle p = initialParticle(i);
+    tickfx::ParticleInit init;
+    init.position = p.position;
+    init.velocity = p.velocity;
+    pool.spawn(init, 0);
+  }
+  return system;
+}
+
+struct Difference {
+  double position = 0.0, velocity = 0.0;  // largest absolute difference, m and m/s
+  bool withinRoundOff = true;
+};
+
+Difference compare(const HandWrittenLoop& aos, const tickfx::ParticlePool& pool,
+                   Difference d = {}) {
+  // A few float ulps of the larger magnitude: what reordering one sum could cost.
+  constexpr double kRelative = 8.0 * std::numeric_limits<float>::epsilon();
+  const std::vector<Particle>& ps = aos.particles();
+  if (pool.size() != ps.size()) {
+    d.withinRoundOff = false;
+    return d;
+  }
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    for (int c = 0; c < 3; ++c) {
+      const double p0 = ps[i].position[c], p1 = pool.position()[c][r];
+      const double v0 = ps[i].velocity[c], v1 = pool.velocity()[c][r];
+      d.position = std::max(d.position, std::abs(p0 - p1));
+      d.velocity = std::max(d.velocity, std::abs(v0 - v1));
+      if (!(std::abs(p0 - p1) <= kRelative * std::max(1.0, std::abs(p0))) ||
+          !(std::abs(v0 - v1) <= kRelative * std::max(1.0, std::abs(v0)))) {
+        d.withinRoundOff = false;
+      }
+    }
+  }
+  return d;
+}
+
+double positionSum(const HandWrittenLoop& aos) {
+  double sum = 0.0;
+  for (const Particle& p : aos.particles()) sum += p.position.cast<double>().sum();
+  return sum;
+}
+
+double positionSum(const tickfx::ParticlePool& pool) {
+  const auto n = static_cast<Eigen::Index>(pool.size());
+  double sum = 0.0;
+  for (int c = 0; c < 3; ++c) sum += pool.position()[c].head(n).cast<double>().sum();
+  return sum;
+}
+
+// ---- timing ----------------------------------------------------------------------------------
+
+struct Case {
+  Case(std::string caseName, std::function<void(std::int64_t)> runTicks)
+      : name(std::move(caseName)), run(std::move(runTicks)) {}
+
+  std::string name;
+  std::function<void(std::int64_t ticks)> run;
+  std::int64_t batch = 1;
+  std::vector<double> secondsPerTick;
+  double timed = 0.0;
+};
+
+double timeBatch(Case& c) {
+  const Clock::time_point start = Clock::now();
+  c.run(c.batch);
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Grows the batch until it takes `target` seconds. Its runs are not recorded, so they are also
+// the warm-up (first-touch page faults of scratch columns, caches, TBB workers waking up).
+void calibrate(Case& c, double target) {
+  c.batch = 1;
+  for (;;) {
+    const double s = timeBatch(c);
+    if (s >= target) return;
+    const double grow = s > 0.0 ? std::min(10.0, 1.2 * target / s) : 10.0;
+    c.batch = std::max(c.batch + 1,
+                       static_cast<std::int64_t>(std::ceil(static_cast<double>(c.batch) * grow)));
+  }
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 == 1 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+struct Options {
+  std::vector<std::size_t> sizes{10'000, 1'000'000, 10'000'000};
+  double minTime = 0.3;
+  int reps = 5;
+};
+
+struct Row {
+  std::size_t n;
+  std::string name;
+  double stepsPerSecond;
+  double ratio;
+};
+
+std::string threadsLabel(int threads) {
+  return std::to_string(threads) + (threads == 1 ? " thread" : " threads");
+}
+
+// Runs every case for `n` particles; returns false when the two sides disagree.
+bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& rows,
+             double& checksum) {
+  std::printf("\nN = %zu\n", n);
+  std::fflush(stdout);
+  HandWrittenLoop aos(n);
+  std::unique_ptr<tickfx::ParticleSystem> one = makeSystem(n, 1);
+  std::unique_ptr<tickfx::ParticleSystem> all = allThreads > 1 ? makeSystem(n, 0) : nullptr;
+
+  // Tick 0 from the identical initial state on every side.
+  aos.tick();
+  one->step();
+  Difference d = compare(aos, one->pool());
+  if (all) {
+    all->step();
+    d = compare(aos, all->pool(), d);
+  }
+  std::printf("  check after one tick, AoS vs tickfx: max |dp| = %.3g m, max |dv| = %.3g m/s: %s\n",
+              d.position, d.velocity, d.withinRoundOff ? "ok" : "MISMATCH");
+
+  // The integrate cases get their own integrators (own scratch), on the systems' pools.
+  tickfx::SemiImplicitEuler integrateOne, integrateAll;
+  tbb::task_arena arenaOne(1), arenaAll(allThreads);
+  std::int64_t tickOne = one->tickCount(), tickAll = tickOne;
+  const auto integrate = [](tbb::task_arena& arena, tickfx::SemiImplicitEuler& integrator,
+                            tickfx::ParticleSystem& system, std::int64_t& tick,
+                            std::int64_t ticks) {
+    arena.execute([&] {
+      for (std::int64_t i = 0; i < ticks; ++i) {
+        integrator.step(system.pool(), system.forces(), tickfx::StepTime{tick++, kStepRateHz});
+      }
+    });
+  };
+
+  std::vector<Case> cases;
+  cases.emplace_back("AoS loop, 1 thread", [&](std::int64_t ticks) {
+    for (std::int64_t i = 0; i < ticks; ++i) aos.tick();
+  });
+  cases.emplace_back("tickfx integrate, " + threadsLabel(1), [&](std::int64_t ticks) {
+    integrate(arenaOne, integrateOne, *one, tickOne, ticks);
+  });
+  if (all) {
+    cases.emplace_back("tickfx integrate, " + threadsLabel(allThreads), [&](std::int64_t ticks) {
+      integrate(arenaAll, integrateAll, *all, tickAll, ticks);
+    });
+  }
+  // step() per tick, not stepTicks(): a frame usually runs one or two ticks, and the arena
+  // entry of each call is part of what a tick costs.
+  cases.emplace_back("tickfx step(), " + threadsLabel(1), [&](std::int64_t ticks) {
+    for (std::int64_t i = 0; i < ticks; ++i) one->step();
+  });
+  if (all) {
+    cases.emplace_back("tickfx step(), " + threadsLabel(allThreads), [&](std::int64_t ticks) {
+      for (std::int64_t i = 0; i < ticks; ++i) all->step();
+    });
+  }
+
+  const double target = o.minTime / o.reps;
+  for (Case& c : cases) calibrate(c, target);
+  const auto finished = [&](const Case& c) {
+    return static_cast<int>(c.secondsPerTick.size()) >= o.reps && c.timed >= o.minTime;
+  };
+  while (!std::all_of(cases.begin(), cases.end(), finished)) {
+    for (Case& c : cases) {
+      const double s = timeBatch(c);
+      c.secondsPerTick.push_back(s / static_cast<double>(c.batch));
+      c.timed += s;
+    }
+  }
+
+  const double aosSeconds = median(cases.front().secondsPerTick);
+  for (const Case& c : cases) {
+    const double s = median(c.secondsPerTick);
+    const auto [lo, hi] = std::minmax_element(c.secondsPerTick.begin(), c.secondsPerTick.end());
+    std::printf("  %-30s %10.4f ms/tick  (median of %zu batches of %lld ticks; %.4f to %.4f)\n",
+                c.name.c_str(), 1e3 * s, c.secondsPerTick.size(), static_cast<long long>(c.batch),
+                1e3 * *lo, 1e3 * *hi);
+    rows.push_back({n, c.name, static_cast<double>(n) / s, aosSeconds / s});
+  }
+  std::fflush(stdout);
+
+  checksum += positionSum(aos) + positionSum(one->pool()) + (all ? positionSum(all->pool()) : 0.0);
+  return d.withinRoundOff;
+}
+
+std::string cpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const std::size_t colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(" \t", colon + 1));
+    }
+  }
+  return "unknown CPU";
+}
+
+void usage(const char* argv0) {
+  std::printf(
+      "usage: %s [--quick] [--sizes=N[,N...]] [--min-time=SECONDS] [--reps=COUNT]\n"
+      "  --quick            smoke run: sizes 1e4,1e5 and --min-time=0.02\n"
+      "  --sizes=1e4,1e6    particle counts (default 1e4,1e6,1e7)\n"
+      "  --min-time=0.3     seconds each case is timed, per size\n"
+      "  --reps=5           minimum number of timed batches per case (the median is reported)\n",
+      argv0);
+}
+
+std::optional<std::vector<std::size_t>> parseSizes(std::string_view list) {
+  std::vector<std::size_t> sizes;
+  while (!list.empty()) {
+    const std::size_t comma = list.find(',');
+    const std::string item(list.substr(0, comma));
+    list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);  // accepts 1e6 as well as 1000000
+    if (item.empty() || *end != '\0' || !(v >= 1.0) || v > 4e9 || v != std::floor(v)) {
+      return std::nullopt;
+    }
+    sizes.push_back(static_cast<std::size_t>(v));
+  }
+  if (sizes.empty()) return std::nullopt;
+  return sizes;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  bool quick = false;
+  std::optional<std::vector<std::size_t>> sizes;
+  std::optional<double> minTime;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    const auto value = [&](std::string_view prefix) -> std::optional<std::string> {
+      if (arg.substr(0, prefix.size()) != prefix) return std::nullopt;
+      return std::string(arg.substr(prefix.size()));
+    };
+    if (arg == "--quick") {
+      quick = true;
+    } else if (auto v = value("--sizes=")) {
+      sizes = parseSizes(*v);
+      if (!sizes) {
+        std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
+        return 2;
+      }
+    } else if (auto t = value("--min-time=")) {
+      minTime = std::atof(t->c_str());
+      if (!(*minTime > 0.0)) {
+        std::fprintf(stderr, "bad --min-time: %s\n", t->c_str());
+        return 2;
+      }
+    } else if (auto r = value("--reps=")) {
+      o.reps = std::atoi(r->c_str());
+      if (o.reps < 1) {
+        std::fprintf(stderr, "bad --reps: %s\n", r->c_str());
+        return 2;
+      }
+    } else if (arg == "--help" || arg == "-h") {
+      usage(argv[0]);
+      return 0;
+    } else {
+      std::fprintf(stderr, "unknown argument: %s\n", argv[i]);
+      usage(argv[0]);
+      return 2;
+    }
+  }
+  if (quick) {
+    o.sizes = {10'000, 100'000};
+    o.minTime = 0.02;
+  }
+  if (sizes) o.sizes = *sizes;
+  if (minTime) o.minTime = *minTime;
+
+  const int allThreads = tbb::info::default_concurrency();
+  std::printf("tick_bench: one tick of gravity + wind + drag, semi-implicit Euler, %lld Hz\n",
+              static_cast<long long>(kStepRateHz));
+  std::printf("machine: %s, %u hardware threads (TBB uses %d)\n", cpuModel().c_str(),
+              std::thread::hardware_concurrency(), allThreads);
+  std::printf("build: %s, compiler %s\n", TICKFX_BENCH_CONFIG, __VERSION__);
+  if (std::string_view(TICKFX_BENCH_CONFIG) != "Release") {
+    std::printf("warning: not a Release build, the figures mean little\n");
+  }
+
+  std::vector<Row> rows;
+  double checksum = 0.0;
+  bool ok = true;
+  for (std::size_t n : o.sizes) ok = runSize(n, o, allThreads, rows, checksum) && ok;
+
+  std::printf("\nchecksum of final positions (keeps every case's work observable): %.9g\n",
+              checksum);
+  if (!ok) std::printf("CHECK FAILED: tickfx and the AoS loop disagree beyond round-off\n");
+  std::printf("\n%10s  %-30s %18s %14s\n", "N", "case", "particle-steps/s", "ratio vs AoS");
+  for (const Row& r : rows) {
+    std::printf("%10zu  %-30s %18.4g %14.2f\n", r.n, r.name.c_str(), r.stepsPerSecond, r.ratio);
+  }
+  return ok ? 0 : 1;
+}
