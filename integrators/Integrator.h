@@ -36,7 +36,8 @@ class Integrator {
   virtual ~Integrator() = default;
   /// The name used in effect files ("semi_implicit_euler", ...).
   virtual std::string_view name() const = 0;
-  /// Order of the global position error for smooth forces: 1, 2 or 4.
+  /// Order of the global position error for smooth forces that depend on time only: 1, 2 or 4
+  /// (see each scheme for position-dependent forces).
   virtual int order() const = 0;
   /// Force evaluations per tick (RK4: 4).
   virtual int evaluationsPerStep() const = 0;

@@ -7,7 +7,10 @@
 namespace tickfx {
 
 /// v_mid = v + a(p, v, t)·dt/2; p ← p + v_mid·dt; v ← v + a(p_new, v_mid, t + dt/2)·dt.
-/// Second order and exact for constant acceleration; not symplectic (loses oscillator energy).
+/// Exact for constant acceleration and second order for forces that depend on time only (a
+/// periodic wind). The second evaluation reads the *new* position, as the scheme is specified
+/// (a field is sampled where the particle now is), which makes it first order for forces that
+/// depend on position: on an undamped spring it loses energy every step. Not symplectic.
 class Midpoint final : public Integrator {
  public:
   std::string_view name() const override { return "midpoint"; }

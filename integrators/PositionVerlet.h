@@ -10,6 +10,11 @@ namespace tickfx {
 /// is the history; a particle in its first tick is started with p_prev = p − v·dt + a·dt²/2, which
 /// makes the first step p + v·dt + a·dt²/2 (exact for constant acceleration). The velocity is a
 /// backward difference, first order, and it lags half a step.
+///
+/// Precision: the velocity lives only in p − p_prev, and a·dt² is added to a position. In float,
+/// when a·dt² falls below the spacing of floats at |p| (at 1000 Hz, 9.8e-6 m against 3.1e-5 m
+/// at 490 m) the motion is quantised: after 10 s of free fall at 1000 Hz the error is metres.
+/// Prefer velocity Verlet for small steps far from the origin.
 class PositionVerlet final : public Integrator {
  public:
   std::string_view name() const override { return "position_verlet"; }
