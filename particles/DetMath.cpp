@@ -9,7 +9,7 @@ namespace {
 // π/2 split into three parts whose products with a small integer are exact (Cody–Waite), so the
 // reduced argument keeps full precision for |x| up to about 1e5.
 constexpr double kPio2Hi = 1.57079632673412561417e+00;
-constexpr double kPio2Mid = 6.07710050650619224932e-11;
+constexpr double kPio2Mid = 6.07710050630396597660e-11;
 constexpr double kPio2Lo = 2.02226624879595063154e-21;
 constexpr double kTwoOverPi = 6.36619772367581382433e-01;
 

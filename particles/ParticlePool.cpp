@@ -124,7 +124,8 @@ void ParticlePool::updateAges(std::int64_t tick, std::int64_t stepRateHz) {
 
 std::size_t ParticlePool::removeDead() {
   // Most ticks nobody dies: find that out with one byte scan and touch nothing else.
-  const auto firstDead = std::find(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{1});
+  const auto firstDead = std::find_if(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_),
+                                      [](std::uint8_t d) { return d != 0; });
   const auto first = static_cast<std::size_t>(firstDead - dead_.begin());
   if (first == size_) return 0;
   for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_}) compact(*c, dead_, first, size_);

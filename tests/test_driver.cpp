@@ -1,0 +1,317 @@
+// The fixed-step driver and the system it drives: the state after T seconds is a function of T
+// alone, not of the frames that got there.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "CoreTestSupport.h"
+#include "particles/StateHash.h"
+
+namespace tickfx {
+namespace {
+
+constexpr Flicks kSecond = kFlicksPerSecond;
+
+// floor(T · rate / kFlicksPerSecond) in exact integers.
+std::int64_t ticksIn(Flicks total, std::int64_t rate) {
+  return static_cast<std::int64_t>(static_cast<__int128>(total) * rate / kFlicksPerSecond);
+}
+
+// The exact fraction of a tick left over after `total` flicks.
+double fractionIn(Flicks total, std::int64_t rate) {
+  const __int128 units = static_cast<__int128>(total) * rate;
+  return static_cast<double>(static_cast<std::int64_t>(units % kFlicksPerSecond)) /
+         static_cast<double>(kFlicksPerSecond);
+}
+
+// α is one float division of exact integers: within 2 roundings (≤ 2^-23 absolute below 1).
+constexpr double kAlphaTolerance = 0x1p-23;
+
+TEST(Clock, CommonFrameRatesAreWholeFlicks) {
+  EXPECT_EQ(frameDuration(FrameRate{24, 1}), 29'400'000);
+  EXPECT_EQ(frameDuration(FrameRate{30, 1}), 23'520'000);
+  EXPECT_EQ(frameDuration(FrameRate{60, 1}), 11'760'000);
+  EXPECT_EQ(frameDuration(FrameRate{144, 1}), 4'900'000);
+  EXPECT_EQ(frameDuration(FrameRate{30000, 1001}), 23'543'520);
+  // 705600000 = 2^9 · 3^2 · 5^5 · 7^2: 11 and 13 fps would drift against the clock.
+  EXPECT_THROW(frameDuration(FrameRate{11, 1}), std::invalid_argument);
+  EXPECT_THROW(frameDuration(FrameRate{13, 1}), std::invalid_argument);
+  EXPECT_THROW(frameDuration(FrameRate{0, 1}), std::invalid_argument);
+  EXPECT_THROW(frameDuration(FrameRate{60, 0}), std::invalid_argument);
+  EXPECT_EQ(flicksFromSeconds(0.1), 70'560'000);
+  EXPECT_EQ(flicksFromSeconds(1.0 / 3.0), 235'200'000);
+  EXPECT_THROW(flicksFromSeconds(-1.0), std::invalid_argument);
+  EXPECT_THROW(flicksFromSeconds(std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+}
+
+// Any frame sequence: after frames totalling T flicks exactly floor(T · rate / kFlicksPerSecond)
+// ticks have been issued, and α is the fraction left over.
+TEST(FixedStepDriver, TicksAreTheFloorOfTheTotalTimeForAnyFrames) {
+  for (std::int64_t rate : {1, 7, 60, 144, 1000, 1'000'000}) {
+    for (const auto& [minFrame, maxFrame] : std::vector<std::pair<Flicks, Flicks>>{
+             {0, 100}, {0, kSecond / 5}, {kSecond, 3 * kSecond}}) {
+      FixedStepDriver driver(rate, std::int64_t{1} << 40);
+      test::JitteredFrames frames(static_cast<std::uint64_t>(rate), minFrame, maxFrame);
+      Flicks total = 0;
+      std::int64_t ticks = 0;
+      for (int f = 0; f < 500; ++f) {
+        const Flicks frame = frames.next();
+        const AdvanceResult r = driver.advance(frame);
+        total += frame;
+        ticks += r.ticks;
+        ASSERT_EQ(ticks, ticksIn(total, rate)) << rate << " Hz, frame " << f;
+        ASSERT_EQ(driver.ticksIssued(), ticks);
+        ASSERT_EQ(r.ticksDropped, 0);
+        ASSERT_EQ(r.ticksPending, 0);
+        ASSERT_GE(r.alpha, 0.0f);
+        ASSERT_LT(r.alpha, 1.0f);
+        ASSERT_NEAR(r.alpha, fractionIn(total, rate), kAlphaTolerance)
+            << rate << " Hz, frame " << f;
+      }
+    }
+  }
+}
+
+TEST(FixedStepDriver, DropExcessCapsAOneSecondFrameAndKeepsTheFraction) {
+  FixedStepDriver driver(60, 16, OverrunPolicy::DropExcess);
+  const Flicks tick = frameDuration(FrameRate{60, 1});
+  AdvanceResult r = driver.advance(tick / 2);
+  EXPECT_EQ(r.ticks, 0);
+  EXPECT_EQ(r.alpha, 0.5f);
+  r = driver.advance(kSecond);  // 60.5 ticks owed
+  EXPECT_EQ(r.ticks, 16);
+  EXPECT_EQ(r.ticksDropped, 44);
+  EXPECT_EQ(r.ticksPending, 0);
+  EXPECT_EQ(r.alpha, 0.5f);
+  EXPECT_EQ(driver.ticksDroppedTotal(), 44);
+  r = driver.advance(tick / 2);
+  EXPECT_EQ(r.ticks, 1);
+  EXPECT_EQ(r.ticksDropped, 0);
+  EXPECT_EQ(r.alpha, 0.0f);
+  r = driver.advance(3 * kSecond);
+  EXPECT_EQ(r.ticks, 16);
+  EXPECT_EQ(r.ticksDropped, 164);
+  EXPECT_EQ(driver.ticksIssued(), 33);
+  EXPECT_EQ(driver.ticksDroppedTotal(), 208);
+  // Issued plus dropped is still the floor of the total time.
+  EXPECT_EQ(driver.ticksIssued() + driver.ticksDroppedTotal(), ticksIn(tick + 4 * kSecond, 60));
+}
+
+TEST(FixedStepDriver, FallBehindReportsTheDebtAndLaterFramesCatchUp) {
+  FixedStepDriver driver(60, 16, OverrunPolicy::FallBehind);
+  const Flicks tick = frameDuration(FrameRate{60, 1});
+  AdvanceResult r = driver.advance(kSecond);
+  EXPECT_EQ(r.ticks, 16);
+  EXPECT_EQ(r.ticksPending, 44);
+  EXPECT_EQ(r.ticksDropped, 0);
+  EXPECT_GE(r.alpha, 0.0f);
+  EXPECT_LT(r.alpha, 1.0f);
+  const std::vector<std::pair<std::int64_t, std::int64_t>> expected{
+      {16, 29}, {16, 14}, {15, 0}, {1, 0}};
+  for (const auto& [ticks, pending] : expected) {
+    r = driver.advance(tick);
+    EXPECT_EQ(r.ticks, ticks);
+    EXPECT_EQ(r.ticksPending, pending);
+    EXPECT_LT(r.alpha, 1.0f);
+  }
+  EXPECT_EQ(r.alpha, 0.0f);
+  EXPECT_EQ(driver.ticksIssued(), ticksIn(kSecond + 4 * tick, 60));  // 64: nothing was lost
+  EXPECT_EQ(driver.ticksDroppedTotal(), 0);
+}
+
+TEST(FixedStepDriver, RejectsInvalidArguments) {
+  EXPECT_THROW(FixedStepDriver(0, 16), std::invalid_argument);
+  EXPECT_THROW(FixedStepDriver(60, 0), std::invalid_argument);
+  FixedStepDriver driver(60, 16);
+  EXPECT_THROW(driver.advance(-1), std::invalid_argument);
+  EXPECT_EQ(driver.advance(0).ticks, 0);
+}
+
+// NTSC: 1001 frames of 30000/1001 fps are 33.4 s exactly; every prefix issues the floor.
+TEST(FixedStepDriver, NtscFrameRateAddsUpExactly) {
+  const Flicks frame = frameDuration(FrameRate{30000, 1001});
+  FixedStepDriver driver(60, 16);
+  for (int f = 1; f <= 1001; ++f) {
+    const AdvanceResult r = driver.advance(frame);
+    ASSERT_EQ(driver.ticksIssued(), ticksIn(f * frame, 60)) << "frame " << f;
+    ASSERT_NEAR(r.alpha, fractionIn(f * frame, 60), kAlphaTolerance);
+  }
+  EXPECT_EQ(driver.ticksIssued(), 2004);  // 1001 · 1001/30000 s · 60 Hz = 2004.002
+}
+
+// ---- the system under the driver -------------------------------------------------------------
+
+struct Checkpoints {
+  std::map<int, std::uint64_t> hash;  // seconds → state hash
+  std::map<int, std::size_t> alive;
+  std::map<int, std::uint64_t> born;
+};
+
+const std::vector<int> kCheckSeconds{1, 2, 5};
+
+// The reference: ticks run directly, no driver.
+Checkpoints stepDirectly(const SystemSettings& settings) {
+  Checkpoints c;
+  const auto system = test::referenceSystem(settings);
+  for (int s : kCheckSeconds) {
+    system->stepTicks(s * settings.stepRateHz - system->tickCount());
+    c.hash[s] = stateHash(system->pool());
+    c.alive[s] = system->pool().size();
+    c.born[s] = system->pool().nextId();
+  }
+  return c;
+}
+
+// Advances by frames from `next` until each checkpoint, trimming the frame that would overshoot
+// it; checks the tick count and α after every frame.
+Checkpoints advanceByFrames(const SystemSettings& settings, const std::function<Flicks()>& next) {
+  Checkpoints c;
+  const auto system = test::referenceSystem(settings);
+  Flicks elapsed = 0;
+  for (int s : kCheckSeconds) {
+    const Flicks target = s * kSecond;
+    while (elapsed < target) {
+      const Flicks frame = std::min(next(), target - elapsed);
+      const AdvanceResult r = system->advance(frame);
+      elapsed += frame;
+      EXPECT_EQ(r.ticksDropped, 0);
+      EXPECT_EQ(system->tickCount(), ticksIn(elapsed, settings.stepRateHz));
+      EXPECT_GE(system->alpha(), 0.0f);
+      EXPECT_LT(system->alpha(), 1.0f);
+    }
+    EXPECT_EQ(system->alpha(), 0.0f);  // whole seconds are whole ticks
+    c.hash[s] = stateHash(system->pool());
+    c.alive[s] = system->pool().size();
+  }
+  return c;
+}
+
+class FrameIndependence : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(FrameIndependence, SameStateHashAtOneTwoAndFiveSecondsForAnyFrames) {
+  const SystemSettings settings = test::referenceSettings(GetParam());
+  const Checkpoints reference = stepDirectly(settings);
+  // Particles are born and die during the run: the comparison is not of an empty pool.
+  EXPECT_GT(reference.alive.at(1), 100u);
+  EXPECT_GT(reference.alive.at(5), 100u);
+  EXPECT_GT(reference.born.at(1), reference.alive.at(1));  // and some have died by 1 s
+  ASSERT_NE(reference.hash.at(1), reference.hash.at(2));
+
+  for (std::int64_t fps : {24, 30, 60, 144}) {
+    const Flicks frame = frameDuration(FrameRate{fps, 1});
+    const Checkpoints c = advanceByFrames(settings, [frame] { return frame; });
+    for (int s : kCheckSeconds) {
+      EXPECT_EQ(c.hash.at(s), reference.hash.at(s)) << fps << " fps, " << s << " s";
+    }
+  }
+  // Frames between 1/240 s and 1/10 s.
+  test::JitteredFrames jitter(99, kSecond / 240, kSecond / 10);
+  const Checkpoints c = advanceByFrames(settings, [&jitter] { return jitter.next(); });
+  for (int s : kCheckSeconds) {
+    EXPECT_EQ(c.hash.at(s), reference.hash.at(s)) << "jittered frames, " << s << " s";
+  }
+}
+
+std::string schemeName(const ::testing::TestParamInfo<std::string>& info) { return info.param; }
+
+INSTANTIATE_TEST_SUITE_P(AllSchemes, FrameIndependence, ::testing::ValuesIn(integratorNames()),
+                         schemeName);
+
+TEST(SystemDriver, NtscFramesReachTheSameStates) {
+  const SystemSettings settings = test::referenceSettings();
+  const auto reference = test::referenceSystem(settings);
+  const auto system = test::referenceSystem(settings);
+  const Flicks frame = frameDuration(FrameRate{30000, 1001});
+  for (int f = 1; f <= 150; ++f) {
+    system->advance(frame);
+    ASSERT_EQ(system->tickCount(), ticksIn(f * frame, 60));
+    ASSERT_LT(system->alpha(), 1.0f);
+  }
+  EXPECT_EQ(system->tickCount(), 300);  // 150 frames = 5.005 s
+  EXPECT_NEAR(system->alpha(), 0.3, kAlphaTolerance);
+  reference->stepTicks(300);
+  EXPECT_EQ(stateHash(system->pool()), stateHash(reference->pool()));
+}
+
+TEST(SystemDriver, DropExcessRunsTheCapOnAOneSecondFrame) {
+  SystemSettings settings = test::referenceSettings();
+  settings.overrunPolicy = OverrunPolicy::DropExcess;
+  const auto system = test::referenceSystem(settings);
+  const AdvanceResult r = system->advance(kSecond);
+  EXPECT_EQ(r.ticks, 16);
+  EXPECT_EQ(r.ticksDropped, 44);
+  EXPECT_EQ(system->tickCount(), 16);
+  const auto reference = test::referenceSystem(settings);
+  reference->stepTicks(16);
+  EXPECT_EQ(stateHash(system->pool()), stateHash(reference->pool()));
+}
+
+TEST(SystemDriver, FallBehindCatchesUpOnLaterFrames) {
+  SystemSettings settings = test::referenceSettings();
+  settings.overrunPolicy = OverrunPolicy::FallBehind;
+  const auto system = test::referenceSystem(settings);
+  const AdvanceResult r = system->advance(kSecond);
+  EXPECT_EQ(r.ticks, 16);
+  EXPECT_EQ(r.ticksPending, 44);
+  const Flicks tick = frameDuration(FrameRate{60, 1});
+  for (int f = 0; f < 4; ++f) system->advance(tick);
+  EXPECT_EQ(system->tickCount(), 64);
+  const auto reference = test::referenceSystem(settings);
+  reference->stepTicks(64);
+  EXPECT_EQ(stateHash(system->pool()), stateHash(reference->pool()));
+}
+
+// R = 37.5 particles/s for 2 s is exactly 75 particles, whatever the step rate and the frames.
+TEST(RateEmission, EmitsFloorOfRateTimesDurationAtAnyFramerate) {
+  EmitterSettings e;
+  e.rate = 37.5;
+  e.speed = 1.0;  // infinite lifetime: every particle emitted is still alive
+  for (std::int64_t stepRate : {60, 7, 1000}) {
+    SystemSettings settings = test::referenceSettings();
+    settings.stepRateHz = stepRate;
+    settings.maxTicksPerFrame = 1000;  // no frame may drop ticks here
+    std::vector<std::function<Flicks()>> framings;
+    for (std::int64_t fps : {24, 30, 60, 144}) {
+      const Flicks frame = frameDuration(FrameRate{fps, 1});
+      framings.emplace_back([frame] { return frame; });
+    }
+    auto jitter = std::make_shared<test::JitteredFrames>(5, kSecond / 240, kSecond / 10);
+    framings.emplace_back([jitter] { return jitter->next(); });
+    for (std::size_t k = 0; k < framings.size(); ++k) {
+      ParticleSystem system(settings, {e}, test::gravityOnly());
+      Flicks elapsed = 0;
+      while (elapsed < 2 * kSecond) {
+        const Flicks frame = std::min(framings[k](), 2 * kSecond - elapsed);
+        system.advance(frame);
+        elapsed += frame;
+      }
+      EXPECT_EQ(system.pool().size(), 75u) << stepRate << " Hz, framing " << k;
+      EXPECT_EQ(system.pool().nextId(), 75u) << stepRate << " Hz, framing " << k;
+    }
+  }
+}
+
+// Within a run the count follows the ticks: floor(R · k / H) after k ticks, never ahead, never a
+// particle lost to rounding (37.5 / 60 = 0.625 per tick).
+TEST(RateEmission, CountAfterEveryTickIsTheFloor) {
+  EmitterSettings e;
+  e.rate = 37.5;
+  SystemSettings settings = test::referenceSettings();
+  ParticleSystem system(settings, {e}, ForceSet{});
+  for (std::int64_t k = 1; k <= 240; ++k) {
+    system.step();
+    ASSERT_EQ(system.pool().nextId(), static_cast<std::uint64_t>(k * 375 / 600)) << "tick " << k;
+  }
+}
+
+}  // namespace
+}  // namespace tickfx

@@ -1,0 +1,222 @@
+// The particle pool: the hard cap, stable deaths, exact ages, custom attributes.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "CoreTestSupport.h"
+#include "particles/StateHash.h"
+
+namespace tickfx {
+namespace {
+
+constexpr float kForever = std::numeric_limits<float>::infinity();
+
+ParticleInit tagged(float x, float lifetime = kForever) {
+  ParticleInit init;
+  init.position = Eigen::Vector3f(x, 2.0f * x, -x);
+  init.velocity = Eigen::Vector3f(0.5f * x, 1.0f, 0.0f);
+  init.lifetime = lifetime;
+  init.mass = 1.0f + x;
+  return init;
+}
+
+TEST(ParticlePool, SpawnsPastTheCapAreDroppedAndCounted) {
+  ParticlePool pool(3);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_EQ(pool.spawn(tagged(static_cast<float>(i), 0.5f), 0), i);
+  EXPECT_EQ(pool.spawn(tagged(3.0f), 0), ParticlePool::npos);
+  EXPECT_EQ(pool.spawn(tagged(4.0f), 1), ParticlePool::npos);
+  EXPECT_EQ(pool.size(), 3u);
+  EXPECT_EQ(pool.droppedSpawns(), 2u);
+  EXPECT_EQ(pool.nextId(), 3u);  // a refused spawn takes no id
+  EXPECT_LE(pool.storageRows(), 3u);
+  // Room again once particles die; the count of refusals is kept.
+  pool.updateAges(30, 60);  // age 0.5 s = lifetime
+  EXPECT_EQ(pool.removeDead(), 3u);
+  EXPECT_EQ(pool.spawn(tagged(5.0f), 30), 0u);
+  EXPECT_EQ(pool.id()[0], 3u);
+  EXPECT_EQ(pool.droppedSpawns(), 2u);
+}
+
+TEST(ParticlePool, CapHoldsAcrossStorageGrowth) {
+  ParticlePool pool(1500);  // storage grows 1024 → 1500, never past the cap
+  std::size_t refused = 0;
+  for (int i = 0; i < 2000; ++i) {
+    if (pool.spawn(tagged(static_cast<float>(i)), i) == ParticlePool::npos) ++refused;
+  }
+  EXPECT_EQ(refused, 500u);
+  EXPECT_EQ(pool.size(), 1500u);
+  EXPECT_EQ(pool.droppedSpawns(), 500u);
+  EXPECT_EQ(pool.storageRows(), 1500u);
+  for (std::size_t i = 0; i < pool.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    ASSERT_EQ(pool.id()[i], i);
+    ASSERT_EQ(pool.birthTick()[i], static_cast<std::int64_t>(i));
+    ASSERT_EQ(pool.position().x[r],
+              static_cast<float>(i));  // rows written before growth survive it
+    ASSERT_EQ(pool.previousPosition().y[r], 2.0f * static_cast<float>(i));
+    ASSERT_EQ(pool.inverseMass()[r], 1.0f / (1.0f + static_cast<float>(i)));
+  }
+}
+
+TEST(ParticlePool, ZeroCapacityRefusesEverything) {
+  ParticlePool pool(0);
+  EXPECT_EQ(pool.spawn(tagged(1.0f), 0), ParticlePool::npos);
+  EXPECT_EQ(pool.size(), 0u);
+  EXPECT_EQ(pool.droppedSpawns(), 1u);
+}
+
+TEST(ParticlePool, SystemCountsTheSpawnsOfABurstPastTheCap) {
+  SystemSettings settings = test::referenceSettings();
+  settings.maxParticles = 100;
+  EmitterSettings e;
+  e.bursts = {Burst{0.0, 250}};
+  ParticleSystem system(settings, {e}, ForceSet{});
+  system.step();
+  EXPECT_EQ(system.pool().size(), 100u);
+  EXPECT_EQ(system.pool().droppedSpawns(), 150u);
+  EXPECT_EQ(system.pool().nextId(), 100u);
+}
+
+TEST(ParticlePool, InfiniteMassIsPinned) {
+  ParticlePool pool(2);
+  ParticleInit init;
+  init.mass = kForever;
+  pool.spawn(init, 0);
+  EXPECT_EQ(pool.inverseMass()[0], 0.0f);
+}
+
+// Deaths at the end of a tick remove rows by a stable compaction: the survivors keep id order and
+// every column (and custom attribute) moves with its particle.
+TEST(ParticlePool, DeathsKeepIdOrderAndMoveEveryColumn) {
+  ParticlePool pool(64);
+  const std::size_t tag = pool.addAttribute("tag", -1.0f);
+  for (int i = 0; i < 20; ++i) {
+    // Odd ids live 0.5 s (30 ticks at 60 Hz), even ids forever.
+    pool.spawn(tagged(static_cast<float>(i), i % 2 == 1 ? 0.5f : kForever), 0);
+    pool.attribute(tag)[i] = 10.0f * static_cast<float>(i);
+  }
+  pool.updateAges(29, 60);
+  EXPECT_EQ(pool.removeDead(), 0u);  // age 29/60 < 0.5
+  pool.updateAges(30, 60);
+  EXPECT_EQ(pool.removeDead(), 10u);
+  ASSERT_EQ(pool.size(), 10u);
+
+  // A module kills ids 4 and 14 by flag; ids 20 and 21 are born meanwhile.
+  pool.spawn(tagged(20.0f), 30);
+  pool.spawn(tagged(21.0f), 30);
+  pool.dead()[2] = 1;  // id 4
+  pool.dead()[7] = 1;  // id 14
+  pool.updateAges(31, 60);
+  EXPECT_EQ(pool.removeDead(), 2u);
+
+  const std::vector<std::uint64_t> expected{0, 2, 6, 8, 10, 12, 16, 18, 20, 21};
+  ASSERT_EQ(pool.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    const float x = static_cast<float>(expected[i]);
+    EXPECT_EQ(pool.id()[i], expected[i]);
+    EXPECT_EQ(pool.position().x[r], x);
+    EXPECT_EQ(pool.position().y[r], 2.0f * x);
+    EXPECT_EQ(pool.previousPosition().z[r], -x);
+    EXPECT_EQ(pool.velocity().x[r], 0.5f * x);
+    EXPECT_EQ(pool.mass()[r], 1.0f + x);
+    EXPECT_EQ(pool.lifetime()[r], kForever);
+    EXPECT_EQ(pool.birthTick()[i], expected[i] < 20 ? 0 : 30);
+    EXPECT_EQ(pool.attribute(tag)[r], expected[i] < 20 ? 10.0f * x : -1.0f);
+    EXPECT_EQ(pool.dead()[i], 0);
+  }
+}
+
+// dead() is "nonzero marks a particle for removal" (ParticlePool.h): a module may write any
+// nonzero byte, and flags other than 1 must not be skipped, nor cleared without a removal.
+TEST(ParticlePool, AnyNonzeroDeadFlagRemovesTheParticle) {
+  ParticlePool pool(16);
+  for (int i = 0; i < 6; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);
+  pool.dead()[1] = 2;
+  pool.dead()[3] = 1;
+  pool.dead()[4] = 0xff;
+  pool.updateAges(1, 60);
+  EXPECT_EQ(pool.removeDead(), 3u);
+  const std::vector<std::uint64_t> expected{0, 2, 5};
+  ASSERT_EQ(pool.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(pool.id()[i], expected[i]);
+    EXPECT_EQ(pool.position().x[static_cast<Eigen::Index>(i)], static_cast<float>(expected[i]));
+  }
+}
+
+// The last tick of a lifetime L is the one after which (tick − birth)/rate ≥ L: a particle with
+// 0.5 s at 60 Hz is alive after 29 ticks and gone after 30.
+TEST(ParticlePool, ALifetimeEndsOnItsTick) {
+  SystemSettings settings = test::referenceSettings();
+  EmitterSettings e;
+  e.bursts = {Burst{0.0, 3}};
+  e.lifetime = 0.5;
+  ParticleSystem system(settings, {e}, ForceSet{});
+  system.stepTicks(29);
+  EXPECT_EQ(system.pool().size(), 3u);
+  EXPECT_EQ(system.pool().age()[0], static_cast<float>(29.0 / 60.0));
+  system.step();
+  EXPECT_EQ(system.pool().size(), 0u);
+}
+
+// age = (tick − birth)/rate, rounded to float once from the exact double quotient: never
+// accumulated, so it does not drift, and the same bits whatever happened in between.
+TEST(ParticlePool, AgesAreExactQuotientsOfTickCounts) {
+  for (std::int64_t rate : {7, 24, 60, 90, 144, 1000, 1'000'000}) {
+    ParticlePool pool(1000);
+    for (std::int64_t b = 0; b < 1000; ++b) pool.spawn(ParticleInit{}, b);
+    for (std::int64_t tick : {std::int64_t{1000}, std::int64_t{4321}, std::int64_t{100'003},
+                              std::int64_t{7'654'321}, std::int64_t{1} << 40}) {
+      pool.updateAges(tick, rate);
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        const double lived = static_cast<double>(tick - pool.birthTick()[i]);
+        const float exact = static_cast<float>(lived / static_cast<double>(rate));
+        ASSERT_EQ(test::bitsOf(pool.age()[static_cast<Eigen::Index>(i)]), test::bitsOf(exact))
+            << "lived " << lived << " ticks at " << rate << " Hz";
+      }
+    }
+  }
+}
+
+TEST(ParticlePool, CustomAttributesStartAtTheirInitialValue) {
+  ParticlePool pool(5000);
+  for (int i = 0; i < 5; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);
+  const std::size_t temp = pool.addAttribute("temperature", 300.0f);
+  EXPECT_EQ(pool.findAttribute("temperature"), temp);
+  EXPECT_EQ(pool.findAttribute("colour"), ParticlePool::npos);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(pool.attribute(temp)[i], 300.0f);  // existing rows too
+  pool.attribute(temp)[2] = 17.0f;
+  // Adding it again returns the same column and resets nothing.
+  EXPECT_EQ(pool.addAttribute("temperature", 5.0f), temp);
+  EXPECT_EQ(pool.attribute(temp)[2], 17.0f);
+  const std::size_t charge = pool.addAttribute("charge", -2.5f);
+  EXPECT_NE(charge, temp);
+  EXPECT_EQ(pool.attributeCount(), 2u);
+  EXPECT_EQ(pool.attributeName(charge), "charge");
+  // New particles, across a storage growth, get the initial values.
+  for (int i = 5; i < 3000; ++i) pool.spawn(tagged(static_cast<float>(i)), 1);
+  for (int i = 5; i < 3000; ++i) {
+    ASSERT_EQ(pool.attribute(temp)[i], 300.0f) << "row " << i;
+    ASSERT_EQ(pool.attribute(charge)[i], -2.5f) << "row " << i;
+  }
+  EXPECT_EQ(pool.attribute(temp)[2], 17.0f);
+}
+
+// The state hash covers custom attributes: changing one changes the hash.
+TEST(ParticlePool, AttributesAreInTheStateHash) {
+  ParticlePool pool(8);
+  const std::size_t a = pool.addAttribute("a", 1.0f);
+  pool.spawn(tagged(1.0f), 0);
+  const std::uint64_t before = stateHash(pool);
+  pool.attribute(a)[0] = 2.0f;
+  EXPECT_NE(stateHash(pool), before);
+  pool.attribute(a)[0] = 1.0f;
+  EXPECT_EQ(stateHash(pool), before);
+}
+
+}  // namespace
+}  // namespace tickfx
