@@ -1,0 +1,882 @@
+#include "io/EffectParser.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <toml++/toml.h>
+
+#include "integrators/Integrator.h"
+#include "io/EditDistance.h"
+#include "io/SettingOverrides.h"
+
+#if !TOML_EXCEPTIONS
+#error "tickfx_io reads parse errors from toml::parse_error: build toml++ with exceptions"
+#endif
+
+namespace tickfx::io {
+namespace {
+
+// The bound on every unbounded quantity (positions, speeds, accelerations, times): far beyond any
+// effect, and far inside the float range the simulation rounds to.
+constexpr double kBig = 1e9;
+constexpr std::int64_t kMaxStepRate = 1'000'000;
+constexpr std::int64_t kMaxParticles = 1'000'000'000;
+constexpr std::int64_t kMaxTicksPerFrame = 100'000;
+constexpr std::int64_t kMaxThreads = 1024;
+constexpr std::size_t kMaxEntries = 10'000;  // emitters, forces
+constexpr std::size_t kMaxBursts = 100'000;  // per emitter
+constexpr std::int64_t kMaxFrameRatePart = 1'000'000;
+
+const std::vector<std::string> kShapes = {"point", "sphere", "box", "disc"};
+const std::vector<std::string> kOverrunPolicies = {"drop", "fall_behind"};
+const std::vector<std::string> kCacheFormats = {"csv", "ply"};
+
+// Parameters of each shape and each force type, to tell "does not apply here" from "unknown".
+const std::map<std::string, std::vector<std::string>>& shapeKeys() {
+  static const std::map<std::string, std::vector<std::string>> keys = {
+      {"point", {}},
+      {"sphere", {"radius", "surface"}},
+      {"box", {"size"}},
+      {"disc", {"radius", "normal"}}};
+  return keys;
+}
+
+const std::map<std::string, std::vector<std::string>>& forceKeys() {
+  static const std::map<std::string, std::vector<std::string>> keys = {
+      {"gravity", {"acceleration"}},
+      {"drag", {"k", "air_velocity"}},
+      {"wind", {"direction", "base", "amplitude", "frequency", "phase"}},
+      {"anchor_spring", {"rest", "stiffness", "damping"}}};
+  return keys;
+}
+
+std::string childPath(std::string_view parent, std::string_view key) {
+  return parent.empty() ? std::string(key) : std::string(parent) + "." + std::string(key);
+}
+
+std::string childPath(std::string_view parent, std::size_t index) {
+  return childPath(parent, std::to_string(index));
+}
+
+std::string joinWords(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+std::string quote(std::string_view s) {
+  constexpr std::size_t kLimit = 40;
+  if (s.size() > kLimit) return "\"" + std::string(s.substr(0, kLimit)) + "...\"";
+  return "\"" + std::string(s) + "\"";
+}
+
+// A float as written in TOML: with a fraction, so that 60.0 does not read as the integer 60.
+std::string floatText(double v) {
+  std::string s = formatNumber(v);
+  if (s.find_first_of(".eni") == std::string::npos) s += ".0";
+  return s;
+}
+
+// What a value is, for "got …" messages.
+std::string describe(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string:
+      return "got a string " + quote(*node.value<std::string_view>());
+    case toml::node_type::integer:
+      return "got the integer " + std::to_string(*node.value<std::int64_t>());
+    case toml::node_type::floating_point:
+      return "got the number " + floatText(*node.value<double>());
+    case toml::node_type::boolean:
+      return std::string("got ") + (*node.value<bool>() ? "true" : "false");
+    case toml::node_type::array:
+      return "got an array";
+    case toml::node_type::table:
+      return "got a table";
+    default:
+      return "got a date or time";
+  }
+}
+
+// A closed or half-open interval; messages spell the bounds out in the "expected" text.
+struct Range {
+  double min = -kBig;
+  double max = kBig;
+  bool minOpen = false;
+  bool maxOpen = false;
+
+  bool contains(double v) const {
+    return (minOpen ? v > min : v >= min) && (maxOpen ? v < max : v <= max);
+  }
+};
+
+// Where findings go while one document is read.
+class Context {
+ public:
+  Context(std::string file, const OverrideOrigins& origins)
+      : file_(std::move(file)), origins_(origins) {}
+
+  SourceLocation at(const toml::node& node) const {
+    if (const std::string* label = origins_.labelOf(node)) return {*label, 0, 0};
+    const toml::source_position& begin = node.source().begin;
+    return {file_, static_cast<int>(begin.line), static_cast<int>(begin.column)};
+  }
+
+  // An unknown key is shown where its name is written.
+  SourceLocation atKey(const toml::key& key, const toml::node& value) const {
+    if (const std::string* label = origins_.labelOf(value)) return {*label, 0, 0};
+    const toml::source_position& begin = key.source().begin;
+    if (begin.line == 0) return at(value);
+    return {file_, static_cast<int>(begin.line), static_cast<int>(begin.column)};
+  }
+
+  void error(const SourceLocation& where, std::string keyPath, std::string message) {
+    diagnostics_.push_back(Diagnostic{Severity::Error, where.file, where.line, where.column,
+                                      std::move(keyPath), std::move(message)});
+  }
+
+  void record(std::string keyPath, const toml::node& node) {
+    sources_.set(std::move(keyPath), at(node));
+  }
+
+  const OverrideOrigins& origins() const { return origins_; }
+  std::vector<Diagnostic>& diagnostics() { return diagnostics_; }
+  SourceMap& sources() { return sources_; }
+
+ private:
+  std::string file_;
+  const OverrideOrigins& origins_;
+  std::vector<Diagnostic> diagnostics_;
+  SourceMap sources_;
+};
+
+// ---- single values -------------------------------------------------------------------------
+// Each check reports what is wrong with `node` (at `path`) and returns nothing, or returns the
+// value. `expected` is the "(expected …)" text: the unit and the range.
+
+std::optional<double> checkNumber(Context& cx, const toml::node& node, const std::string& path,
+                                  const std::string& expected, const Range& range) {
+  std::optional<double> v;
+  if (const auto i = node.value_exact<std::int64_t>()) v = static_cast<double>(*i);
+  if (const auto f = node.value_exact<double>()) v = *f;
+  if (!v) {
+    cx.error(cx.at(node), path, describe(node) + " (expected " + expected + ")");
+    return std::nullopt;
+  }
+  if (!std::isfinite(*v)) {
+    cx.error(cx.at(node), path,
+             formatNumber(*v) + " is not a finite number (expected " + expected + ")");
+    return std::nullopt;
+  }
+  if (!range.contains(*v)) {
+    cx.error(cx.at(node), path, formatNumber(*v) + " is out of range (expected " + expected + ")");
+    return std::nullopt;
+  }
+  cx.record(path, node);
+  return v;
+}
+
+std::optional<std::int64_t> checkInteger(Context& cx, const toml::node& node,
+                                         const std::string& path, const std::string& expected,
+                                         std::int64_t min, std::int64_t max) {
+  if (const auto f = node.value_exact<double>()) {
+    cx.error(cx.at(node), path, floatText(*f) + " is not an integer (expected " + expected + ")");
+    return std::nullopt;
+  }
+  const auto v = node.value_exact<std::int64_t>();
+  if (!v) {
+    cx.error(cx.at(node), path, describe(node) + " (expected " + expected + ")");
+    return std::nullopt;
+  }
+  if (*v < min || *v > max) {
+    cx.error(cx.at(node), path,
+             std::to_string(*v) + " is out of range (expected " + expected + ")");
+    return std::nullopt;
+  }
+  cx.record(path, node);
+  return v;
+}
+
+// One of `names`, with a suggestion when the word is close to one.
+std::optional<std::string> checkChoice(Context& cx, const toml::node& node, const std::string& path,
+                                       const std::vector<std::string>& names,
+                                       std::string_view what) {
+  const auto v = node.value_exact<std::string>();
+  if (!v) {
+    cx.error(
+        cx.at(node), path,
+        describe(node) + " (expected " + std::string(what) + ", one of: " + joinWords(names) + ")");
+    return std::nullopt;
+  }
+  for (const std::string& name : names) {
+    if (*v == name) {
+      cx.record(path, node);
+      return v;
+    }
+  }
+  const std::optional<std::string> guess = closestMatch(*v, names);
+  cx.error(cx.at(node), path,
+           "unknown " + std::string(what) + " " + quote(*v) +
+               (guess ? " (did you mean " + quote(*guess) + "?)"
+                      : " (expected one of: " + joinWords(names) + ")"));
+  return std::nullopt;
+}
+
+// ---- tables ----------------------------------------------------------------------------------
+
+// Reads the keys of one table. Every key a reader asks for is known; finish() reports the rest.
+class TableReader {
+ public:
+  TableReader(Context& cx, const toml::table& table, std::string path)
+      : cx_(cx), table_(table), path_(std::move(path)) {
+    cx_.record(path_, table_);
+  }
+
+  const std::string& path() const { return path_; }
+  std::string pathOf(std::string_view key) const { return childPath(path_, key); }
+  const toml::table& table() const { return table_; }
+
+  // The value of `key`, or nullptr; the key becomes known either way.
+  const toml::node* take(std::string_view key) {
+    if (known_.insert(std::string(key)).second) knownOrder_.emplace_back(key);
+    return table_.get(key);
+  }
+
+  // A required key is missing: the error points at the table's header.
+  void missing(std::string_view key, const std::string& expected) {
+    cx_.error(cx_.at(table_), pathOf(key), "missing (expected " + expected + ")");
+  }
+
+  template <typename T>
+  bool number(std::string_view key, T& out, const std::string& expected, const Range& range,
+              bool required = false) {
+    const toml::node* node = take(key);
+    if (node == nullptr) {
+      if (required) missing(key, expected);
+      return false;
+    }
+    const std::optional<double> v = checkNumber(cx_, *node, pathOf(key), expected, range);
+    if (v) out = static_cast<T>(*v);
+    return v.has_value();
+  }
+
+  template <typename T>
+  bool integer(std::string_view key, T& out, const std::string& expected, std::int64_t min,
+               std::int64_t max, bool required = false) {
+    const toml::node* node = take(key);
+    if (node == nullptr) {
+      if (required) missing(key, expected);
+      return false;
+    }
+    const std::optional<std::int64_t> v = checkInteger(cx_, *node, pathOf(key), expected, min, max);
+    if (v) out = static_cast<T>(*v);
+    return v.has_value();
+  }
+
+  bool boolean(std::string_view key, bool& out) {
+    const toml::node* node = take(key);
+    if (node == nullptr) return false;
+    const auto v = node->value_exact<bool>();
+    if (!v) {
+      cx_.error(cx_.at(*node), pathOf(key), describe(*node) + " (expected true or false)");
+      return false;
+    }
+    cx_.record(pathOf(key), *node);
+    out = *v;
+    return true;
+  }
+
+  // A non-empty string.
+  bool string(std::string_view key, std::string& out, const std::string& expected) {
+    const toml::node* node = take(key);
+    if (node == nullptr) return false;
+    const auto v = node->value_exact<std::string>();
+    if (!v || v->empty()) {
+      cx_.error(cx_.at(*node), pathOf(key),
+                (v ? std::string("got an empty string") : describe(*node)) + " (expected " +
+                    expected + ")");
+      return false;
+    }
+    cx_.record(pathOf(key), *node);
+    out = *v;
+    return true;
+  }
+
+  bool choice(std::string_view key, std::string& out, const std::vector<std::string>& names,
+              std::string_view what, bool required = false) {
+    const toml::node* node = take(key);
+    if (node == nullptr) {
+      if (required) missing(key, std::string(what) + ", one of: " + joinWords(names));
+      return false;
+    }
+    const std::optional<std::string> v = checkChoice(cx_, *node, pathOf(key), names, what);
+    if (v) out = *v;
+    return v.has_value();
+  }
+
+  // [x, y, z], each component in `range`; `nonZero` for directions.
+  bool vec3(std::string_view key, Eigen::Vector3d& out, const std::string& expected,
+            const Range& range, bool nonZero = false) {
+    const toml::node* node = take(key);
+    if (node == nullptr) return false;
+    const std::string path = pathOf(key);
+    const toml::array* array = node->as_array();
+    if (array == nullptr) {
+      cx_.error(cx_.at(*node), path, describe(*node) + " (expected " + expected + ")");
+      return false;
+    }
+    if (array->size() != 3) {
+      cx_.error(cx_.at(*node), path,
+                "got " + std::to_string(array->size()) +
+                    (array->size() == 1 ? " entry" : " entries") + " (expected " + expected + ")");
+      return false;
+    }
+    Eigen::Vector3d v;
+    bool ok = true;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::optional<double> c =
+          checkNumber(cx_, *array->get(i), childPath(path, i), expected, range);
+      if (c) v[static_cast<Eigen::Index>(i)] = *c;
+      ok = ok && c.has_value();
+    }
+    if (!ok) return false;
+    if (nonZero && v.isZero(0.0)) {
+      cx_.error(cx_.at(*node), path, "got [0, 0, 0] (expected " + expected + ")");
+      return false;
+    }
+    cx_.record(path, *node);
+    out = v;
+    return true;
+  }
+
+  // Marks keys as known without reading them (parameters of a variant that could not be told).
+  void allow(const std::vector<std::string>& keys) {
+    for (const std::string& k : keys) take(k);
+  }
+
+  // Reports every key nobody asked for. `notHere` holds keys that belong to another variant
+  // (another shape, another force type) and why they do not apply to this one.
+  void finish(const std::map<std::string, std::string>& notHere = {}) {
+    for (const auto& [key, value] : table_) {
+      const std::string name(key.str());
+      if (known_.count(name) != 0) continue;
+      const std::string path = pathOf(name);
+      if (const auto it = notHere.find(name); it != notHere.end()) {
+        cx_.error(cx_.atKey(key, value), path, it->second);
+        continue;
+      }
+      const std::optional<std::string> guess = closestMatch(name, knownOrder_);
+      cx_.error(cx_.atKey(key, value), path,
+                "unknown key " + quote(name) +
+                    (guess ? " (did you mean " + quote(*guess) + "?)"
+                           : " (expected one of: " + joinWords(knownOrder_) + ")"));
+    }
+  }
+
+ private:
+  Context& cx_;
+  const toml::table& table_;
+  std::string path_;
+  std::set<std::string> known_;
+  std::vector<std::string> knownOrder_;
+};
+
+// ---- the sections of a version-1 document ----------------------------------------------------
+
+void readSimulation(Context& cx, const toml::table& table, SystemSettings& s) {
+  TableReader r(cx, table, "simulation");
+  r.integer("step_rate", s.stepRateHz, "ticks per second (Hz), an integer from 1 to 1000000", 1,
+            kMaxStepRate, /*required=*/true);
+  r.choice("integrator", s.integrator, integratorNames(), "integrator");
+  r.integer("seed", s.seed, "an integer from 0 to 9223372036854775807", 0,
+            std::numeric_limits<std::int64_t>::max());
+  r.integer("max_particles", s.maxParticles, "an integer from 1 to 1000000000", 1, kMaxParticles);
+  r.integer("max_ticks_per_frame", s.maxTicksPerFrame, "an integer from 1 to 100000", 1,
+            kMaxTicksPerFrame);
+  std::string overrun;
+  if (r.choice("overrun", overrun, kOverrunPolicies, "overrun policy")) {
+    s.overrunPolicy = overrun == "drop" ? OverrunPolicy::DropExcess : OverrunPolicy::FallBehind;
+  }
+  r.integer("threads", s.threads, "worker threads, an integer from 0 (all cores) to 1024", 0,
+            kMaxThreads);
+  r.finish();
+}
+
+const std::string kPositionText = "[x, y, z] in metres, each from -1e9 to 1e9";
+const std::string kDirectionText = "a direction [x, y, z], each from -1e9 to 1e9, not all zero";
+const std::string kSecondsText = "seconds, a number from 0 to 1e9";
+
+void readBursts(Context& cx, TableReader& r, EmitterSettings& e, std::int64_t maxParticles) {
+  const toml::node* node = r.take("bursts");
+  if (node == nullptr) return;
+  const std::string path = r.pathOf("bursts");
+  const std::string expected = "an array of bursts {time = seconds, count = particles}";
+  const toml::array* array = node->as_array();
+  if (array == nullptr) {
+    cx.error(cx.at(*node), path, describe(*node) + " (expected " + expected + ")");
+    return;
+  }
+  if (array->size() > kMaxBursts) {
+    cx.error(cx.at(*node), path,
+             std::to_string(array->size()) + " bursts are too many (expected at most 100000)");
+    return;
+  }
+  cx.record(path, *node);
+  const std::string countText =
+      "particles, an integer from 1 to simulation.max_particles = " + std::to_string(maxParticles);
+  for (std::size_t i = 0; i < array->size(); ++i) {
+    const toml::node& entry = *array->get(i);
+    const toml::table* table = entry.as_table();
+    if (table == nullptr) {
+      cx.error(cx.at(entry), childPath(path, i),
+               describe(entry) + " (expected a burst {time = seconds, count = particles})");
+      continue;
+    }
+    TableReader br(cx, *table, childPath(path, i));
+    Burst burst;
+    const bool timeOk = br.number("time", burst.time, kSecondsText, Range{0.0, kBig}, true);
+    const bool countOk = br.integer("count", burst.count, countText, 1, maxParticles, true);
+    br.finish();
+    if (timeOk && countOk) e.bursts.push_back(burst);
+  }
+}
+
+void readShape(TableReader& r, EmitterSettings& e) {
+  std::string shape = "point";
+  const bool known =
+      r.choice("shape", shape, kShapes, "shape") || r.table().get("shape") == nullptr;
+  if (!known) {
+    // The shape could not be read: its parameters cannot be judged either.
+    for (const auto& [name, keys] : shapeKeys()) r.allow(keys);
+    return;
+  }
+  const std::string radiusText = "metres, a number from 0 to 1e9";
+  if (shape == "sphere") {
+    SphereShape s;
+    r.number("radius", s.radius, radiusText, Range{0.0, kBig});
+    r.boolean("surface", s.surface);
+    e.shape = s;
+  } else if (shape == "box") {
+    BoxShape s;
+    r.vec3("size", s.size, "[x, y, z] edge lengths in metres, each from 0 to 1e9",
+           Range{0.0, kBig});
+    e.shape = s;
+  } else if (shape == "disc") {
+    DiscShape s;
+    r.number("radius", s.radius, radiusText, Range{0.0, kBig});
+    r.vec3("normal", s.normal, kDirectionText, Range{-kBig, kBig}, /*nonZero=*/true);
+    e.shape = s;
+  } else {
+    e.shape = PointShape{};
+  }
+}
+
+std::map<std::string, std::string> notForShape(const std::string& shape) {
+  const std::vector<std::string>& own = shapeKeys().at(shape);
+  const std::string expected = own.empty()
+                                   ? "(expected no parameters for a point)"
+                                   : "(expected for a " + shape + ": " + joinWords(own) + ")";
+  std::map<std::string, std::string> out;
+  for (const auto& [other, keys] : shapeKeys()) {
+    for (const std::string& k : keys) {
+      if (std::find(own.begin(), own.end(), k) == own.end()) {
+        out[k] = "does not apply to shape " + quote(shape) + " " + expected;
+      }
+    }
+  }
+  return out;
+}
+
+void readEmitter(Context& cx, const toml::table& table, std::size_t index,
+                 std::int64_t maxParticles, EmitterSettings& e) {
+  TableReader r(cx, table, childPath("emitters", index));
+  e.name = "emitter_" + std::to_string(index);
+  r.string("name", e.name, "a name: a non-empty string, unique among the emitters");
+  r.vec3("position", e.position, kPositionText, Range{-kBig, kBig});
+  readShape(r, e);
+  r.number("rate", e.rate, "particles per second, a number from 0 to 1e9", Range{0.0, kBig});
+  r.number("start", e.start, kSecondsText, Range{0.0, kBig});
+  double stop = 0.0;
+  if (r.number("stop", stop, "seconds, a number from start to 1e9", Range{0.0, kBig})) {
+    if (stop < e.start) {
+      cx.error(cx.at(*table.get("stop")), r.pathOf("stop"),
+               formatNumber(stop) + " is before start = " + formatNumber(e.start) +
+                   " (expected seconds, a number from start to 1e9)");
+    } else {
+      e.stop = stop;
+    }
+  }
+  readBursts(cx, r, e, maxParticles);
+  r.vec3("direction", e.direction, kDirectionText, Range{-kBig, kBig}, /*nonZero=*/true);
+  r.number("speed", e.speed, "metres per second, a number from 0 to 1e9", Range{0.0, kBig});
+  r.number("speed_jitter", e.speedJitter, "a fraction from 0 to 1", Range{0.0, 1.0});
+  r.number("spread", e.spreadDegrees, "degrees, a number from 0 to 180", Range{0.0, 180.0});
+  r.number("lifetime", e.lifetime, "seconds, a number > 0 and <= 1e9", Range{0.0, kBig, true});
+  r.number("lifetime_jitter", e.lifetimeJitter, "a fraction >= 0 and < 1",
+           Range{0.0, 1.0, false, true});
+  r.number("mass", e.mass, "kilograms, a number > 0 and <= 1e9", Range{0.0, kBig, true});
+
+  std::string shape = "point";
+  if (const toml::node* s = table.get("shape")) shape = s->value_or<std::string>("");
+  r.finish(shapeKeys().count(shape) != 0 ? notForShape(shape)
+                                         : std::map<std::string, std::string>{});
+}
+
+std::optional<ForceSettings> readForce(Context& cx, const toml::table& table, std::size_t index) {
+  TableReader r(cx, table, childPath("forces", index));
+  std::string type;
+  if (!r.choice("type", type, forceTypeNames(), "force type", /*required=*/true)) {
+    for (const auto& [name, keys] : forceKeys()) r.allow(keys);
+    r.finish();
+    return std::nullopt;
+  }
+  const Range any{-kBig, kBig};
+  const std::string accelerationText = "m/s², a number from -1e9 to 1e9";
+  std::optional<ForceSettings> force;
+  bool ok = true;
+  if (type == "gravity") {
+    GravitySettings g;
+    r.vec3("acceleration", g.acceleration, "[x, y, z] in m/s², each from -1e9 to 1e9", any);
+    force = g;
+  } else if (type == "drag") {
+    DragSettings d;
+    ok = r.number("k", d.k, "a rate in 1/s, a number from 0 to 1e9", Range{0.0, kBig}, true) && ok;
+    r.vec3("air_velocity", d.airVelocity, "[x, y, z] in m/s, each from -1e9 to 1e9", any);
+    force = d;
+  } else if (type == "wind") {
+    WindSettings w;
+    r.vec3("direction", w.direction, kDirectionText, any, /*nonZero=*/true);
+    r.number("base", w.base, accelerationText, any);
+    ok = r.number("amplitude", w.amplitude, accelerationText, any, true) && ok;
+    ok = r.number("frequency", w.frequency, "hertz, a number from 0 to 1000000", Range{0.0, 1e6},
+                  true) &&
+         ok;
+    r.number("phase", w.phase, "radians, a number from -1e9 to 1e9", any);
+    force = w;
+  } else {
+    AnchorSpringSettings a;
+    r.vec3("rest", a.rest, kPositionText, any);
+    ok = r.number("stiffness", a.stiffness, "N/m, a number > 0 and <= 1e9", Range{0.0, kBig, true},
+                  true) &&
+         ok;
+    r.number("damping", a.damping, "N·s/m, a number from 0 to 1e9", Range{0.0, kBig});
+    force = a;
+  }
+  const std::vector<std::string>& own = forceKeys().at(type);
+  std::map<std::string, std::string> notHere;
+  for (const auto& [other, keys] : forceKeys()) {
+    for (const std::string& k : keys) {
+      if (std::find(own.begin(), own.end(), k) == own.end()) {
+        notHere[k] = "does not apply to a force of type " + quote(type) + " (expected for " + type +
+                     ": type, " + joinWords(own) + ")";
+      }
+    }
+  }
+  r.finish(notHere);
+  return force;
+}
+
+// "30000/1001" or "24" as a frame rate.
+std::optional<FrameRate> parseRatio(std::string_view text) {
+  const auto readPart = [](std::string_view part) -> std::optional<std::int64_t> {
+    std::int64_t v = 0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (ec != std::errc() || end != part.data() + part.size() || part.empty()) return std::nullopt;
+    return v;
+  };
+  const std::size_t slash = text.find('/');
+  const auto num = readPart(text.substr(0, slash));
+  const auto den = slash == std::string_view::npos ? std::optional<std::int64_t>(1)
+                                                   : readPart(text.substr(slash + 1));
+  if (!num || !den) return std::nullopt;
+  return FrameRate{*num, *den};
+}
+
+void readFps(Context& cx, TableReader& r, OutputSettings& out) {
+  const toml::node* node = r.take("fps");
+  if (node == nullptr) return;
+  const std::string path = r.pathOf("fps");
+  const std::string expected =
+      "frames per second, an integer from 1 to 1000000 or a ratio string like \"30000/1001\"";
+  std::optional<FrameRate> rate;
+  std::string shown;
+  if (const auto s = node->value_exact<std::string>()) {
+    rate = parseRatio(*s);
+    shown = quote(*s);
+    if (!rate) {
+      cx.error(cx.at(*node), path, shown + " is not a frame rate (expected " + expected + ")");
+      return;
+    }
+  } else if (const auto i = node->value_exact<std::int64_t>()) {
+    rate = FrameRate{*i, 1};
+    shown = std::to_string(*i);
+  } else {
+    cx.error(cx.at(*node), path, describe(*node) + " (expected " + expected + ")");
+    return;
+  }
+  if (rate->numerator < 1 || rate->numerator > kMaxFrameRatePart || rate->denominator < 1 ||
+      rate->denominator > kMaxFrameRatePart) {
+    cx.error(cx.at(*node), path, shown + " is out of range (expected " + expected + ")");
+    return;
+  }
+  try {
+    frameDuration(*rate);
+  } catch (const std::invalid_argument&) {
+    cx.error(cx.at(*node), path,
+             shown +
+                 " frames per second do not last a whole number of flicks (expected a rate "
+                 "whose frame is a whole number of 1/705600000 s, such as 24, 25, 30, 60, 120 "
+                 "or \"30000/1001\")");
+    return;
+  }
+  cx.record(path, *node);
+  out.fps = *rate;
+}
+
+void readOutput(Context& cx, const toml::table& table, OutputSettings& out) {
+  TableReader r(cx, table, "output");
+  readFps(cx, r, out);
+  const bool hasSeconds =
+      r.number("seconds", out.seconds, "seconds, a number > 0 and <= 1e9", Range{0.0, kBig, true});
+  std::int64_t frames = 0;
+  if (r.integer("frames", frames, "an integer from 1 to 1000000000", 1, 1'000'000'000)) {
+    if (hasSeconds || table.get("seconds") != nullptr) {
+      cx.error(cx.at(*table.get("frames")), r.pathOf("frames"),
+               "given together with output.seconds (expected either seconds or frames)");
+    } else {
+      out.frames = frames;
+    }
+  }
+  if (const toml::node* node = r.take("formats")) {
+    const std::string path = r.pathOf("formats");
+    if (const toml::array* array = node->as_array()) {
+      std::vector<CacheFormat> formats;
+      bool ok = true;
+      for (std::size_t i = 0; i < array->size(); ++i) {
+        const std::string entryPath = childPath(path, i);
+        const auto name = checkChoice(cx, *array->get(i), entryPath, kCacheFormats, "cache format");
+        if (!name) {
+          ok = false;
+          continue;
+        }
+        const CacheFormat f = *name == "csv" ? CacheFormat::Csv : CacheFormat::Ply;
+        if (std::find(formats.begin(), formats.end(), f) != formats.end()) {
+          cx.error(cx.at(*array->get(i)), entryPath,
+                   quote(*name) + " is listed twice (expected each format at most once)");
+          ok = false;
+          continue;
+        }
+        formats.push_back(f);
+      }
+      if (ok) {
+        cx.record(path, *node);
+        out.formats = formats;
+      }
+    } else {
+      cx.error(
+          cx.at(*node), path,
+          describe(*node) + " (expected an array of cache formats, such as [\"csv\", \"ply\"])");
+    }
+  }
+  r.string("directory", out.directory, "a directory path, a non-empty string");
+  r.finish();
+}
+
+// An array of tables ([[emitters]], [[forces]]): each entry handed to `read`.
+template <typename Read>
+void readEntries(Context& cx, TableReader& top, std::string_view key, bool required, Read read) {
+  const toml::node* node = top.take(key);
+  const std::string path(key);
+  const std::string expected = "an array of tables, written [[" + path + "]]";
+  if (node == nullptr) {
+    if (required) top.missing(key, "at least one [[" + path + "]] table");
+    return;
+  }
+  const toml::array* array = node->as_array();
+  if (array == nullptr) {
+    cx.error(cx.at(*node), path, describe(*node) + " (expected " + expected + ")");
+    return;
+  }
+  if (array->empty() && required) {
+    cx.error(cx.at(*node), path,
+             "got an empty array (expected at least one [[" + path + "]] table)");
+    return;
+  }
+  if (array->size() > kMaxEntries) {
+    cx.error(cx.at(*node), path,
+             std::to_string(array->size()) + " entries are too many (expected at most 10000)");
+    return;
+  }
+  cx.record(path, *node);
+  for (std::size_t i = 0; i < array->size(); ++i) {
+    const toml::node& entry = *array->get(i);
+    if (const toml::table* table = entry.as_table()) {
+      read(*table, i);
+    } else {
+      cx.error(cx.at(entry), childPath(path, i), describe(entry) + " (expected a table)");
+    }
+  }
+}
+
+// Validates a document of the current version (format_version was handled by the migration).
+EffectSettings readCurrentVersion(Context& cx, const toml::table& document) {
+  EffectSettings effect;
+  TableReader top(cx, document, "");
+  if (const toml::node* version = top.take("format_version");
+      version && cx.origins().labelOf(*version)) {
+    cx.error(cx.at(*version), "format_version",
+             "cannot be changed by an override (expected the version the file is written in)");
+  }
+
+  if (const toml::node* node = top.take("simulation")) {
+    if (const toml::table* table = node->as_table()) {
+      readSimulation(cx, *table, effect.simulation);
+    } else {
+      cx.error(cx.at(*node), "simulation", describe(*node) + " (expected a [simulation] table)");
+    }
+  } else {
+    top.missing("simulation", "a [simulation] table with at least step_rate");
+  }
+
+  const auto maxParticles = static_cast<std::int64_t>(effect.simulation.maxParticles);
+  std::map<std::string, std::size_t> names;
+  readEntries(cx, top, "emitters", /*required=*/true, [&](const toml::table& table, std::size_t i) {
+    EmitterSettings e;
+    readEmitter(cx, table, i, maxParticles, e);
+    if (const auto [it, fresh] = names.emplace(e.name, i); !fresh) {
+      const toml::node* name = table.get("name");
+      cx.error(name ? cx.at(*name) : cx.at(table), childPath(childPath("emitters", i), "name"),
+               quote(e.name) + " is already the name of emitters." + std::to_string(it->second) +
+                   " (expected a name unique among the emitters)");
+    }
+    effect.emitters.push_back(std::move(e));
+  });
+  readEntries(cx, top, "forces", /*required=*/false, [&](const toml::table& table, std::size_t i) {
+    if (auto force = readForce(cx, table, i)) effect.forces.push_back(*force);
+  });
+
+  if (const toml::node* node = top.take("output")) {
+    if (const toml::table* table = node->as_table()) {
+      readOutput(cx, *table, effect.output);
+    } else {
+      cx.error(cx.at(*node), "output", describe(*node) + " (expected an [output] table)");
+    }
+  }
+  top.finish();
+  return effect;
+}
+
+// Turns a document of version `from` into version from + 1 in place. Each change of the format
+// adds a case (renamed keys, new required keys given the values that keep the old behaviour), so
+// files of every earlier version keep loading.
+void migrateOneVersion(toml::table& /*document*/, std::int64_t from) {
+  switch (from) {
+    default:
+      throw std::logic_error("no migration from format_version " + std::to_string(from));
+  }
+}
+
+// Reads format_version and brings an older document up to the current version. Returns false
+// when the document is of a version this build cannot read (nothing else is worth reporting).
+bool migrateToCurrent(Context& cx, toml::table& document) {
+  const std::string expected = "format_version = " + std::to_string(kEffectFormatVersion);
+  const toml::node* node = document.get("format_version");
+  if (node == nullptr) {
+    cx.error(cx.at(document), "format_version", "missing (expected " + expected + ")");
+    return true;  // read it as the current version, to report everything else too
+  }
+  const auto version = node->value_exact<std::int64_t>();
+  if (!version) {
+    cx.error(cx.at(*node), "format_version", describe(*node) + " (expected " + expected + ")");
+    return true;
+  }
+  if (*version < 1 || *version > kEffectFormatVersion) {
+    const std::string known = kEffectFormatVersion == 1
+                                  ? std::string("1")
+                                  : "1 to " + std::to_string(kEffectFormatVersion);
+    cx.error(cx.at(*node), "format_version",
+             "version " + std::to_string(*version) + " is not one this build reads (expected " +
+                 known + ")");
+    return false;
+  }
+  cx.record("format_version", *node);
+  for (std::int64_t from = *version; from < kEffectFormatVersion; ++from)
+    migrateOneVersion(document, from);
+  return true;
+}
+
+}  // namespace
+
+LoadResult parseEffect(std::string_view text, std::string_view fileName,
+                       const std::vector<std::string>& overrides) {
+  LoadResult result;
+  const std::string file(fileName);
+  toml::table document;
+  try {
+    document = toml::parse(text, std::string_view(file));
+  } catch (const toml::parse_error& e) {
+    const toml::source_position& begin = e.source().begin;
+    result.diagnostics.push_back(Diagnostic{Severity::Error, file, static_cast<int>(begin.line),
+                                            static_cast<int>(begin.column), "",
+                                            std::string(e.description())});
+    return result;
+  }
+
+  OverrideOrigins origins;
+  Context cx(file, origins);
+  if (migrateToCurrent(cx, document)) {
+    const std::vector<Diagnostic> overrideErrors = applyOverrides(document, overrides, origins);
+    cx.diagnostics().insert(cx.diagnostics().end(), overrideErrors.begin(), overrideErrors.end());
+    EffectSettings effect = readCurrentVersion(cx, document);
+    if (!hasErrors(cx.diagnostics())) {
+      effect.sources = std::move(cx.sources());
+      result.effect = std::move(effect);
+    }
+  }
+  result.diagnostics = std::move(cx.diagnostics());
+  // Findings about overrides in command-line order, then the file's by position.
+  std::map<std::string, std::size_t> rank;
+  for (std::size_t i = 0; i < overrides.size(); ++i) rank.emplace(overrideLabel(overrides[i]), i);
+  std::stable_sort(result.diagnostics.begin(), result.diagnostics.end(),
+                   [&](const Diagnostic& a, const Diagnostic& b) {
+                     const auto ra = rank.find(a.file), rb = rank.find(b.file);
+                     return (ra == rank.end() ? overrides.size() : ra->second) <
+                            (rb == rank.end() ? overrides.size() : rb->second);
+                   });
+  sortDiagnostics(result.diagnostics);
+  return result;
+}
+
+LoadResult loadEffectFile(const std::filesystem::path& path,
+                          const std::vector<std::string>& overrides) {
+  const std::string file = path.string();
+  std::error_code ec;
+  std::string problem;
+  if (!std::filesystem::exists(path, ec)) {
+    problem = "no such file";
+  } else if (std::filesystem::is_directory(path, ec)) {
+    problem = "is a directory";
+  }
+  std::ifstream in;
+  if (problem.empty()) {
+    in.open(path, std::ios::binary);
+    if (!in) problem = "cannot be opened";
+  }
+  if (!problem.empty()) {
+    LoadResult result;
+    result.diagnostics.push_back(Diagnostic{Severity::Error, file, 0, 0, "",
+                                            problem + " (expected a readable effect file)"});
+    return result;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseEffect(text.str(), file, overrides);
+}
+
+}  // namespace tickfx::io

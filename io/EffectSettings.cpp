@@ -1,0 +1,43 @@
+#include "io/EffectSettings.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tickfx::io {
+
+std::string_view forceTypeName(const ForceSettings& force) {
+  struct Name {
+    std::string_view operator()(const GravitySettings&) const { return "gravity"; }
+    std::string_view operator()(const DragSettings&) const { return "drag"; }
+    std::string_view operator()(const WindSettings&) const { return "wind"; }
+    std::string_view operator()(const AnchorSpringSettings&) const { return "anchor_spring"; }
+  };
+  return std::visit(Name{}, force);
+}
+
+const std::vector<std::string>& forceTypeNames() {
+  static const std::vector<std::string> names = {"gravity", "drag", "wind", "anchor_spring"};
+  return names;
+}
+
+std::string_view cacheFormatName(CacheFormat format) {
+  return format == CacheFormat::Csv ? "csv" : "ply";
+}
+
+std::int64_t OutputSettings::frameCount() const {
+  if (frames) return *frames;
+  const double exact =
+      seconds * static_cast<double>(fps.numerator) / static_cast<double>(fps.denominator);
+  // 10 s at 24 fps is 240 frames even if the product comes out as 240.00000000000003.
+  const double nearest = std::round(exact);
+  const double count =
+      std::abs(exact - nearest) <= 1e-9 * std::max(1.0, nearest) ? nearest : std::ceil(exact);
+  return std::max<std::int64_t>(1, static_cast<std::int64_t>(count));
+}
+
+double OutputSettings::durationSeconds() const {
+  return static_cast<double>(frameCount()) * static_cast<double>(fps.denominator) /
+         static_cast<double>(fps.numerator);
+}
+
+}  // namespace tickfx::io

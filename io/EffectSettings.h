@@ -1,0 +1,89 @@
+// An effect file as plain data: what the parser produces and the builder consumes. Nothing here
+// simulates; the structs of the core (SystemSettings, EmitterSettings) are reused as they are.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "io/SourceMap.h"
+#include "particles/Clock.h"
+#include "particles/Emitter.h"
+#include "particles/ParticleSystem.h"
+
+namespace tickfx::io {
+
+/// The effect-file format this build reads and writes. Older versions are migrated on load.
+inline constexpr std::int64_t kEffectFormatVersion = 1;
+
+/// `type = "gravity"`: a constant acceleration.
+struct GravitySettings {
+  Eigen::Vector3d acceleration{0.0, -9.81, 0.0};  // m/s²
+};
+
+/// `type = "drag"`: a = k · (air_velocity − v).
+struct DragSettings {
+  double k = 0.0;                                         // 1/s
+  Eigen::Vector3d airVelocity = Eigen::Vector3d::Zero();  // m/s
+};
+
+/// `type = "wind"`: a = direction · (base + amplitude · sin(2π · frequency · t + phase)).
+struct WindSettings {
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // any length but zero
+  double base = 0.0;                                     // m/s²
+  double amplitude = 0.0;                                // m/s²
+  double frequency = 0.0;                                // Hz
+  double phase = 0.0;                                    // radians
+};
+
+/// `type = "anchor_spring"`: a = −(stiffness · (p − rest) + damping · v) / m.
+struct AnchorSpringSettings {
+  Eigen::Vector3d rest = Eigen::Vector3d::Zero();  // metres
+  double stiffness = 0.0;                          // N/m
+  double damping = 0.0;                            // N·s/m
+};
+
+/// One entry of [[forces]], in file order (the order the forces are summed in).
+using ForceSettings =
+    std::variant<GravitySettings, DragSettings, WindSettings, AnchorSpringSettings>;
+
+/// The `type` of a force as written in effect files ("gravity", "drag", "wind", "anchor_spring").
+std::string_view forceTypeName(const ForceSettings& force);
+/// Every force type, in the order above.
+const std::vector<std::string>& forceTypeNames();
+
+enum class CacheFormat { Csv, Ply };
+/// "csv" or "ply".
+std::string_view cacheFormatName(CacheFormat format);
+
+/// The [output] table: what `tickfx run` writes.
+struct OutputSettings {
+  FrameRate fps{24, 1};  // frames per second, an exact ratio
+  /// The output's length: `frames` when the file gives it, else ⌈seconds · fps⌉ frames.
+  double seconds = 10.0;
+  std::optional<std::int64_t> frames;
+  std::vector<CacheFormat> formats{CacheFormat::Csv};  // may be empty: simulate, write nothing
+  std::string directory = "out";  // as written; relative to the working directory of the command
+
+  /// Frames to write (>= 1).
+  std::int64_t frameCount() const;
+  /// frameCount() / fps, in seconds.
+  double durationSeconds() const;
+};
+
+/// A whole effect file, validated: every field is in range for the builder.
+struct EffectSettings {
+  std::int64_t formatVersion = kEffectFormatVersion;  // after migration: always the current one
+  SystemSettings simulation;
+  std::vector<EmitterSettings> emitters;  // at least one
+  std::vector<ForceSettings> forces;
+  OutputSettings output;
+  /// Where each value was written (for lint findings); defaults are not recorded.
+  SourceMap sources;
+};
+
+}  // namespace tickfx::io
