@@ -1,0 +1,212 @@
+// tickfx run: simulate an effect through the fixed-step driver and write one cache per frame.
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/Commands.h"
+#include "app/ProgressLine.h"
+#include "io/CsvCache.h"
+#include "io/EffectBuilder.h"
+#include "io/EffectLint.h"
+#include "io/EffectParser.h"
+#include "io/FrameData.h"
+#include "io/FrameTimes.h"
+#include "io/PlyCache.h"
+#include "io/StateDump.h"
+#include "particles/StateHash.h"
+
+namespace tickfx::app {
+namespace {
+
+constexpr const char* kHelp =
+    "usage: tickfx run EFFECT.toml [options]\n"
+    "\n"
+    "Simulates EFFECT.toml and writes one interpolated cache per frame (frame_0001.csv, ...).\n"
+    "Frame times (the default comes from the effect's [output] table):\n"
+    "  --seconds S           run for S seconds (the last frame is shortened to end exactly at S)\n"
+    "  --frames N            run for N frames\n"
+    "  --fps F               frames of 1/F s; F an integer or a ratio such as 30000/1001\n"
+    "  --jitter SEED         seeded random frame durations in [1/240 s, 1/10 s] ending exactly at S\n"
+    "  --frame-times FILE    one frame duration in seconds a line\n"
+    "Output:\n"
+    "  --out DIR             cache directory (default: the effect's output.directory)\n"
+    "  --format LIST         comma-separated: csv, ply; 'none' writes no caches\n"
+    "  --hash                print 'state-hash: <16 hex digits>' and 'ticks: N' of the last tick\n"
+    "  --dump FILE           write the last tick's state as CSV: id,px,py,pz,vx,vy,vz,age\n"
+    "Simulation:\n"
+    "  --set key.path=value  override a key of the effect (repeatable), e.g. simulation.integrator=rk4\n"
+    "  --threads N           worker threads (default: the effect's, 0 = all cores)\n"
+    "  --quiet               no summary (errors, warnings and --hash lines still print)\n";
+
+std::vector<io::CacheFormat> parseFormats(const std::string& text) {
+  std::vector<io::CacheFormat> formats;
+  if (text == "none") return formats;
+  std::stringstream list(text);
+  std::string name;
+  while (std::getline(list, name, ',')) {
+    if (name == "csv") {
+      formats.push_back(io::CacheFormat::Csv);
+    } else if (name == "ply") {
+      formats.push_back(io::CacheFormat::Ply);
+    } else {
+      throw UsageError("run: --format: unknown format '" + name + "' (expected csv, ply or none)");
+    }
+  }
+  if (formats.empty()) throw UsageError("run: --format: empty list (expected csv, ply or none)");
+  return formats;
+}
+
+struct FramePlan {
+  std::vector<Flicks> frames;
+  std::string description;
+};
+
+FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::string>& seconds,
+                     const std::optional<std::string>& frames, const std::optional<std::string>& fps,
+                     const std::optional<std::string>& jitter,
+                     const std::optional<std::string>& frameTimes) {
+  if (seconds && frames) throw UsageError("run: give --seconds or --frames, not both");
+  if (jitter && frameTimes) throw UsageError("run: give --jitter or --frame-times, not both");
+  if ((jitter || frameTimes) && fps) throw UsageError("run: --fps does not go with --jitter or --frame-times");
+  if (frameTimes && (seconds || frames)) throw UsageError("run: --frame-times sets the length; drop --seconds/--frames");
+  if (jitter && frames) throw UsageError("run: --jitter needs a length in --seconds, not --frames");
+
+  FramePlan plan;
+  if (frameTimes) {
+    plan.frames = io::readFrameTimes(*frameTimes);
+    plan.description = "frame times from " + *frameTimes;
+    return plan;
+  }
+  FrameRate rate = output.fps;
+  if (fps) {
+    try {
+      rate = io::parseFrameRate(*fps);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("run: --fps: ") + e.what());
+    }
+  }
+  const double defaultSeconds = output.durationSeconds();
+  const double length = seconds ? parseNumber(*seconds, "run: --seconds", 0.0, 1.0e6) : defaultSeconds;
+  const Flicks total = flicksFromSeconds(length);
+  if (jitter) {
+    const auto seed = static_cast<std::uint64_t>(parseInteger(*jitter, "run: --jitter", 0, INT64_MAX));
+    plan.frames = io::jitteredFrames(seed, total);
+    plan.description = "jittered frames (seed " + *jitter + ")";
+    return plan;
+  }
+  const std::string rateText = std::to_string(rate.numerator) +
+                               (rate.denominator == 1 ? "" : "/" + std::to_string(rate.denominator));
+  if (frames) {
+    plan.frames = io::fixedRateFrameCount(rate, parseInteger(*frames, "run: --frames", 0, 100'000'000));
+  } else if (seconds) {
+    plan.frames = io::fixedRateFrames(rate, total);
+  } else {
+    plan.frames = io::fixedRateFrameCount(rate, output.frameCount());
+  }
+  plan.description = "at " + rateText + " fps";
+  return plan;
+}
+
+std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t frame, const char* extension) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame_%04" PRId64 ".%s", frame, extension);
+  return dir / name;
+}
+
+}  // namespace
+
+int runCommand(Arguments& args) {
+  if (args.flag("--help")) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  const std::vector<std::string> overrides = args.values("--set");
+  const auto seconds = args.value("--seconds");
+  const auto frames = args.value("--frames");
+  const auto fps = args.value("--fps");
+  const auto jitter = args.value("--jitter");
+  const auto frameTimes = args.value("--frame-times");
+  const auto out = args.value("--out");
+  const auto format = args.value("--format");
+  const auto dump = args.value("--dump");
+  const auto threads = args.value("--threads");
+  const bool printHash = args.flag("--hash");
+  const bool quiet = args.flag("--quiet");
+  const std::string effectPath = args.positionals(1, "one effect file: tickfx run EFFECT.toml")[0];
+
+  // Everything that can be wrong with the request is found before anything is written.
+  const io::LoadResult load = io::loadEffectFile(effectPath, overrides);
+  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
+  if (!load.ok()) return kExitUsage;
+  const io::EffectSettings& effect = *load.effect;
+  for (const io::Diagnostic& d : io::lintEffect(effect)) std::fprintf(stderr, "%s\n", d.format().c_str());
+
+  const std::vector<io::CacheFormat> formats = format ? parseFormats(*format) : effect.output.formats;
+  const std::filesystem::path outDir = out ? *out : effect.output.directory;
+  std::optional<int> threadOverride;
+  if (threads) threadOverride = static_cast<int>(parseInteger(*threads, "run: --threads", 0, 256));
+  FramePlan plan;
+  try {
+    plan = planFrames(effect.output, seconds, frames, fps, jitter, frameTimes);
+  } catch (const std::runtime_error& e) {
+    if (dynamic_cast<const UsageError*>(&e) != nullptr) throw;
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitUsage;
+  }
+
+  const auto system = io::buildSystem(effect, threadOverride);
+  if (!formats.empty()) std::filesystem::create_directories(outDir);
+
+  const auto wallStart = std::chrono::steady_clock::now();
+  ProgressLine progress;
+  Flicks elapsed = 0;
+  std::int64_t ticksDropped = 0;
+  const auto frameCount = static_cast<std::int64_t>(plan.frames.size());
+  for (std::int64_t f = 1; f <= frameCount; ++f) {
+    const Flicks duration = plan.frames[static_cast<std::size_t>(f - 1)];
+    ticksDropped += system->advance(duration).ticksDropped;
+    elapsed += duration;
+    if (!formats.empty()) {
+      const io::FrameData data = io::captureFrame(*system, f, secondsFromFlicks(elapsed));
+      for (io::CacheFormat fmt : formats) {
+        if (fmt == io::CacheFormat::Csv) io::writeCsvCache(data, cachePath(outDir, f, "csv"));
+        if (fmt == io::CacheFormat::Ply) io::writePlyCache(data, cachePath(outDir, f, "ply"));
+      }
+    }
+    progress.update(f, frameCount, secondsFromFlicks(elapsed), system->pool().size());
+  }
+  progress.finish();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+
+  if (dump) io::writeStateDump(system->pool(), *dump);
+  const ParticlePool& pool = system->pool();
+  if (!quiet) {
+    std::printf("%s: %lld ticks at %lld Hz (%s), %lld frames %s, %.6g s simulated\n", effectPath.c_str(),
+                static_cast<long long>(system->tickCount()), static_cast<long long>(effect.simulation.stepRateHz),
+                effect.simulation.integrator.c_str(), static_cast<long long>(frameCount),
+                plan.description.c_str(), secondsFromFlicks(elapsed));
+    std::printf("particles alive: %zu (emitted %llu, refused by max_particles: %llu)\n", pool.size(),
+                static_cast<unsigned long long>(pool.nextId() + pool.droppedSpawns()),
+                static_cast<unsigned long long>(pool.droppedSpawns()));
+    std::printf("ticks dropped by the cap (max_ticks_per_frame = %lld): %lld\n",
+                static_cast<long long>(effect.simulation.maxTicksPerFrame), static_cast<long long>(ticksDropped));
+    std::printf("wall time: %.3f s\n", wall);
+    if (!formats.empty() && frameCount > 0) {
+      std::printf("caches: %s (frame_0001 to frame_%04lld)\n", outDir.string().c_str(),
+                  static_cast<long long>(frameCount));
+    }
+    if (dump) std::printf("state dump: %s\n", dump->c_str());
+  }
+  if (printHash) {
+    std::printf("state-hash: %s\n", hashToHex(stateHash(pool)).c_str());
+    std::printf("ticks: %lld\n", static_cast<long long>(system->tickCount()));
+  }
+  return kExitOk;
+}
+
+}  // namespace tickfx::app

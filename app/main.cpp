@@ -1,0 +1,51 @@
+// tickfx: run, check and study particle effects from the command line.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "app/Commands.h"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: tickfx COMMAND [ARGS]\n"
+    "\n"
+    "commands:\n"
+    "  run EFFECT.toml    simulate an effect and write per-frame caches\n"
+    "  check EFFECT.toml  validate an effect and print lint warnings\n"
+    "  study              the integrator study: three experiments against exact solutions\n"
+    "\n"
+    "`tickfx COMMAND --help` describes a command. Exit codes: 0 ok, 2 usage or effect errors,\n"
+    "1 failure at run time.\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace tickfx::app;
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0 ||
+      std::strcmp(argv[1], "help") == 0) {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? kExitUsage : kExitOk;
+  }
+  if (std::strcmp(argv[1], "--version") == 0) {
+    std::printf("tickfx %s\n", TICKFX_VERSION);
+    return kExitOk;
+  }
+  const std::string command = argv[1];
+  Arguments args(command, std::vector<std::string>(argv + 2, argv + argc));
+  try {
+    if (command == "run") return runCommand(args);
+    if (command == "check") return checkCommand(args);
+    if (command == "study") return studyCommand(args);
+    std::fprintf(stderr, "tickfx: unknown command '%s'\n\n%s", command.c_str(), kUsage);
+    return kExitUsage;
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "tickfx %s\n", e.what());
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tickfx %s: error: %s\n", command.c_str(), e.what());
+    return kExitFailure;
+  }
+}

@@ -1,0 +1,27 @@
+#include "io/FrameData.h"
+
+#include "particles/ParticleSystem.h"
+
+namespace tickfx::io {
+
+FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double timeSeconds) {
+  const ParticlePool& pool = system.pool();
+  const auto n = static_cast<Eigen::Index>(pool.size());
+  FrameData data;
+  data.frame = frame;
+  data.timeSeconds = timeSeconds;
+  data.id.assign(pool.id().begin(), pool.id().begin() + n);
+  system.interpolatedPositions(system.alpha(), data.position);
+  data.velocity.resize(n);
+  for (int c = 0; c < 3; ++c) data.velocity[c] = pool.velocity()[c].head(n);
+  data.age = pool.age().head(n);
+  data.life = pool.lifetime().head(n);
+  data.mass = pool.mass().head(n);
+  for (std::size_t a = 0; a < pool.attributeCount(); ++a) {
+    data.attributeNames.push_back(pool.attributeName(a));
+    data.attributes.emplace_back(pool.attribute(a).head(n));
+  }
+  return data;
+}
+
+}  // namespace tickfx::io

@@ -1,0 +1,37 @@
+// One rendered frame of particles: what a cache file holds.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "particles/ParticlePool.h"
+
+namespace tickfx {
+class ParticleSystem;
+}  // namespace tickfx
+
+namespace tickfx::io {
+
+/// A copy of the particles as a frame shows them: positions interpolated between the last two
+/// ticks, everything else as of the last tick. Rows are in id order.
+struct FrameData {
+  std::int64_t frame = 0;    // frame number, from 1
+  double timeSeconds = 0.0;  // the frame's time (for metadata only)
+  std::vector<std::uint64_t> id;
+  Vec3Column position;  // metres, interpolated
+  Vec3Column velocity;  // metres per second
+  FloatColumn age;      // seconds
+  FloatColumn life;     // seconds (lifetime; +inf for immortal particles)
+  FloatColumn mass;     // kilograms
+  std::vector<std::string> attributeNames;
+  std::vector<FloatColumn> attributes;
+
+  std::size_t size() const { return id.size(); }
+};
+
+/// Captures `system` as frame `frame` at time `timeSeconds`, interpolating positions with the
+/// system's current α.
+FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double timeSeconds);
+
+}  // namespace tickfx::io

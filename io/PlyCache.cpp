@@ -1,0 +1,125 @@
+#include "io/PlyCache.h"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "io/AtomicFile.h"
+
+namespace tickfx::io {
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "PLY caches are written little-endian by copying memory");
+
+const char* const kFixedFloats[] = {"x", "y", "z", "vx", "vy", "vz", "age", "life", "mass"};
+
+std::vector<const FloatColumn*> floatColumns(const FrameData& f) {
+  std::vector<const FloatColumn*> cols = {&f.position.x, &f.position.y, &f.position.z,
+                                          &f.velocity.x, &f.velocity.y, &f.velocity.z,
+                                          &f.age,        &f.life,       &f.mass};
+  for (const FloatColumn& a : f.attributes) cols.push_back(&a);
+  return cols;
+}
+
+}  // namespace
+
+void writePlyCache(const FrameData& frame, const std::filesystem::path& path) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "ply\nformat binary_little_endian 1.0\n";
+    out << "comment tickfx frame " << frame.frame << "\n";
+    char time[64];
+    std::snprintf(time, sizeof time, "%.17g", frame.timeSeconds);
+    out << "comment time " << time << "\n";
+    out << "element vertex " << frame.size() << "\n";
+    out << "property double id\n";
+    for (const char* name : kFixedFloats) out << "property float " << name << "\n";
+    for (const std::string& name : frame.attributeNames) out << "property float " << name << "\n";
+    out << "end_header\n";
+    const std::vector<const FloatColumn*> cols = floatColumns(frame);
+    std::vector<char> row(sizeof(double) + cols.size() * sizeof(float));
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      const double id = static_cast<double>(frame.id[i]);
+      std::memcpy(row.data(), &id, sizeof id);
+      for (std::size_t c = 0; c < cols.size(); ++c) {
+        const float v = (*cols[c])[static_cast<Eigen::Index>(i)];
+        std::memcpy(row.data() + sizeof(double) + c * sizeof(float), &v, sizeof v);
+      }
+      out.write(row.data(), static_cast<std::streamsize>(row.size()));
+    }
+  });
+}
+
+FrameData readPlyCache(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open");
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(path.string() + ": " + what);
+  };
+  std::string line;
+  if (!std::getline(in, line) || line != "ply") fail("not a PLY file");
+  if (!std::getline(in, line) || line != "format binary_little_endian 1.0")
+    fail("not binary little-endian PLY");
+  FrameData frame;
+  std::size_t count = 0;
+  std::vector<std::string> floats;
+  bool sawId = false;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream words(line);
+    std::string word, type, name;
+    words >> word;
+    if (word == "comment") {
+      words >> name;
+      if (name == "tickfx") words >> name;  // "comment tickfx frame N"
+      if (name == "frame") words >> frame.frame;
+      if (name == "time") words >> frame.timeSeconds;
+    } else if (word == "element") {
+      words >> name >> count;
+      if (name != "vertex") fail("unexpected element '" + name + "'");
+    } else if (word == "property") {
+      words >> type >> name;
+      if (type == "double" && name == "id" && floats.empty()) {
+        sawId = true;
+      } else if (type == "float") {
+        floats.push_back(name);
+      } else {
+        fail("unexpected property '" + line + "'");
+      }
+    } else {
+      fail("unexpected header line '" + line + "'");
+    }
+  }
+  if (line != "end_header" || !sawId || floats.size() < 9) fail("incomplete header");
+  for (std::size_t k = 0; k < 9; ++k) {
+    if (floats[k] != kFixedFloats[k]) fail("unexpected property order at '" + floats[k] + "'");
+  }
+  const auto n = static_cast<Eigen::Index>(count);
+  frame.attributeNames.assign(floats.begin() + 9, floats.end());
+  frame.attributes.assign(frame.attributeNames.size(), FloatColumn(n));
+  frame.position.resize(n);
+  frame.velocity.resize(n);
+  frame.age.resize(n);
+  frame.life.resize(n);
+  frame.mass.resize(n);
+  frame.id.resize(count);
+  std::vector<FloatColumn*> cols = {&frame.position.x, &frame.position.y, &frame.position.z,
+                                    &frame.velocity.x, &frame.velocity.y, &frame.velocity.z,
+                                    &frame.age,        &frame.life,       &frame.mass};
+  for (FloatColumn& a : frame.attributes) cols.push_back(&a);
+  std::vector<char> row(sizeof(double) + cols.size() * sizeof(float));
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!in.read(row.data(), static_cast<std::streamsize>(row.size()))) fail("truncated body");
+    double id = 0;
+    std::memcpy(&id, row.data(), sizeof id);
+    frame.id[i] = static_cast<std::uint64_t>(id);
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      std::memcpy(&(*cols[c])[static_cast<Eigen::Index>(i)],
+                  row.data() + sizeof(double) + c * sizeof(float), sizeof(float));
+    }
+  }
+  return frame;
+}
+
+}  // namespace tickfx::io

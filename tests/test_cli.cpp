@@ -1,0 +1,216 @@
+// `tickfx run`, `check` and `study` as processes: exit codes, output, and files written or not.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "io/CsvCache.h"
+#include "io/PlyCache.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("tickfx_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+            "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `tickfx ARGS` from the source tree (so samples/... resolve), stdin closed.
+  Result run(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command = "cd '" TICKFX_SOURCE_DIR "' && '" TICKFX_CLI "' " + args + " </dev/null >'" +
+                                out.string() + "' 2>'" + err.string() + "'";
+    const int status = std::system(command.c_str());
+    Result r;
+    r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = readAll(out);
+    r.err = readAll(err);
+    return r;
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string writeFile(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name) << text;
+    return path(name);
+  }
+  static std::string hashOf(const Result& r) {
+    std::smatch m;
+    static const std::regex re("state-hash: ([0-9a-f]{16})\nticks: ([0-9]+)\n");
+    return std::regex_search(r.out, m, re) ? m[1].str() + "@" + m[2].str() : "no hash in: " + r.out + r.err;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, HelpOnEveryCommandExitsZero) {
+  for (const char* c : {"--help", "run --help", "check --help", "study --help"}) {
+    const Result r = run(c);
+    EXPECT_EQ(r.exit, 0) << c;
+    EXPECT_NE(r.out.find("usage: tickfx"), std::string::npos) << c;
+  }
+  EXPECT_EQ(run("").exit, 2);
+  EXPECT_EQ(run("explode").exit, 2);
+}
+
+TEST_F(Cli, RunWritesOneCachePerFrameAndReportsTheHash) {
+  const Result r = run("run samples/fountain.toml --seconds 1 --fps 24 --format csv,ply --out " + path("c") + " --hash");
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_TRUE(fs::exists(path("c/frame_0024.csv")));
+  EXPECT_TRUE(fs::exists(path("c/frame_0024.ply")));
+  EXPECT_FALSE(fs::exists(path("c/frame_0025.csv")));
+  EXPECT_NE(r.out.find("ticks dropped by the cap (max_ticks_per_frame = 16): 0"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << "no progress line when stderr is not a terminal";
+  // 1 s at 120 Hz is 120 ticks, and a second run gives the same bits.
+  EXPECT_EQ(hashOf(r).substr(17), "120");
+  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 1 --fps 24 --format none --hash")), hashOf(r));
+}
+
+TEST_F(Cli, CsvAndPlyCachesHoldTheSameBits) {
+  ASSERT_EQ(run("run samples/burst.toml --frames 12 --fps 24 --format csv,ply --out " + path("c")).exit, 0);
+  const tickfx::io::FrameData csv = tickfx::io::readCsvCache(path("c/frame_0012.csv"));
+  const tickfx::io::FrameData ply = tickfx::io::readPlyCache(path("c/frame_0012.ply"));
+  ASSERT_GT(csv.size(), 0u);
+  ASSERT_EQ(csv.size(), ply.size());
+  EXPECT_EQ(csv.id, ply.id);
+  EXPECT_EQ(ply.frame, 12);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_TRUE((csv.position[c] == ply.position[c]).all());
+    EXPECT_TRUE((csv.velocity[c] == ply.velocity[c]).all());
+  }
+  EXPECT_TRUE((csv.age == ply.age).all());
+  EXPECT_TRUE((csv.life == ply.life).all());
+  EXPECT_EQ(readAll(path("c/frame_0012.ply")).rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+}
+
+TEST_F(Cli, OscillatorDumpAgreesWithMinusCosT) {
+  // Velocity Verlet at 60 Hz: phase error ω³dt²t/24 ≈ 2.3e-4 rad after 20 s.
+  for (const auto& [integrator, tolerance] :
+       std::vector<std::pair<std::string, double>>{{"velocity_verlet", 3e-4}, {"rk4", 2e-5}}) {
+    const std::string dump = path("dump_" + integrator + ".csv");
+    const Result r = run("run samples/oscillator.toml --seconds 20 --format none --set simulation.integrator=" +
+                         integrator + " --dump " + dump);
+    ASSERT_EQ(r.exit, 0) << r.err;
+    std::istringstream rows(readAll(dump));
+    std::string header, row;
+    std::getline(rows, header);
+    std::getline(rows, row);
+    EXPECT_EQ(header, "id,px,py,pz,vx,vy,vz,age");
+    double id, px, py, pz, vx, vy, vz, age;
+    ASSERT_EQ(std::sscanf(row.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &id, &px, &py, &pz, &vx, &vy, &vz, &age), 8);
+    EXPECT_NEAR(px, -std::cos(20.0), tolerance) << integrator;
+    EXPECT_NEAR(vx, std::sin(20.0), tolerance) << integrator;
+    EXPECT_EQ(age, 20.0);
+  }
+}
+
+TEST_F(Cli, JitteredAndRecordedFrameTimesReachTheSameTickState) {
+  const std::string reference = hashOf(run("run samples/fountain.toml --seconds 2 --fps 60 --format none --hash"));
+  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 2 --jitter 7 --format none --hash")), reference);
+  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 2 --fps 30000/1001 --format none --hash")), reference);
+  std::string times;
+  for (int i = 0; i < 40; ++i) times += (i % 2 == 0 ? "0.03\n" : "0.07\n");  // 40 frames, 2 s
+  const std::string file = writeFile("times.txt", "# alternating frames\n" + times);
+  EXPECT_EQ(hashOf(run("run samples/fountain.toml --frame-times " + file + " --format none --hash")), reference);
+}
+
+TEST_F(Cli, CheckWarnsAboutTheAliasedWindWithTheStepRateNeeded) {
+  const Result bad = run("check samples/wind_aliasing.toml");
+  EXPECT_EQ(bad.exit, 0);
+  EXPECT_NE(bad.err.find("samples/wind_aliasing.toml:"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("warning: forces.0.frequency:"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("use a step_rate of at least 33 Hz"), std::string::npos) << bad.err;
+  const Result good = run("check samples/wind_aliasing_fixed.toml");
+  EXPECT_EQ(good.exit, 0);
+  EXPECT_EQ(good.err, "");
+  EXPECT_NE(good.out.find("ok, 0 warning(s)"), std::string::npos);
+}
+
+TEST_F(Cli, EffectErrorsExitTwoAndWriteNothing) {
+  const std::string effect = writeFile("bad.toml",
+                                       "format_version = 1\n"
+                                       "[simulation]\n"
+                                       "step_rate = 0\n"
+                                       "integrator = \"rk5\"\n"
+                                       "[[emitters]]\n"
+                                       "rate = 10.0\n");
+  for (const std::string command : {"run", "check"}) {
+    const Result r = run(command + " " + effect + (command == "run" ? " --out " + path("never") : ""));
+    EXPECT_EQ(r.exit, 2) << command;
+    EXPECT_NE(r.err.find(effect + ":3:13: error: simulation.step_rate:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(effect + ":4:14: error: simulation.integrator:"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("never")));
+  }
+  const Result set = run("run samples/fountain.toml --set simulation.step_rate=-5 --out " + path("never"));
+  EXPECT_EQ(set.exit, 2);
+  EXPECT_NE(set.err.find("--set simulation.step_rate"), std::string::npos) << set.err;
+  EXPECT_FALSE(fs::exists(path("never")));
+}
+
+TEST_F(Cli, UsageErrorsExitTwoAndWriteNothing) {
+  const std::string out = " --out " + path("never");
+  for (const std::string args :
+       {"run samples/fountain.toml --seconds 1 --frames 3", "run samples/fountain.toml --fps 0",
+        "run samples/fountain.toml --fps 7/0", "run samples/fountain.toml --format gif",
+        "run samples/fountain.toml --bogus", "run samples/fountain.toml --seconds nan",
+        "run samples/fountain.toml --jitter 3 --fps 60", "run", "check", "study extra"}) {
+    const Result r = run(args + out);
+    EXPECT_EQ(r.exit, 2) << args << "\n" << r.err;
+    EXPECT_FALSE(r.err.empty()) << args;
+    EXPECT_FALSE(fs::exists(path("never"))) << args;
+  }
+  const Result missing = run("run samples/no_such_effect.toml" + out);
+  EXPECT_EQ(missing.exit, 2);
+  EXPECT_NE(missing.err.find("samples/no_such_effect.toml"), std::string::npos);
+  const Result badTimes = run("run samples/fountain.toml --frame-times " + writeFile("t.txt", "0.1\nsoon\n") + out);
+  EXPECT_EQ(badTimes.exit, 2);
+  EXPECT_NE(badTimes.err.find("t.txt:2: error: 'soon' is not a frame duration"), std::string::npos) << badTimes.err;
+}
+
+TEST_F(Cli, FailureAtRunTimeExitsOne) {
+  writeFile("occupied", "a file where the cache folder should go");
+  const Result r = run("run samples/fountain.toml --frames 2 --out " + path("occupied"));
+  EXPECT_EQ(r.exit, 1) << r.err;
+  EXPECT_NE(r.err.find("error:"), std::string::npos);
+}
+
+TEST_F(Cli, StudyWritesOneCsvPerExperiment) {
+  const Result r = run("study --out " + path("study"));
+  ASSERT_EQ(r.exit, 0) << r.err;
+  for (const char* name : {"constant_acceleration.csv", "oscillator.csv", "wind.csv"}) {
+    EXPECT_TRUE(fs::exists(path(std::string("study/") + name))) << name;
+  }
+  // Explicit Euler at dt = 1/20 s lags the exact fall by |a|·dt·T/2 = 2.4525 m after 10 s (less
+  // the float round-off of 200 steps at |p| up to 490 m).
+  const std::string csv = readAll(path("study/constant_acceleration.csv"));
+  const std::size_t row = csv.find("\nexplicit_euler,0.05,20,10,");
+  ASSERT_NE(row, std::string::npos) << csv;
+  const double error = std::stod(csv.substr(csv.rfind(',', csv.find('\n', row + 1)) + 1));
+  EXPECT_NEAR(error, 2.4525, 2e-3);
+}
+
+}  // namespace
