@@ -216,4 +216,84 @@ TEST_F(Cli, StudyWritesOneCsvPerExperiment) {
   EXPECT_NEAR(error, 2.4525, 2e-3);
 }
 
+// Bad effect files through the command line: exit code 2, the first message exactly (file, line,
+// column, key path, what is wrong and what is expected), and no output folder created. The io
+// tests check every message of these and more cases through the library.
+struct BadEffect {
+  const char* name;
+  const char* text;
+  const char* firstMessage;  // after the file name
+};
+
+const BadEffect kBadEffects[] = {
+    {"empty",
+     "",
+     ":1:1: error: format_version: missing (expected format_version = 1)"},
+    {"wrong_type",
+     "format_version = 1\n[simulation]\nstep_rate = 60\nintegrator = 42\n[[emitters]]\nrate = 10.0\n",
+     ":4:14: error: simulation.integrator: got the integer 42 (expected integrator, one of: explicit_euler, semi_implicit_euler, midpoint, position_verlet, velocity_verlet, rk4)"},
+    {"missing_step_rate",
+     "format_version = 1\n[simulation]\nintegrator = \"rk4\"\n[[emitters]]\nrate = 1.0\n",
+     ":2:1: error: simulation.step_rate: missing (expected ticks per second (Hz), an integer from 1 to 1000000)"},
+    {"unknown_key",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\nsped = 3.0\n",
+     ":6:1: error: emitters.0.sped: unknown key \"sped\" (did you mean \"speed\"?)"},
+    {"negative_rate",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = -5.0\n",
+     ":5:8: error: emitters.0.rate: -5 is out of range (expected particles per second, a number from 0 to 1e9)"},
+    {"zero_step_rate",
+     "format_version = 1\n[simulation]\nstep_rate = 0\n[[emitters]]\nrate = 1.0\n",
+     ":3:13: error: simulation.step_rate: 0 is out of range (expected ticks per second (Hz), an integer from 1 to 1000000)"},
+    {"nan",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = nan\n",
+     ":5:8: error: emitters.0.rate: nan is not a finite number (expected particles per second, a number from 0 to 1e9)"},
+    {"inf",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nspeed = inf\n",
+     ":5:9: error: emitters.0.speed: inf is not a finite number (expected metres per second, a number from 0 to 1e9)"},
+    {"absurd_count",
+     "format_version = 1\n[simulation]\nstep_rate = 60\nmax_particles = 100000000000\n[[emitters]]\nrate = 10.0\n",
+     ":4:17: error: simulation.max_particles: 100000000000 is out of range (expected an integer from 1 to 1000000000)"},
+    {"malformed",
+     "format_version = 1\n[simulation\nstep_rate = 60\n",
+     ":2:12: error: Error while parsing table header: expected ']', saw '\\n'"},
+    {"misspelt_integrator",
+     "format_version = 1\n[simulation]\nstep_rate = 60\nintegrator = \"semi_implict_euler\"\n[[emitters]]\nrate = 10.0\n",
+     ":4:14: error: simulation.integrator: unknown integrator \"semi_implict_euler\" (did you mean \"semi_implicit_euler\"?)"},
+    {"unknown_force",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\n[[forces]]\ntype = \"gravty\"\n",
+     ":7:8: error: forces.0.type: unknown force type \"gravty\" (did you mean \"gravity\"?)"},
+    {"unknown_shape",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\nshape = \"cube\"\n",
+     ":6:9: error: emitters.0.shape: unknown shape \"cube\" (expected one of: point, sphere, box, disc)"},
+    {"absurd_burst",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nbursts = [{ time = 0.0, count = 20000000000 }]\n",
+     ":5:33: error: emitters.0.bursts.0.count: 20000000000 is out of range (expected particles, an integer from 1 to simulation.max_particles = 1000000)"},
+    {"bad_fps",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\n[output]\nfps = \"30000/0\"\n",
+     ":7:7: error: output.fps: \"30000/0\" is out of range (expected frames per second, an integer from 1 to 1000000 or a ratio string like \"30000/1001\")"},
+    {"future_version",
+     "format_version = 7\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 1.0\n",
+     ":1:18: error: format_version: version 7 is not one this build reads (expected 1)"},
+    {"wind_without_frequency",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\n[[forces]]\ntype = \"wind\"\namplitude = 1.0\n",
+     ":6:1: error: forces.0.frequency: missing (expected hertz, a number from 0 to 1000000)"},
+};
+
+class CliBadEffect : public Cli, public ::testing::WithParamInterface<BadEffect> {};
+
+TEST_P(CliBadEffect, ExitsTwoWithTheMessageAndWritesNothing) {
+  const BadEffect& bad = GetParam();
+  const std::string file = writeFile(std::string(bad.name) + ".toml", bad.text);
+  for (const std::string command : {"run", "check"}) {
+    const Result r = run(command + " " + file + (command == "run" ? " --out " + path("never") : ""));
+    EXPECT_EQ(r.exit, 2) << command;
+    EXPECT_EQ(r.err.substr(0, r.err.find('\n')), file + bad.firstMessage) << command;
+    EXPECT_EQ(r.out, "") << command;
+    EXPECT_FALSE(fs::exists(path("never"))) << command;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, CliBadEffect, ::testing::ValuesIn(kBadEffects),
+                         [](const ::testing::TestParamInfo<BadEffect>& p) { return std::string(p.param.name); });
+
 }  // namespace

@@ -1,0 +1,3 @@
+if(TARGET tickfx_io)
+  tickfx_add_test(test_io_caches ${CMAKE_CURRENT_SOURCE_DIR}/test_io_caches.cpp LIBS tickfx_io)
+endif()

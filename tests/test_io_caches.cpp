@@ -1,0 +1,159 @@
+// Frame caches and frame schedules: what is written reads back bit for bit, and bad files fail
+// loudly with their name and place.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <numeric>
+
+#include "fields/Gravity.h"
+#include "io/CsvCache.h"
+#include "io/FrameData.h"
+#include "io/FrameTimes.h"
+#include "io/PlyCache.h"
+#include "particles/ParticleSystem.h"
+
+namespace fs = std::filesystem;
+
+namespace tickfx::io {
+namespace {
+
+class Caches : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("tickfx_caches_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // 300 particles with spread, jittered lifetimes (some already dead), a custom attribute and
+  // an α strictly between 0 and 1, so interpolation and every column are exercised.
+  static FrameData sampleFrame() {
+    SystemSettings settings;
+    settings.stepRateHz = 50;
+    EmitterSettings e;
+    e.shape = SphereShape{0.3, false};
+    e.bursts = {{0.0, 300}};
+    e.speed = 4.0;
+    e.spreadDegrees = 60.0;
+    e.lifetime = 0.2;
+    e.lifetimeJitter = 0.9;
+    e.mass = 0.25;
+    ForceSet forces;
+    forces.add(std::make_unique<Gravity>());
+    ParticleSystem system(settings, {e}, std::move(forces));
+    const std::size_t heat = system.pool().addAttribute("heat", 1.5f);
+    system.advance(frameDuration({24, 1}) * 3);
+    for (std::size_t i = 0; i < system.pool().size(); ++i) {
+      system.pool().attribute(heat)[static_cast<Eigen::Index>(i)] = 0.1f * static_cast<float>(i);
+    }
+    EXPECT_GT(system.alpha(), 0.0f);
+    return captureFrame(system, 3, 0.125);
+  }
+
+  static void expectSameBits(const FrameData& a, const FrameData& b) {
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(a.id, b.id);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(std::memcmp(a.position[c].data(), b.position[c].data(), a.size() * 4), 0);
+      EXPECT_EQ(std::memcmp(a.velocity[c].data(), b.velocity[c].data(), a.size() * 4), 0);
+    }
+    EXPECT_EQ(std::memcmp(a.age.data(), b.age.data(), a.size() * 4), 0);
+    EXPECT_EQ(std::memcmp(a.life.data(), b.life.data(), a.size() * 4), 0);
+    EXPECT_EQ(std::memcmp(a.mass.data(), b.mass.data(), a.size() * 4), 0);
+    ASSERT_EQ(a.attributeNames, b.attributeNames);
+    EXPECT_EQ(std::memcmp(a.attributes[0].data(), b.attributes[0].data(), a.size() * 4), 0);
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Caches, CsvRoundTripIsBitExact) {
+  const FrameData frame = sampleFrame();
+  ASSERT_GT(frame.size(), 50u);
+  ASSERT_LT(frame.size(), 300u) << "some particles should have died";
+  writeCsvCache(frame, dir_ / "f.csv");
+  expectSameBits(readCsvCache(dir_ / "f.csv"), frame);
+  std::ifstream in(dir_ / "f.csv");
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "id,px,py,pz,vx,vy,vz,age,life,mass,heat");
+}
+
+TEST_F(Caches, PlyRoundTripIsBitExactWithHeaderAndMetadata) {
+  const FrameData frame = sampleFrame();
+  writePlyCache(frame, dir_ / "f.ply");
+  const FrameData back = readPlyCache(dir_ / "f.ply");
+  expectSameBits(back, frame);
+  EXPECT_EQ(back.frame, 3);
+  EXPECT_EQ(back.timeSeconds, 0.125);
+  // Header, then exactly 8 + 10·4 bytes per particle (double id, ten floats).
+  const std::string expectedHeader =
+      "ply\nformat binary_little_endian 1.0\ncomment tickfx frame 3\ncomment time 0.125\n"
+      "element vertex " + std::to_string(frame.size()) +
+      "\nproperty double id\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float vx\nproperty float vy\nproperty float vz\nproperty float age\n"
+      "property float life\nproperty float mass\nproperty float heat\nend_header\n";
+  EXPECT_EQ(fs::file_size(dir_ / "f.ply"), expectedHeader.size() + frame.size() * 48);
+  std::ifstream in(dir_ / "f.ply", std::ios::binary);
+  std::string head(expectedHeader.size(), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  EXPECT_EQ(head, expectedHeader);
+}
+
+TEST_F(Caches, TruncatedOrForeignFilesAreRefusedByName) {
+  writePlyCache(sampleFrame(), dir_ / "f.ply");
+  fs::resize_file(dir_ / "f.ply", fs::file_size(dir_ / "f.ply") - 7);
+  try {
+    readPlyCache(dir_ / "f.ply");
+    FAIL() << "a truncated PLY was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), (dir_ / "f.ply").string() + ": truncated body");
+  }
+  std::ofstream(dir_ / "bad.csv") << "id,px,py,pz,vx,vy,vz,age,life,mass\n0,1,2,3,4,5,6,7,8,9\n1,1,2,x,4,5,6,7,8,9\n";
+  try {
+    readCsvCache(dir_ / "bad.csv");
+    FAIL() << "a malformed CSV was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), (dir_ / "bad.csv").string() + ":3: bad number 'x'");
+  }
+}
+
+TEST_F(Caches, AFailedWriteLeavesTheOldFileAndNoTemporary) {
+  const FrameData frame = sampleFrame();
+  writeCsvCache(frame, dir_ / "f.csv");
+  const auto before = fs::file_size(dir_ / "f.csv");
+  fs::create_directories(dir_ / "blocked.csv");  // a folder where the file should go
+  EXPECT_THROW(writeCsvCache(frame, dir_ / "blocked.csv"), std::exception);
+  EXPECT_EQ(fs::file_size(dir_ / "f.csv"), before);
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+}
+
+TEST(FrameTimes, SchedulesEndExactlyWhereAsked) {
+  const Flicks fiveSeconds = 5 * kFlicksPerSecond;
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const std::vector<Flicks> frames = jitteredFrames(seed, fiveSeconds);
+    EXPECT_EQ(std::accumulate(frames.begin(), frames.end(), Flicks{0}), fiveSeconds);
+    for (std::size_t i = 0; i + 1 < frames.size(); ++i) {
+      EXPECT_GE(frames[i], kFlicksPerSecond / 240);
+      EXPECT_LE(frames[i], kFlicksPerSecond / 10);
+    }
+    EXPECT_EQ(frames, jitteredFrames(seed, fiveSeconds)) << "a pure function of the seed";
+  }
+  EXPECT_NE(jitteredFrames(1, fiveSeconds), jitteredFrames(2, fiveSeconds));
+  const std::vector<Flicks> ntsc = fixedRateFrames(parseFrameRate("30000/1001"), fiveSeconds);
+  EXPECT_EQ(ntsc.size(), 150u);  // 149 whole frames of 1001/30000 s and a shorter last one
+  EXPECT_EQ(ntsc.front(), 23'543'520);
+  EXPECT_EQ(std::accumulate(ntsc.begin(), ntsc.end(), Flicks{0}), fiveSeconds);
+  EXPECT_THROW(parseFrameRate("0"), std::invalid_argument);
+  EXPECT_THROW(parseFrameRate("24/"), std::invalid_argument);
+  // 705600000 = 2⁹·3²·5⁵·7²: 1/11 s is not a whole number of flicks.
+  EXPECT_THROW(parseFrameRate("11"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tickfx::io
