@@ -13,5 +13,6 @@ inline constexpr int kExitUsage = 2;
 int runCommand(Arguments& args);
 int checkCommand(Arguments& args);
 int studyCommand(Arguments& args);
+int determinismCommand(Arguments& args);
 
 }  // namespace tickfx::app

@@ -10,6 +10,7 @@
 
 #include "app/Commands.h"
 #include "app/ProgressLine.h"
+#include "io/AtomicFile.h"
 #include "io/CsvCache.h"
 #include "io/EffectBuilder.h"
 #include "io/EffectLint.h"
@@ -38,6 +39,8 @@ constexpr const char* kHelp =
     "  --format LIST         comma-separated: csv, ply; 'none' writes no caches\n"
     "  --hash                print 'state-hash: <16 hex digits>' and 'ticks: N' of the last tick\n"
     "  --dump FILE           write the last tick's state as CSV: id,px,py,pz,vx,vy,vz,age\n"
+    "  --trace FILE          write the state hash after every tick (tick,state_hash): diff two\n"
+    "                        traces to find the first tick where two runs part\n"
     "Simulation:\n"
     "  --set key.path=value  override a key of the effect (repeatable), e.g. simulation.integrator=rk4\n"
     "  --threads N           worker threads (default: the effect's, 0 = all cores)\n"
@@ -134,6 +137,7 @@ int runCommand(Arguments& args) {
   const auto out = args.value("--out");
   const auto format = args.value("--format");
   const auto dump = args.value("--dump");
+  const auto trace = args.value("--trace");
   const auto threads = args.value("--threads");
   const bool printHash = args.flag("--hash");
   const bool quiet = args.flag("--quiet");
@@ -160,6 +164,10 @@ int runCommand(Arguments& args) {
   }
 
   const auto system = io::buildSystem(effect, threadOverride);
+  std::vector<std::pair<std::int64_t, std::uint64_t>> tickHashes;
+  if (trace) {
+    system->setTickObserver([&](const ParticleSystem& s) { tickHashes.emplace_back(s.tickCount(), stateHash(s.pool())); });
+  }
   if (!formats.empty()) std::filesystem::create_directories(outDir);
 
   const auto wallStart = std::chrono::steady_clock::now();
@@ -184,6 +192,12 @@ int runCommand(Arguments& args) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
 
   if (dump) io::writeStateDump(system->pool(), *dump);
+  if (trace) {
+    io::writeFileAtomically(*trace, [&](std::ostream& os) {
+      os << "tick,state_hash\n";
+      for (const auto& [tick, hash] : tickHashes) os << tick << ',' << hashToHex(hash) << '\n';
+    });
+  }
   const ParticlePool& pool = system->pool();
   if (!quiet) {
     std::printf("%s: %lld ticks at %lld Hz (%s), %lld frames %s, %.6g s simulated\n", effectPath.c_str(),

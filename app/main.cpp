@@ -16,6 +16,8 @@ constexpr const char* kUsage =
     "  run EFFECT.toml    simulate an effect and write per-frame caches\n"
     "  check EFFECT.toml  validate an effect and print lint warnings\n"
     "  study              the integrator study: three experiments against exact solutions\n"
+    "  determinism EFFECT.toml  run an effect under many frame rates and thread counts and\n"
+    "                     compare the state after every tick\n"
     "\n"
     "`tickfx COMMAND --help` describes a command. Exit codes: 0 ok, 2 usage or effect errors,\n"
     "1 failure at run time.\n";
@@ -39,6 +41,7 @@ int main(int argc, char** argv) {
     if (command == "run") return runCommand(args);
     if (command == "check") return checkCommand(args);
     if (command == "study") return studyCommand(args);
+    if (command == "determinism") return determinismCommand(args);
     std::fprintf(stderr, "tickfx: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return kExitUsage;
   } catch (const UsageError& e) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -66,6 +67,9 @@ class ParticleSystem {
   FixedStepDriver& driver() { return driver_; }
   const SystemSettings& settings() const { return settings_; }
   const std::vector<Emitter>& emitters() const { return emitters_; }
+  /// Calls `observer` after every tick, with the state after that tick (a trace of per-tick
+  /// hashes, a debugger's breakpoint). An empty function removes it. It runs on the driving thread.
+  void setTickObserver(std::function<void(const ParticleSystem&)> observer) { tickObserver_ = std::move(observer); }
   /// Restores the tick counter (with the pool and the driver, a saved state is complete).
   void restoreTickCount(std::int64_t tick) { tick_ = tick; }
 
@@ -80,6 +84,7 @@ class ParticleSystem {
   FixedStepDriver driver_;
   class ThreadArena;  // the TBB arena, kept out of this header
   std::unique_ptr<ThreadArena> arena_;
+  std::function<void(const ParticleSystem&)> tickObserver_;
   std::int64_t tick_ = 0;
   float alpha_ = 0.0f;
 };

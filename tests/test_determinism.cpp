@@ -1,0 +1,175 @@
+// The guarantee: the state after tick k is bitwise identical whatever frame times drove the
+// driver and whatever the thread count.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "app/DeterminismCheck.h"
+#include "fields/Gravity.h"
+#include "fields/LinearDrag.h"
+#include "fields/PeriodicWind.h"
+#include "io/EffectBuilder.h"
+#include "io/EffectParser.h"
+#include "io/FrameData.h"
+#include "io/FrameTimes.h"
+#include "particles/ParticleSystem.h"
+#include "particles/StateHash.h"
+
+namespace fs = std::filesystem;
+
+namespace tickfx::app {
+namespace {
+
+std::vector<fs::path> sampleEffects() {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(fs::path(TICKFX_SOURCE_DIR) / "samples")) {
+    if (entry.path().extension() == ".toml") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+io::EffectSettings load(const fs::path& file) {
+  const io::LoadResult r = io::loadEffectFile(file);
+  EXPECT_TRUE(r.ok()) << file;
+  return *r.effect;
+}
+
+class EverySample : public ::testing::TestWithParam<fs::path> {};
+
+TEST_P(EverySample, HashesAt1s2s5sAgreeUnderEveryFrameSchedule) {
+  const io::EffectSettings effect = load(GetParam());
+  const std::int64_t rate = effect.simulation.stepRateHz;
+  const std::vector<std::int64_t> ticks = {rate, 2 * rate, 5 * rate};
+  std::vector<DriveTrace> traces;
+  for (const DriveCase& drive : standardDriveCases(5 * kFlicksPerSecond, {1})) {
+    traces.push_back(traceDrive(effect, drive, ticks));
+    EXPECT_EQ(traces.back().ticks, ticks) << drive.label;
+    EXPECT_EQ(traces.back().ticksDropped, 0) << drive.label;
+  }
+  ASSERT_EQ(traces.size(), 10u);
+  const Divergence d = firstDivergence(traces);
+  EXPECT_EQ(d.tick, -1) << "runs part at tick " << d.tick << ", first: " << traces[d.runs.empty() ? 0 : d.runs[0]].label;
+}
+
+INSTANTIATE_TEST_SUITE_P(Samples, EverySample, ::testing::ValuesIn(sampleEffects()),
+                         [](const ::testing::TestParamInfo<fs::path>& p) { return p.param.stem().string(); });
+
+// Adds nothing; remembers which threads evaluated forces, to prove the thread count was real.
+class ThreadRecorder final : public ForceModule {
+ public:
+  std::string_view typeName() const override { return "thread_recorder"; }
+  void accumulate(const ForceInput&, RowRange, Vec3Rows&) const override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    threads_.insert(std::this_thread::get_id());
+  }
+  std::size_t distinctThreads() const { return threads_.size(); }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::set<std::thread::id> threads_;
+};
+
+TEST(Threads, OneTwoThreeAndEightThreadsGiveTheSameBitsAfterEveryTick) {
+  std::vector<std::vector<std::uint64_t>> traces;
+  for (int threads : {1, 2, 3, 8}) {
+    SystemSettings settings;
+    settings.stepRateHz = 60;
+    settings.integrator = "rk4";
+    settings.threads = threads;
+    settings.seed = 5;
+    EmitterSettings e;
+    e.shape = BoxShape{Eigen::Vector3d(4.0, 1.0, 4.0)};
+    e.bursts = {{0.0, 120000}};  // 15 blocks of rows
+    e.rate = 20000.0;
+    e.speed = 2.0;
+    e.spreadDegrees = 90.0;
+    e.lifetime = 0.25;
+    e.lifetimeJitter = 0.8;
+    ForceSet forces;
+    forces.add(std::make_unique<Gravity>());
+    PeriodicWind::Settings wind;
+    wind.amplitude = 2.0f;
+    wind.frequency = 1.5;
+    forces.add(std::make_unique<PeriodicWind>(wind));
+    forces.add(std::make_unique<LinearDrag>(0.4f));
+    auto* recorder = static_cast<ThreadRecorder*>(&forces.add(std::make_unique<ThreadRecorder>()));
+    ParticleSystem system(settings, {e}, std::move(forces));
+    std::vector<std::uint64_t> hashes;
+    system.setTickObserver([&](const ParticleSystem& s) { hashes.push_back(stateHash(s.pool())); });
+    system.stepTicks(20);
+    traces.push_back(hashes);
+    if (threads == 8) {
+      EXPECT_GT(recorder->distinctThreads(), 2u) << "8 threads asked, fewer ran";
+    }
+    if (threads == 1) {
+      EXPECT_EQ(recorder->distinctThreads(), 1u);
+    }
+  }
+  for (std::size_t i = 1; i < traces.size(); ++i) EXPECT_EQ(traces[i], traces[0]) << "thread set " << i;
+}
+
+// A frame that two schedules both render shows the same bits: t = 1 s and 2 s at 24, 60 and
+// 120 fps; t = 0.2 s at 25 and 50 fps.
+TEST(InterpolatedCaches, AFrameTwoSchedulesShareIsBitwiseIdentical) {
+  const io::EffectSettings effect = load(fs::path(TICKFX_SOURCE_DIR) / "samples/burst.toml");
+  auto frameAt = [&](FrameRate rate, Flicks time) {
+    const auto system = io::buildSystem(effect, 1);
+    const Flicks frame = frameDuration(rate);
+    for (Flicks t = 0; t < time; t += frame) system->advance(frame);
+    return io::captureFrame(*system, 0, secondsFromFlicks(time));
+  };
+  auto expectSame = [](const io::FrameData& a, const io::FrameData& b, const char* what) {
+    ASSERT_GT(a.size(), 0u) << what;
+    ASSERT_EQ(a.id, b.id) << what;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(std::memcmp(a.position[c].data(), b.position[c].data(), a.size() * sizeof(float)), 0) << what;
+      EXPECT_EQ(std::memcmp(a.velocity[c].data(), b.velocity[c].data(), a.size() * sizeof(float)), 0) << what;
+    }
+    EXPECT_EQ(std::memcmp(a.age.data(), b.age.data(), a.size() * sizeof(float)), 0) << what;
+  };
+  for (Flicks t : {kFlicksPerSecond, 2 * kFlicksPerSecond}) {
+    const io::FrameData at24 = frameAt({24, 1}, t);
+    expectSame(at24, frameAt({60, 1}, t), "24 vs 60 fps");
+    expectSame(at24, frameAt({120, 1}, t), "24 vs 120 fps");
+  }
+  // 0.2 s is 24 ticks at 120 Hz plus nothing: and at 25 fps vs 50 fps an α of 0 on both sides.
+  expectSame(frameAt({25, 1}, kFlicksPerSecond / 5), frameAt({50, 1}, kFlicksPerSecond / 5), "25 vs 50 fps");
+}
+
+TEST(FirstDivergence, NamesTheFirstTickAndTheRunsThatDiffer) {
+  std::vector<DriveTrace> traces(3);
+  for (DriveTrace& t : traces) t.ticks = {1, 2, 3, 4};
+  traces[0].hashes = {10, 20, 30, 40};
+  traces[1].hashes = {10, 20, 30, 40};
+  traces[2].hashes = {10, 20, 31, 41};
+  Divergence d = firstDivergence(traces);
+  EXPECT_EQ(d.tick, 3);
+  EXPECT_EQ(d.runs, std::vector<std::size_t>{2});
+  traces[2].hashes = {10, 20, 30, 40};
+  EXPECT_EQ(firstDivergence(traces).tick, -1);
+  traces[1].ticks.pop_back();  // a run that stopped short parts where it stopped
+  traces[1].hashes.pop_back();
+  d = firstDivergence(traces);
+  EXPECT_EQ(d.tick, 4);
+  EXPECT_EQ(d.runs, std::vector<std::size_t>{1});
+}
+
+TEST(FirstDivergence, ADifferentSeedIsCaughtAtTheFirstTickWithParticles) {
+  io::EffectSettings effect = load(fs::path(TICKFX_SOURCE_DIR) / "samples/fountain.toml");
+  const DriveCase drive{"60 fps", io::fixedRateFrames({60, 1}, kFlicksPerSecond / 2), 1};
+  std::vector<DriveTrace> traces{traceDrive(effect, drive)};
+  effect.simulation.seed += 1;
+  traces.push_back(traceDrive(effect, drive));
+  const Divergence d = firstDivergence(traces);
+  EXPECT_EQ(d.tick, 1) << "the fountain emits in its first tick";
+  EXPECT_EQ(d.runs, std::vector<std::size_t>{1});
+}
+
+}  // namespace
+}  // namespace tickfx::app
