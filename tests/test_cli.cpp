@@ -201,6 +201,27 @@ TEST_F(Cli, FailureAtRunTimeExitsOne) {
   EXPECT_NE(r.err.find("error:"), std::string::npos);
 }
 
+TEST_F(Cli, DeterminismPrintsTheTableAndAVerdict) {
+  const Result r = run("determinism samples/fountain.toml --seconds 1 --threads 1,2");
+  EXPECT_EQ(r.exit, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("30000/1001 fps"), std::string::npos);
+  EXPECT_NE(r.out.find("jitter 3"), std::string::npos);
+  EXPECT_NE(r.out.find("verdict: all 12 runs agree bit for bit after every one of 120 ticks"), std::string::npos) << r.out;
+  // The same hash as a plain run of the same length.
+  const std::string plain = hashOf(run("run samples/fountain.toml --seconds 1 --format none --hash"));
+  EXPECT_NE(r.out.find("(state-hash " + plain.substr(0, 16) + ")"), std::string::npos) << r.out;
+  EXPECT_EQ(run("determinism samples/fountain.toml --threads 0").exit, 2);
+}
+
+TEST_F(Cli, TracesOfTwoFrameRatesAreIdenticalTickForTick) {
+  ASSERT_EQ(run("run samples/burst.toml --seconds 2 --fps 24 --format none --trace " + path("a.csv")).exit, 0);
+  ASSERT_EQ(run("run samples/burst.toml --seconds 2 --jitter 5 --format none --trace " + path("b.csv")).exit, 0);
+  const std::string a = readAll(path("a.csv"));
+  EXPECT_EQ(a.rfind("tick,state_hash\n1,", 0), 0u) << a.substr(0, 40);
+  EXPECT_NE(a.find("\n240,"), std::string::npos) << "2 s at 120 Hz";
+  EXPECT_EQ(a, readAll(path("b.csv")));
+}
+
 TEST_F(Cli, StudyWritesOneCsvPerExperiment) {
   const Result r = run("study --out " + path("study"));
   ASSERT_EQ(r.exit, 0) << r.err;
