@@ -3,6 +3,8 @@
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -11,6 +13,7 @@
 #include "app/Commands.h"
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
+#include "io/Checkpoint.h"
 #include "io/CsvCache.h"
 #include "io/EffectBuilder.h"
 #include "io/EffectLint.h"
@@ -41,6 +44,11 @@ constexpr const char* kHelp =
     "  --dump FILE           write the last tick's state as CSV: id,px,py,pz,vx,vy,vz,age\n"
     "  --trace FILE          write the state hash after every tick (tick,state_hash): diff two\n"
     "                        traces to find the first tick where two runs part\n"
+    "Checkpoints:\n"
+    "  --checkpoint-every N  write the whole state after every N-th frame ...\n"
+    "  --checkpoint-dir D    ... into D/checkpoint_<frame>.tfxc (default: the cache directory)\n"
+    "  --resume FILE         continue from a checkpoint of this effect (same --set and frame\n"
+    "                        options as the run that wrote it); reaches the same state hash\n"
     "Simulation:\n"
     "  --set key.path=value  override a key of the effect (repeatable), e.g. simulation.integrator=rk4\n"
     "  --threads N           worker threads (default: the effect's, 0 = all cores)\n"
@@ -121,6 +129,20 @@ std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t f
   return dir / name;
 }
 
+std::filesystem::path checkpointPath(const std::filesystem::path& dir, std::int64_t frame) {
+  char name[64];
+  std::snprintf(name, sizeof name, "checkpoint_%06" PRId64 ".tfxc", frame);
+  return dir / name;
+}
+
+// The effect as a checkpoint knows it: the file's bytes and every override, in order.
+std::uint64_t effectFingerprint(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const std::string& o : overrides) bytes += '\0' + o;
+  return io::fingerprint(bytes);
+}
+
 }  // namespace
 
 int runCommand(Arguments& args) {
@@ -138,6 +160,9 @@ int runCommand(Arguments& args) {
   const auto format = args.value("--format");
   const auto dump = args.value("--dump");
   const auto trace = args.value("--trace");
+  const auto checkpointEvery = args.value("--checkpoint-every");
+  const auto checkpointDir = args.value("--checkpoint-dir");
+  const auto resume = args.value("--resume");
   const auto threads = args.value("--threads");
   const bool printHash = args.flag("--hash");
   const bool quiet = args.flag("--quiet");
@@ -163,19 +188,52 @@ int runCommand(Arguments& args) {
     return kExitUsage;
   }
 
+  std::int64_t every = 0;
+  if (checkpointEvery) every = parseInteger(*checkpointEvery, "run: --checkpoint-every", 1, 1'000'000'000);
+  if (checkpointDir && !checkpointEvery) throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
+  const std::filesystem::path checkpoints = checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
+  const std::uint64_t effectHash = effectFingerprint(effectPath, overrides);
+
   const auto system = io::buildSystem(effect, threadOverride);
+  std::int64_t firstFrame = 1;
+  Flicks resumedAt = 0;
+  if (resume) {
+    // Verified whole before anything is written; a refusal is bad input (exit 2).
+    io::CheckpointInfo info;
+    try {
+      info = io::readCheckpoint(*resume, *system, effectHash);
+    } catch (const std::runtime_error& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      return kExitUsage;
+    }
+    Flicks planned = 0;
+    for (std::int64_t f = 0; f < info.frame && f < static_cast<std::int64_t>(plan.frames.size()); ++f) {
+      planned += plan.frames[static_cast<std::size_t>(f)];
+    }
+    if (info.frame > static_cast<std::int64_t>(plan.frames.size()) || planned != info.elapsed) {
+      std::fprintf(stderr,
+                   "%s: error: the checkpoint is at frame %lld (%.9g s) but this run's frame %lld ends at "
+                   "%.9g s (give the frame options of the run that wrote it)\n",
+                   resume->c_str(), static_cast<long long>(info.frame), secondsFromFlicks(info.elapsed),
+                   static_cast<long long>(info.frame), secondsFromFlicks(planned));
+      return kExitUsage;
+    }
+    firstFrame = info.frame + 1;
+    resumedAt = info.elapsed;
+  }
   std::vector<std::pair<std::int64_t, std::uint64_t>> tickHashes;
   if (trace) {
     system->setTickObserver([&](const ParticleSystem& s) { tickHashes.emplace_back(s.tickCount(), stateHash(s.pool())); });
   }
   if (!formats.empty()) std::filesystem::create_directories(outDir);
+  if (every > 0) std::filesystem::create_directories(checkpoints);
 
   const auto wallStart = std::chrono::steady_clock::now();
   ProgressLine progress;
-  Flicks elapsed = 0;
+  Flicks elapsed = resumedAt;
   std::int64_t ticksDropped = 0;
   const auto frameCount = static_cast<std::int64_t>(plan.frames.size());
-  for (std::int64_t f = 1; f <= frameCount; ++f) {
+  for (std::int64_t f = firstFrame; f <= frameCount; ++f) {
     const Flicks duration = plan.frames[static_cast<std::size_t>(f - 1)];
     ticksDropped += system->advance(duration).ticksDropped;
     elapsed += duration;
@@ -185,6 +243,9 @@ int runCommand(Arguments& args) {
         if (fmt == io::CacheFormat::Csv) io::writeCsvCache(data, cachePath(outDir, f, "csv"));
         if (fmt == io::CacheFormat::Ply) io::writePlyCache(data, cachePath(outDir, f, "ply"));
       }
+    }
+    if (every > 0 && f % every == 0) {
+      io::writeCheckpoint(checkpointPath(checkpoints, f), *system, io::CheckpointInfo{effectHash, f, elapsed});
     }
     progress.update(f, frameCount, secondsFromFlicks(elapsed), system->pool().size());
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "particles/ParallelFor.h"
 
@@ -159,8 +161,13 @@ std::size_t ParticlePool::findAttribute(const std::string& name) const {
 
 void ParticlePool::resizeForRestore(std::size_t size, std::uint64_t nextId,
                                     std::uint64_t droppedSpawns) {
+  if (size > maxParticles_) {
+    throw std::invalid_argument("restored particle count " + std::to_string(size) + " exceeds max_particles " +
+                                std::to_string(maxParticles_));
+  }
   reserve(size);
-  size_ = std::min(size, storageRows_);
+  size_ = size;
+  std::fill(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
   firstUnstepped_ = size_;
   nextId_ = nextId;
   droppedSpawns_ = droppedSpawns;

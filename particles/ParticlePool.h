@@ -117,7 +117,8 @@ class ParticlePool {
   std::size_t storageRows() const { return storageRows_; }
   /// Makes room for `rows` rows without changing size() (for restoring a saved state).
   void reserve(std::size_t rows);
-  /// Sets size() directly; rows past the old size must then be written by the caller (restore).
+  /// Sets size() directly (throws std::invalid_argument past maxParticles) and clears the dead
+  /// flags; the caller then writes every column of rows [0, size) (restoring a saved state).
   void resizeForRestore(std::size_t size, std::uint64_t nextId, std::uint64_t droppedSpawns);
 
  private:

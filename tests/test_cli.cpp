@@ -222,6 +222,60 @@ TEST_F(Cli, TracesOfTwoFrameRatesAreIdenticalTickForTick) {
   EXPECT_EQ(a, readAll(path("b.csv")));
 }
 
+TEST_F(Cli, AResumedRunReachesTheUninterruptedHash) {
+  const std::string args = "run samples/smoke_drift.toml --seconds 3 --fps 24 --format none --hash";
+  const Result whole = run(args + " --checkpoint-every 20 --checkpoint-dir " + path("ck"));
+  ASSERT_EQ(whole.exit, 0) << whole.err;
+  for (const char* f : {"checkpoint_000020.tfxc", "checkpoint_000040.tfxc", "checkpoint_000060.tfxc"}) {
+    EXPECT_TRUE(fs::exists(path(std::string("ck/") + f))) << f;
+  }
+  EXPECT_FALSE(fs::exists(path("ck/checkpoint_000080.tfxc")));
+  for (const char* from : {"ck/checkpoint_000020.tfxc", "ck/checkpoint_000060.tfxc"}) {
+    const Result resumed = run(args + " --resume " + path(from));
+    ASSERT_EQ(resumed.exit, 0) << resumed.err;
+    EXPECT_EQ(hashOf(resumed), hashOf(whole)) << from;
+  }
+  // The caches of a resumed run carry on with the frame numbers of the uninterrupted one.
+  ASSERT_EQ(run("run samples/smoke_drift.toml --seconds 3 --fps 24 --format csv --out " + path("c") +
+                " --resume " + path("ck/checkpoint_000060.tfxc")).exit, 0);
+  EXPECT_FALSE(fs::exists(path("c/frame_0060.csv")));
+  EXPECT_TRUE(fs::exists(path("c/frame_0061.csv")));
+  EXPECT_TRUE(fs::exists(path("c/frame_0072.csv")));
+}
+
+TEST_F(Cli, BadCheckpointsAreRefusedAndNothingIsWritten) {
+  ASSERT_EQ(run("run samples/burst.toml --seconds 1 --fps 24 --format none --checkpoint-every 12 --checkpoint-dir " +
+                path("ck")).exit, 0);
+  const std::string good = path("ck/checkpoint_000012.tfxc");
+  const std::string bytes = readAll(good);
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] = static_cast<char>(flipped[bytes.size() / 2] ^ 0x10);
+  const std::string corrupted = writeFile("corrupted.tfxc", flipped);
+  const std::string truncated = writeFile("truncated.tfxc", bytes.substr(0, bytes.size() - 1));
+  const std::string out = " --format csv --out " + path("never");
+  struct Case {
+    std::string args, message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"run samples/burst.toml --seconds 1 --fps 24 --resume " + corrupted,
+            corrupted + ": error: checksum mismatch"},
+           {"run samples/burst.toml --seconds 1 --fps 24 --resume " + truncated,
+            truncated + ": error: checkpoint is truncated (expected " + std::to_string(bytes.size()) + " bytes, found " +
+                std::to_string(bytes.size() - 1) + ")"},
+           {"run samples/fountain.toml --seconds 1 --fps 24 --resume " + good,
+            good + ": error: checkpoint was written for another effect"},
+           {"run samples/burst.toml --seconds 1 --fps 24 --set simulation.seed=8 --resume " + good,
+            good + ": error: checkpoint was written for another effect"},
+           {"run samples/burst.toml --seconds 1 --fps 30 --resume " + good,
+            good + ": error: the checkpoint is at frame 12 (0.5 s) but this run's frame 12 ends at 0.4 s"},
+           {"run samples/burst.toml --seconds 1 --fps 24 --resume " + path("missing.tfxc"), path("missing.tfxc")}}) {
+    const Result r = run(c.args + out);
+    EXPECT_EQ(r.exit, 2) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind(c.message, 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(path("never"))) << c.args;
+  }
+}
+
 TEST_F(Cli, StudyWritesOneCsvPerExperiment) {
   const Result r = run("study --out " + path("study"));
   ASSERT_EQ(r.exit, 0) << r.err;

@@ -1,0 +1,77 @@
+// Checkpoints: the whole simulation state in one file, so that a run can stop and resume and
+// still reach the state hash of the uninterrupted run.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string_view>
+
+#include "particles/Clock.h"
+#include "particles/ParticleSystem.h"
+
+namespace tickfx::io {
+
+/// What the caller stores beside the simulation state and gets back on resume.
+struct CheckpointInfo {
+  /// Fingerprint of the effect (file bytes and overrides, see fingerprint()), computed by the
+  /// caller; a checkpoint is only ever read back into the effect it was written for.
+  std::uint64_t effectHash = 0;
+  /// Frames completed when the checkpoint was written.
+  std::int64_t frame = 0;
+  /// Flicks of frame time fed to the driver so far.
+  Flicks elapsed = 0;
+};
+
+/// The format version this build writes and the only one it reads.
+inline constexpr std::uint32_t kCheckpointVersion = 1;
+
+/// Writes the state of `system` (after its last completed tick) and `info` to `path`.
+///
+/// The file appears whole or not at all (io::writeFileAtomically): when writing fails, an
+/// existing `path` is left as it was and no temporary stays behind. Throws std::runtime_error
+/// "PATH: error: cannot write checkpoint (...)".
+///
+/// Layout, version 1, every integer little-endian, floats as their IEEE-754 bits:
+///
+///     header   "TICKFXCK"  u32 version  u32 flags (0)  u64 file length  u64 effect hash
+///     payload  i64 step rate (Hz)   str integrator   u64 max particles
+///              i64 max ticks per frame   u32 overrun policy (0 drop excess, 1 fall behind)
+///              i64 tick count   i64 ticks issued   i64 ticks dropped   i64 driver remainder
+///              i64 frame   i64 elapsed (flicks)
+///              u64 particle count n   u64 next id   u64 dropped spawns   u32 attribute count
+///              f32[n] × 16: position, velocity, previous position, acceleration (x, y, z each),
+///                           age, lifetime, mass, inverse mass
+///              u64[n] id   i64[n] birth tick
+///              per attribute: str name, f32[n] values
+///     trailer  u64 checksum: fingerprint() of every byte before it
+///
+/// where str is a u32 byte count followed by that many UTF-8 bytes.
+void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,
+                     const CheckpointInfo& info);
+
+/// Reads the checkpoint at `path` into `system` and returns the stored info.
+///
+/// The whole file is read and verified before `system` is touched: magic, version, length,
+/// checksum, `expectedEffectHash`, then that `system` was built from matching settings (step
+/// rate, integrator, max particles, max ticks per frame, overrun policy, the same attribute
+/// names). Only then are the pool (every column and attribute, size, next id, dropped spawns),
+/// the driver (ticks issued, ticks dropped, remainder) and the tick count replaced, so `system`
+/// continues exactly as the system that wrote the file would have. ParticleSystem::alpha() is
+/// not part of the state: it is that of the next advance().
+///
+/// On any refusal throws std::runtime_error "PATH: error: what (expected)", e.g.
+/// "ckpt.bin: error: checkpoint is truncated (expected 5120 bytes, found 1000)", and `system` is
+/// left exactly as it was.
+CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
+                              std::uint64_t expectedEffectHash);
+
+/// A 64-bit non-cryptographic fingerprint of `bytes`, for effect hashes and the checksum.
+///
+/// Stable across versions and platforms (it is part of the file format): starting from
+/// h = 0xcbf29ce484222325, each 8-byte little-endian word w of the input (the last one padded
+/// with zero bytes) is mixed in as h = (h ^ w) · 0x100000001b3, h ^= h >> 29,
+/// h *= 0xbf58476d1ce4e5b9, h ^= h >> 32; then the byte count is mixed in the same way. Every
+/// step is a bijection of h, so any change confined to one word always changes the result.
+std::uint64_t fingerprint(std::string_view bytes);
+
+}  // namespace tickfx::io
