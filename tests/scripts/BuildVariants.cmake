@@ -1,0 +1,166 @@
+# cmake -P script behind the determinism.compilers test.
+#
+# Builds only the tickfx CLI in three more variants (clang++ Release, clang++ Debug, g++ Debug),
+# runs every sample of GOLDEN_FILE through each of them and through the main build's MAIN_TICKFX,
+# and fails with a table unless every state hash is the golden one.
+#
+# Inputs: SOURCE_DIR, WORK_DIR (variants are built in WORK_DIR/<name>), GENERATOR, MAIN_TICKFX,
+# MAIN_NAME (a label for the main build), GOLDEN_FILE.
+cmake_minimum_required(VERSION 3.22)
+
+foreach(var SOURCE_DIR WORK_DIR GENERATOR MAIN_TICKFX MAIN_NAME GOLDEN_FILE)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "BuildVariants.cmake: -D${var}=... is required")
+  endif()
+endforeach()
+
+# clang is one of the project's required Debian packages (scripts/common.sh): a machine without it
+# is misconfigured, and skipping would hide exactly the difference this test exists to find.
+find_program(CLANGXX NAMES clang++ clang++-14 NO_CACHE)
+find_program(GXX NAMES g++ g++-12 NO_CACHE)
+foreach(compiler CLANGXX GXX)
+  if(NOT ${compiler})
+    message(FATAL_ERROR "determinism.compilers: ${compiler} not found. clang and g++ are required "
+                        "packages of tickfx (scripts/common.sh installs them: "
+                        "apt-get install clang g++).")
+  endif()
+endforeach()
+
+set(variants clang-release clang-debug gcc-debug)
+set(clang-release_compiler ${CLANGXX})
+set(clang-release_type Release)
+set(clang-debug_compiler ${CLANGXX})
+set(clang-debug_type Debug)
+set(gcc-debug_compiler ${GXX})
+set(gcc-debug_type Debug)
+
+cmake_host_system_information(RESULT jobs QUERY NUMBER_OF_LOGICAL_CORES)
+
+set(failures 0)
+
+# A variant that does not build is a finding (the project's code rejected by one compiler or one
+# build type): it is reported with the compiler's output, and the other variants still run.
+function(run_step what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message("determinism.compilers: ${what} failed (${rc}):\n  ${ARGN}\n${out}\n${err}")
+    set(step_ok FALSE PARENT_SCOPE)
+  endif()
+endfunction()
+
+foreach(v ${variants})
+  set(dir ${WORK_DIR}/${v})
+  # A kept variant directory makes a second run incremental; one configured with another generator
+  # or compiler cannot be reconfigured in place, so it is started afresh.
+  if(EXISTS ${dir}/CMakeCache.txt)
+    file(STRINGS ${dir}/CMakeCache.txt cached REGEX "^(CMAKE_GENERATOR|CMAKE_CXX_COMPILER):")
+    list(TRANSFORM cached REPLACE ":[A-Z]+=" "=")
+    if(NOT "CMAKE_CXX_COMPILER=${${v}_compiler}" IN_LIST cached OR
+       NOT "CMAKE_GENERATOR=${GENERATOR}" IN_LIST cached)
+      file(REMOVE_RECURSE ${dir})
+    endif()
+  endif()
+  string(TIMESTAMP start "%s")
+  set(step_ok TRUE)
+  # -Werror stays off: a warning of the other compiler is not what this test is about, and an
+  # error that remains is a real one.
+  run_step("configuring ${v}" ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${dir} -G ${GENERATOR}
+      -DCMAKE_CXX_COMPILER=${${v}_compiler} -DCMAKE_BUILD_TYPE=${${v}_type}
+      -DTICKFX_BUILD_TESTS=OFF -DTICKFX_BUILD_BENCH=OFF -DTICKFX_BUILD_SAMPLES=OFF
+      -DTICKFX_BUILD_CLI=ON -DTICKFX_WERROR=OFF -DTICKFX_SANITIZE=OFF)
+  if(step_ok)
+    run_step("building ${v} (${${v}_compiler}, ${${v}_type})"
+             ${CMAKE_COMMAND} --build ${dir} --target tickfx_cli -j ${jobs})
+  endif()
+  string(TIMESTAMP stop "%s")
+  math(EXPR seconds "${stop} - ${start}")
+  if(step_ok)
+    message("built ${v} (${${v}_compiler}, ${${v}_type}) in ${seconds} s")
+    set(${v}_tickfx ${dir}/bin/tickfx)
+  else()
+    math(EXPR failures "${failures} + 1")
+  endif()
+endforeach()
+
+set(runs ${MAIN_NAME} ${variants})
+set(${MAIN_NAME}_tickfx ${MAIN_TICKFX})
+
+file(STRINGS ${GOLDEN_FILE} lines)
+set(samples "")
+foreach(line ${lines})
+  if(line MATCHES "^([^# \t]+)[ \t]+([0-9a-f]+)[ \t]*$")
+    list(APPEND samples ${CMAKE_MATCH_1})
+    set(golden_${CMAKE_MATCH_1} ${CMAKE_MATCH_2})
+  endif()
+endforeach()
+if(NOT samples)
+  message(FATAL_ERROR "determinism.compilers: no hashes in ${GOLDEN_FILE}")
+endif()
+
+# Left-aligns `text` in `width` columns, appended to the variable `out`.
+function(append_cell out text width)
+  string(LENGTH "${text}" n)
+  set(spaces "")
+  if(n LESS width)
+    math(EXPR pad "${width} - ${n}")
+    string(REPEAT " " ${pad} spaces)
+  endif()
+  set(${out} "${${out}}${text}${spaces}  " PARENT_SCOPE)
+endfunction()
+
+# The hash `tickfx` gives for `sample`, or a word saying why there is none. 60 fps frames take the
+# driver's path, as a user's run does, where the golden test takes stepTicks. A tick dropped by the
+# cap would give the hash of an earlier tick, so a drop is a failure of its own.
+function(hash_of out tickfx sample)
+  if(NOT tickfx)
+    set(${out} "no-build" PARENT_SCOPE)
+    return()
+  endif()
+  execute_process(
+    COMMAND ${tickfx} run samples/${sample} --seconds 2 --fps 60 --format none --hash
+    WORKING_DIRECTORY ${SOURCE_DIR}
+    RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE stderr)
+  set(hash "")
+  if(stdout MATCHES "state-hash: ([0-9a-f]+)")
+    set(hash ${CMAKE_MATCH_1})
+  endif()
+  if(NOT rc EQUAL 0 OR NOT hash)
+    message("${tickfx} run samples/${sample} failed (${rc}):\n${stdout}\n${stderr}")
+    set(${out} "run-failed" PARENT_SCOPE)
+  elseif(NOT stdout MATCHES "ticks dropped by the cap \\([^)]*\\): 0\n")
+    message("${tickfx} run samples/${sample}: the cap dropped ticks at 60 fps:\n${stdout}")
+    set(${out} "dropped-ticks" PARENT_SCOPE)
+  else()
+    set(${out} ${hash} PARENT_SCOPE)
+  endif()
+endfunction()
+
+set(table "")
+append_cell(table "sample" 26)
+append_cell(table "golden" 16)
+foreach(r ${runs})
+  append_cell(table "${r}" 17)
+endforeach()
+string(APPEND table "\n")
+foreach(s ${samples})
+  append_cell(table "${s}" 26)
+  append_cell(table "${golden_${s}}" 16)
+  foreach(r ${runs})
+    hash_of(cell "${${r}_tickfx}" ${s})
+    if(NOT cell STREQUAL "${golden_${s}}")
+      string(APPEND cell "*")
+      math(EXPR failures "${failures} + 1")
+    endif()
+    append_cell(table "${cell}" 17)
+  endforeach()
+  string(APPEND table "\n")
+endforeach()
+
+message("state hashes of `tickfx run samples/<sample> --seconds 2 --fps 60 --format none --hash` "
+        "(* not the golden hash):\n${table}")
+if(failures GREATER 0)
+  message(FATAL_ERROR "determinism.compilers: ${failures} build(s) or run(s) did not give the "
+                      "golden hash of ${GOLDEN_FILE}. The promise is that the state after tick k "
+                      "is the same bits with g++ or clang++, Release or Debug.")
+endif()
+message("determinism.compilers: every build gives every golden hash")
