@@ -15,6 +15,8 @@ bool ForceSet::isLocal() const {
 
 void ForceSet::beginTick(const ParticlePool& pool, std::int64_t tick) {
   for (auto& m : modules_) m->beginTick(pool, tick);
+  const auto n = static_cast<Eigen::Index>(pool.size());
+  anyPinned_ = n > 0 && (pool.inverseMass().head(n) == 0.0f).any();
 }
 
 void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
@@ -31,6 +33,13 @@ void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& accelerat
   acceleration.y.setConstant(uniform.y());
   acceleration.z.setConstant(uniform.z());
   for (; next < modules_.size(); ++next) modules_[next]->accumulate(in, rows, acceleration);
+  if (anyPinned_) {
+    // A pinned particle (infinite mass) does not move: no force accelerates it, gravity included.
+    const auto pinned = in.pool.inverseMass().segment(rows.offset(), rows.count()) == 0.0f;
+    acceleration.x = pinned.select(0.0f, acceleration.x);
+    acceleration.y = pinned.select(0.0f, acceleration.y);
+    acceleration.z = pinned.select(0.0f, acceleration.z);
+  }
 }
 
 }  // namespace tickfx

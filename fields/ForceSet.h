@@ -25,14 +25,17 @@ class ForceSet {
   /// True when every module is local (see ForceModule::isLocal).
   bool isLocal() const;
 
+  /// Once per tick before any evaluation: the modules' beginTick, and whether any particle is
+  /// pinned (inverse mass 0), which evaluate() then holds still.
   void beginTick(const ParticlePool& pool, std::int64_t tick);
 
   /// Writes the total acceleration at `in` for rows `rows` into `acceleration` (overwrites):
-  /// 0 + a_1 + a_2 + ... in module order, for every row.
+  /// 0 + a_1 + a_2 + ... in module order, for every row; 0 for pinned particles.
   void evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const;
 
  private:
   std::vector<std::unique_ptr<ForceModule>> modules_;
+  bool anyPinned_ = false;
 };
 
 }  // namespace tickfx

@@ -154,6 +154,9 @@ class Reader {
 
 // Everything the file says, parsed and checked but not yet applied; the columns still point
 // into the file's bytes.
+// A spring on file: ids a and b, then rest length, stiffness, damping and break ratio as float bits.
+constexpr std::size_t kSpringBytes = 8 + 8 + 4 * 4;
+
 struct Parsed {
   std::int64_t stepRateHz = 0;
   std::string_view integrator;
@@ -168,6 +171,8 @@ struct Parsed {
   const char* ids = nullptr;
   const char* births = nullptr;
   std::vector<std::pair<std::string_view, const char*>> attributes;
+  std::vector<Spring> springs;
+  std::uint64_t springsBroken = 0;
 };
 
 Parsed parsePayload(std::string_view payload) {
@@ -195,8 +200,21 @@ Parsed parsePayload(std::string_view payload) {
     const std::string_view name = r.str("an attribute name");
     p.attributes.emplace_back(name, r.column(p.size, 4, "an attribute column"));
   }
+  const std::uint64_t springs = r.u64("the spring count");
+  p.springsBroken = r.u64("the broken-spring count");
+  if (springs > r.remaining() / kSpringBytes) throw Malformed{"it ends inside the springs"};
+  p.springs.resize(static_cast<std::size_t>(springs));
+  for (Spring& spring : p.springs) {
+    spring.a = r.u64("a spring");
+    spring.b = r.u64("a spring");
+    const std::uint32_t fields[4] = {r.u32("a spring"), r.u32("a spring"), r.u32("a spring"), r.u32("a spring")};
+    std::memcpy(&spring.restLength, &fields[0], 4);
+    std::memcpy(&spring.stiffness, &fields[1], 4);
+    std::memcpy(&spring.damping, &fields[2], 4);
+    std::memcpy(&spring.breakRatio, &fields[3], 4);
+  }
   if (r.remaining() != 0) {
-    throw Malformed{std::to_string(r.remaining()) + " bytes follow the last attribute"};
+    throw Malformed{std::to_string(r.remaining()) + " bytes follow the last spring"};
   }
   if (p.tick < 0 || p.ticksIssued < 0 || p.ticksDropped < 0 || p.remainder < 0) {
     throw Malformed{"negative tick count or driver state"};
@@ -265,6 +283,10 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
     return "checkpoint has particle attributes " + nameList(stored) + " (expected " +
            nameList(expected) + ")";
   }
+  if (!p.springs.empty() && system.springs() == nullptr) {
+    return "checkpoint has " + std::to_string(p.springs.size()) +
+           " springs (expected none: this effect has no structures)";
+  }
   if (p.size > pool.maxParticles()) {
     return "checkpoint is malformed (" + std::to_string(p.size) +
            " particles, more than max_particles " + std::to_string(pool.maxParticles()) + ")";
@@ -288,6 +310,7 @@ void apply(const Parsed& p, ParticleSystem& system) {
   }
   // Between ticks no particle is flagged; a used target may have stale flags past its old size.
   std::fill_n(pool.dead().begin(), n, std::uint8_t{0});
+  if (system.springs() != nullptr) system.springs()->restore(p.springs, p.springsBroken);
   system.driver().restore(p.ticksIssued, p.ticksDropped, p.remainder);
   system.restoreTickCount(p.tick);
 }
@@ -362,6 +385,19 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   for (std::size_t a = 0; a < pool.attributeCount(); ++a) {
     w.str(pool.attributeName(a));
     w.column(pool.attribute(a).data(), n);
+  }
+  const std::vector<Spring> none;
+  const std::vector<Spring>& springs = system.springs() ? system.springs()->springs() : none;
+  w.u64(springs.size());
+  w.u64(system.springs() ? system.springs()->brokenCount() : 0);
+  for (const Spring& spring : springs) {
+    w.u64(spring.a);
+    w.u64(spring.b);
+    for (float value : {spring.restLength, spring.stiffness, spring.damping, spring.breakRatio}) {
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, &value, 4);
+      w.u32(bits);
+    }
   }
 
   w.patchU64(kLengthOffset, w.bytes().size() + kTrailerBytes);

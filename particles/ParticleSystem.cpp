@@ -5,6 +5,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include "particles/Clock.h"
 #include "particles/ParallelFor.h"
 
 namespace tickfx {
@@ -44,7 +45,8 @@ std::vector<Emitter> makeEmitters(const std::vector<EmitterSettings>& settings, 
 }  // namespace
 
 ParticleSystem::ParticleSystem(const SystemSettings& settings,
-                               const std::vector<EmitterSettings>& emitters, ForceSet forces)
+                               const std::vector<EmitterSettings>& emitters, ForceSet forces,
+                               const std::vector<StructureSettings>& structures)
     : settings_(settings),
       pool_(settings.maxParticles),
       emitters_(makeEmitters(emitters, settings.stepRateHz)),
@@ -53,6 +55,20 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
       driver_(settings.stepRateHz, settings.maxTicksPerFrame, settings.overrunPolicy),
       arena_(std::make_unique<ThreadArena>(settings.threads)) {
   if (settings.threads < 0) throw std::invalid_argument("threads must be >= 0");
+  for (std::size_t i = 0; i < forces_.size() && springs_ == nullptr; ++i) {
+    springs_ = dynamic_cast<SpringNetwork*>(&forces_.module(i));
+  }
+  if (!structures.empty() && springs_ == nullptr) {
+    springs_ = static_cast<SpringNetwork*>(&forces_.add(std::make_unique<SpringNetwork>()));
+  }
+  for (std::size_t i = 0; i < structures.size(); ++i) {
+    // Validate now, not at the structure's birth tick: bad settings fail the construction.
+    buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
+    const Flicks at = flicksFromSeconds(structures[i].time);
+    const auto tick = static_cast<std::int64_t>(
+        (static_cast<__int128>(at) * settings.stepRateHz + kFlicksPerSecond - 1) / kFlicksPerSecond);
+    structures_.push_back(PendingStructure{structures[i], tick, static_cast<std::uint32_t>(i)});
+  }
 }
 
 ParticleSystem::~ParticleSystem() = default;
@@ -78,12 +94,33 @@ void ParticleSystem::stepTicks(std::int64_t ticks) {
 
 void ParticleSystem::runTick() {
   for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, tick_);
+  for (const PendingStructure& p : structures_) {
+    if (p.tick == tick_) spawnStructure(p);
+  }
   forces_.beginTick(pool_, tick_);
   integrator_->step(pool_, forces_, StepTime{tick_, settings_.stepRateHz});
   pool_.markAllStepped();
   ++tick_;
   pool_.updateAges(tick_, settings_.stepRateHz);
   pool_.removeDead();
+}
+
+void ParticleSystem::spawnStructure(const PendingStructure& p) {
+  const StructureBuild build = buildStructure(p.settings, settings_.seed, p.index);
+  std::vector<std::uint64_t> ids(build.particles.size());
+  std::vector<bool> spawned(build.particles.size(), false);
+  for (std::size_t i = 0; i < build.particles.size(); ++i) {
+    const std::size_t row = pool_.spawn(build.particles[i], tick_);
+    if (row == ParticlePool::npos) continue;  // refused by max_particles, counted by the pool
+    ids[i] = pool_.id()[row];
+    spawned[i] = true;
+  }
+  for (Spring s : build.springs) {
+    if (!spawned[s.a] || !spawned[s.b]) continue;
+    s.a = ids[s.a];
+    s.b = ids[s.b];
+    springs_->add(s);
+  }
 }
 
 void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {

@@ -12,6 +12,7 @@
 #include "particles/Emitter.h"
 #include "particles/FixedStepDriver.h"
 #include "particles/ParticlePool.h"
+#include "particles/Structure.h"
 
 namespace tickfx {
 
@@ -35,8 +36,11 @@ struct SystemSettings {
 class ParticleSystem {
  public:
   /// Throws std::invalid_argument for invalid settings (unknown integrator, bad emitter, ...).
+  ///
+  /// `structures` (ropes, cloth, clusters) are born at their time and joined by springs: the
+  /// system then uses the first SpringNetwork in `forces`, or appends one if there is none.
   ParticleSystem(const SystemSettings& settings, const std::vector<EmitterSettings>& emitters,
-                 ForceSet forces);
+                 ForceSet forces, const std::vector<StructureSettings>& structures = {});
   ~ParticleSystem();
   ParticleSystem(const ParticleSystem&) = delete;
   ParticleSystem& operator=(const ParticleSystem&) = delete;
@@ -67,6 +71,9 @@ class ParticleSystem {
   FixedStepDriver& driver() { return driver_; }
   const SystemSettings& settings() const { return settings_; }
   const std::vector<Emitter>& emitters() const { return emitters_; }
+  /// The spring network structures use (nullptr when the system has neither).
+  const SpringNetwork* springs() const { return springs_; }
+  SpringNetwork* springs() { return springs_; }
   /// Calls `observer` after every tick, with the state after that tick (a trace of per-tick
   /// hashes, a debugger's breakpoint). An empty function removes it. It runs on the driving thread.
   void setTickObserver(std::function<void(const ParticleSystem&)> observer) { tickObserver_ = std::move(observer); }
@@ -74,13 +81,22 @@ class ParticleSystem {
   void restoreTickCount(std::int64_t tick) { tick_ = tick; }
 
  private:
+  struct PendingStructure;
   void runTick();
+  void spawnStructure(const PendingStructure& p);
 
   SystemSettings settings_;
   ParticlePool pool_;
   std::vector<Emitter> emitters_;
   ForceSet forces_;
   std::unique_ptr<Integrator> integrator_;
+  struct PendingStructure {
+    StructureSettings settings;  // born at `tick`; its index keys its random numbers
+    std::int64_t tick;
+    std::uint32_t index;
+  };
+  std::vector<PendingStructure> structures_;
+  SpringNetwork* springs_ = nullptr;  // owned by forces_
   FixedStepDriver driver_;
   class ThreadArena;  // the TBB arena, kept out of this header
   std::unique_ptr<ThreadArena> arena_;

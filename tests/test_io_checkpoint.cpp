@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
+#include "fields/Gravity.h"
 #include "io/Checkpoint.h"
 #include "particles/StateHash.h"
 
@@ -343,7 +344,8 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
   ASSERT_GT(n, 0u);
 
   const std::size_t payload =
-      8 + (4 + 15) + 68 + 3 * 8 + 4 + n * (16 * 4 + 8 + 8) + (4 + 4 + 4 * n) * 2;  // "heat", "spin"
+      8 + (4 + 15) + 68 + 3 * 8 + 4 + n * (16 * 4 + 8 + 8) + (4 + 4 + 4 * n) * 2  // "heat", "spin"
+      + 8 + 8;                                                                   // no springs
   ASSERT_EQ(bytes.size(), 32 + payload + 8);
   EXPECT_EQ(bytes.substr(0, 8), "TICKFXCK");
   EXPECT_EQ(bytes.substr(8, 8), std::string("\x01\0\0\0\0\0\0\0", 8));
@@ -600,9 +602,16 @@ TEST_F(ioCheckpointRefusal, MalformedPayloadWithAGoodChecksum) {
   const std::size_t count = particleCountOffset("velocity_verlet");
   {
     std::string bad = bytes_;
-    bad.erase(bad.size() - 12, 4);  // the last value of the last attribute
+    bad.erase(bad.size() - 8 - 16 - 4, 4);  // the last value of the last attribute (16 bytes of
+                                            // spring counts follow it)
     reseal(bad);
-    expectRefused(bad, "checkpoint is malformed (it ends inside an attribute column)");
+    expectRefused(bad, "checkpoint is malformed (it ends inside the broken-spring count)");
+  }
+  {
+    std::string bad = bytes_;
+    storeU64(bad, bad.size() - 8 - 16, 3);  // three springs announced, none there
+    reseal(bad);
+    expectRefused(bad, "checkpoint is malformed (it ends inside the springs)");
   }
   {
     std::string bad = bytes_;
@@ -614,7 +623,7 @@ TEST_F(ioCheckpointRefusal, MalformedPayloadWithAGoodChecksum) {
     std::string bad = bytes_;
     bad.insert(bad.size() - 8, "\x01\x02\x03\x04\x05", 5);
     reseal(bad);
-    expectRefused(bad, "checkpoint is malformed (5 bytes follow the last attribute)");
+    expectRefused(bad, "checkpoint is malformed (5 bytes follow the last spring)");
   }
   {
     std::string bad = bytes_;
@@ -740,6 +749,56 @@ TEST(ioFingerprint, EveryBitAndTheLengthCount) {
   EXPECT_NE(fingerprint(std::string_view("", 0)), fingerprint(std::string_view("\0", 1)));
   EXPECT_NE(fingerprint(std::string_view("ab", 2)), fingerprint(std::string_view("ab\0", 3)));
   EXPECT_NE(fingerprint(std::string(8, '\0')), fingerprint(std::string(16, '\0')));
+}
+
+}  // namespace
+}  // namespace tickfx::io
+
+namespace tickfx::io {
+namespace {
+
+// A rope and a cloth with breakable springs: the spring network (springs left, broken count) is
+// part of the state a checkpoint carries.
+TEST(ioCheckpointSprings, AResumedStructureReachesTheUninterruptedHash) {
+  auto make = [] {
+    SystemSettings settings;
+    settings.stepRateHz = 120;
+    settings.integrator = "semi_implicit_euler";
+    StructureSettings rope;
+    rope.shape = RopeShape{Eigen::Vector3d(0, 2, 0), Eigen::Vector3d(2, 2, 0), 20, true, false};
+    rope.stiffness = 400.0;
+    rope.damping = 0.5;
+    rope.breakRatio = 1.02;  // gravity stretches the top links past this: some break
+    StructureSettings cloth;
+    cloth.shape = ClothShape{};
+    cloth.time = 0.1;  // born after the checkpoint below would be too late: it is born before
+    cloth.stiffness = 200.0;
+    ForceSet forces;
+    forces.add(std::make_unique<Gravity>());
+    return std::make_unique<ParticleSystem>(settings, std::vector<EmitterSettings>{}, std::move(forces),
+                                            std::vector<StructureSettings>{rope, cloth});
+  };
+  auto whole = make();
+  whole->stepTicks(240);
+  ASSERT_GT(whole->springs()->brokenCount(), 0u) << "the test wants broken springs in the state";
+
+  const fs::path path = fs::temp_directory_path() / ("tickfx_ckpt_springs_" + std::to_string(::getpid()));
+  auto first = make();
+  first->stepTicks(60);
+  ASSERT_GT(first->springs()->brokenCount(), 0u);
+  writeCheckpoint(path, *first, CheckpointInfo{42, 0, 0});
+  auto resumed = make();
+  readCheckpoint(path, *resumed, 42);
+  EXPECT_EQ(resumed->springs()->springs().size(), first->springs()->springs().size());
+  EXPECT_EQ(resumed->springs()->brokenCount(), first->springs()->brokenCount());
+  resumed->stepTicks(180);
+  EXPECT_EQ(stateHash(resumed->pool()), stateHash(whole->pool()));
+  EXPECT_EQ(resumed->springs()->brokenCount(), whole->springs()->brokenCount());
+
+  // The same file into an effect without structures is refused.
+  ParticleSystem plain(SystemSettings{}, {}, ForceSet{});
+  EXPECT_THROW(readCheckpoint(path, plain, 42), std::runtime_error);
+  fs::remove(path);
 }
 
 }  // namespace

@@ -1,0 +1,100 @@
+#include "fields/SpringNetwork.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tickfx {
+namespace {
+
+constexpr std::uint32_t kMissing = std::numeric_limits<std::uint32_t>::max();
+
+// Rows are in id order (spawns append increasing ids, deaths compact stably): binary search.
+std::uint32_t rowOf(const std::vector<std::uint64_t>& ids, std::size_t size, std::uint64_t id) {
+  const auto end = ids.begin() + static_cast<std::ptrdiff_t>(size);
+  const auto it = std::lower_bound(ids.begin(), end, id);
+  return (it != end && *it == id) ? static_cast<std::uint32_t>(it - ids.begin()) : kMissing;
+}
+
+}  // namespace
+
+void SpringNetwork::beginTick(const ParticlePool& pool, std::int64_t /*tick*/) {
+  const std::size_t n = pool.size();
+  const Vec3Column& p = pool.position();
+  // Resolve ends, drop springs with a dead end, break the overstretched: all from the state at
+  // the start of the tick, in spring order, so the surviving list is the same on every run.
+  struct Ends {
+    std::uint32_t a, b, spring;
+  };
+  std::vector<Ends> ends;
+  ends.reserve(springs_.size());
+  std::size_t kept = 0;
+  for (std::size_t s = 0; s < springs_.size(); ++s) {
+    const Spring& spring = springs_[s];
+    const std::uint32_t ra = rowOf(pool.id(), n, spring.a);
+    const std::uint32_t rb = rowOf(pool.id(), n, spring.b);
+    if (ra == kMissing || rb == kMissing) {
+      // An end not born yet keeps the spring; an end that died removes it.
+      const bool died = (ra == kMissing && spring.a < pool.nextId()) || (rb == kMissing && spring.b < pool.nextId());
+      if (!died) springs_[kept++] = spring;
+      continue;
+    }
+    if (spring.breakRatio > 0.0f) {
+      const float dx = p.x[rb] - p.x[ra], dy = p.y[rb] - p.y[ra], dz = p.z[rb] - p.z[ra];
+      const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (length > spring.breakRatio * spring.restLength) {
+        ++broken_;
+        continue;
+      }
+    }
+    ends.push_back(Ends{ra, rb, static_cast<std::uint32_t>(kept)});
+    springs_[kept++] = spring;
+  }
+  springs_.resize(kept);
+
+  // Each row's links, in spring order (a counting sort keeps that order within a row).
+  first_.assign(n + 1, 0);
+  for (const Ends& e : ends) {
+    ++first_[e.a + 1];
+    ++first_[e.b + 1];
+  }
+  for (std::size_t r = 0; r < n; ++r) first_[r + 1] += first_[r];
+  links_.resize(first_[n]);
+  std::vector<std::uint32_t> fill(first_.begin(), first_.end() - 1);
+  for (const Ends& e : ends) {
+    links_[fill[e.a]++] = Link{e.b, e.spring};
+    links_[fill[e.b]++] = Link{e.a, e.spring};
+  }
+}
+
+void SpringNetwork::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acc) const {
+  const Vec3View& p = in.position;
+  const Vec3View& v = in.velocity;
+  const FloatColumn& invMass = in.pool.inverseMass();
+  for (std::size_t i = rows.begin; i < rows.end; ++i) {
+    if (i + 1 >= first_.size()) break;  // rows spawned after beginTick (none within a tick)
+    float fx = 0.0f, fy = 0.0f, fz = 0.0f;
+    const Eigen::Vector3f pi = p.at(i), vi = v.at(i);
+    for (std::uint32_t l = first_[i]; l < first_[i + 1]; ++l) {
+      const Spring& s = springs_[links_[l].spring];
+      const std::size_t j = links_[l].other;
+      const Eigen::Vector3f pj = p.at(j), vj = v.at(j);
+      const float dx = pj.x() - pi.x(), dy = pj.y() - pi.y(), dz = pj.z() - pi.z();
+      const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (!(length > 0.0f)) continue;  // coincident ends: no direction, no force
+      const float ux = dx / length, uy = dy / length, uz = dz / length;
+      const float closing = (vj.x() - vi.x()) * ux + (vj.y() - vi.y()) * uy + (vj.z() - vi.z()) * uz;
+      const float f = s.stiffness * (length - s.restLength) + s.damping * closing;
+      fx += f * ux;
+      fy += f * uy;
+      fz += f * uz;
+    }
+    const float w = invMass[static_cast<Eigen::Index>(i)];
+    const auto k = static_cast<Eigen::Index>(i - rows.begin);
+    acc.x[k] += fx * w;
+    acc.y[k] += fy * w;
+    acc.z[k] += fz * w;
+  }
+}
+
+}  // namespace tickfx

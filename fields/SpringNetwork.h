@@ -1,0 +1,67 @@
+// Damped springs between particles: ropes, cloth, soft clusters.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "fields/ForceModule.h"
+
+namespace tickfx {
+
+/// A spring between the particles with ids `a` and `b`. Units: metres, N/m, N·s/m.
+struct Spring {
+  std::uint64_t a = 0;
+  std::uint64_t b = 0;
+  float restLength = 1.0f;  // metres
+  float stiffness = 1.0f;   // k, N/m
+  float damping = 0.0f;     // c, N·s/m, along the spring
+  /// The spring breaks, for good, at the start of a tick where its length exceeds
+  /// breakRatio · restLength; 0 means it never breaks.
+  float breakRatio = 0.0f;
+};
+
+/// Damped Hooke springs between particles: on particle i, from its spring to j,
+///   F = (k · (|d| − L) + c · (v_j − v_i)·d̂) · d̂,   d = p_j − p_i,   a_i += F / m_i.
+///
+/// Gather, not scatter: each particle sums the forces of its own springs, in the order the springs
+/// were added, reading its partners' state; the two ends of a spring compute exactly opposite
+/// forces (d and −d have the same length bits). So the result does not depend on the thread
+/// count, and the module is not local (isLocal() is false: integrators run split passes).
+///
+/// Springs are kept by particle id: at the start of each tick (beginTick) the module maps ids to
+/// rows, removes springs whose ends have died, breaks springs stretched past their ratio (from the
+/// state at the start of the tick), and rebuilds each particle's list. A particle with inverse
+/// mass 0 (pinned) gets no acceleration from springs; ForceSet zeroes every other force on it too.
+class SpringNetwork final : public ForceModule {
+ public:
+  std::string_view typeName() const override { return "springs"; }
+  bool isLocal() const override { return false; }
+  void beginTick(const ParticlePool& pool, std::int64_t tick) override;
+  void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
+
+  /// Adds a spring (ends may be spawned later; until both exist it does nothing).
+  void add(const Spring& spring) { springs_.push_back(spring); }
+  /// Springs still in the network (dead ends and broken ones are removed at beginTick).
+  const std::vector<Spring>& springs() const { return springs_; }
+  /// Springs broken by stretching since construction.
+  std::uint64_t brokenCount() const { return broken_; }
+  /// Replaces the whole network (restoring a saved state).
+  void restore(std::vector<Spring> springs, std::uint64_t broken) {
+    springs_ = std::move(springs);
+    broken_ = broken;
+  }
+
+ private:
+  struct Link {
+    std::uint32_t other;   // row of the other end
+    std::uint32_t spring;  // index into springs_
+  };
+
+  std::vector<Spring> springs_;
+  std::uint64_t broken_ = 0;
+  // Per tick: row → [first_[row], first_[row+1]) in links_, in spring order.
+  std::vector<std::uint32_t> first_;
+  std::vector<Link> links_;
+};
+
+}  // namespace tickfx
