@@ -73,7 +73,10 @@ void buildCloth(Builder& b, const ClothShape& c) {
   }
   const double k = b.s.stiffness, shear = k * c.shearStiffnessScale, bend = k * c.bendStiffnessScale;
   auto join = [&](int c0, int r0, int c1, int r1, double stiffness) {
-    if (c1 < 0 || c1 >= w || r1 < 0 || r1 >= h || stiffness <= 0.0) return;
+    // Both ends: index(w, row) is a valid index (the next row's first particle), so a spring
+    // off the grid's edge would silently wrap instead of failing.
+    const bool inside = c0 >= 0 && c0 < w && r0 >= 0 && r0 < h && c1 >= 0 && c1 < w && r1 >= 0 && r1 < h;
+    if (!inside || stiffness <= 0.0) return;
     b.spring(index(c0, r0), index(c1, r1), stiffness, at[index(c0, r0)], at[index(c1, r1)]);
   };
   // Structural, then shear, then bend, each row by row: the order of the springs is part of the

@@ -1,0 +1,374 @@
+// Spring networks: a 256 × 256 cloth (structural + shear + bend springs) hanging from its top edge
+// under gravity, semi-implicit Euler at 60 Hz, with 1 and 2 threads.
+//
+//   spring_bench                  the 256 × 256 cloth (under 10 s on 2 cores)
+//   spring_bench --quick          smoke run: a 64 × 64 cloth, short timings
+//   spring_bench --side=128       a side × side cloth
+//   spring_bench --min-time=0.5 --reps=9
+//
+// What counts as a spring evaluation: the network gathers, so every force evaluation computes each
+// spring twice, once from each end (each end sums the forces of its own springs). One spring
+// computed at one end is one "spring evaluation"; a tick of semi-implicit Euler (one force
+// evaluation) makes 2·S of them for S springs. The table also gives springs per second (S per force
+// evaluation, each spring once) and ticks per second.
+//
+// Cases, each on its own system built from the same cloth:
+//   step()          ParticleSystem::step(): structure birth (tick 0 only), SpringNetwork::beginTick
+//                   (ids to rows, per-particle link lists), the force evaluation and the update,
+//                   ages and removal of the dead: what a tick costs a user.
+//   evaluate        ForceSet::evaluate over every row in blocks of kParallelBlockRows, as an
+//                   integrator's force pass does: gravity and the springs' gather only.
+//   beginTick       SpringNetwork::beginTick alone (one thread by design: it runs before the
+//                   parallel passes).
+// Each of step() and evaluate runs with 1 and with 2 threads; the table gives the ratio 2 / 1.
+//
+// Timing as in tick_bench: each case runs in batches of ticks sized to take min-time/reps
+// seconds; the cases take turns batch by batch until each has at least `reps` batches and
+// `min-time` seconds; a case's figure is the median over its batches of the time per tick.
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "fields/ForceSet.h"
+#include "fields/Gravity.h"
+#include "fields/SpringNetwork.h"
+#include "particles/ParallelFor.h"
+#include "particles/ParticleSystem.h"
+#include "particles/StateHash.h"
+#include "particles/Structure.h"
+
+#ifndef TICKFX_BENCH_CONFIG
+#define TICKFX_BENCH_CONFIG "unknown"
+#endif
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr std::int64_t kStepRateHz = 60;
+
+// A curtain of side × side particles 1 cm apart hanging from its top edge: 10 g a particle,
+// k = 5 N/m (shear 2.5, bend 0.5), c = 0.01 N·s/m. Stable for semi-implicit Euler at 60 Hz: the
+// stiffest mode has ω² ≤ 2·Σk/m = 12.8·k/m = 6400 s⁻², so ω·dt ≤ 1.33 < 2, and the damping keeps
+// (ω·dt)² + 2·(24·c/m)·dt = 1.78 + 0.8 below 4. The cloth stretches a lot under its own weight
+// (soft springs), which changes nothing in the cost of a spring; the run checks that it stays
+// finite.
+tickfx::StructureSettings curtain(int side) {
+  tickfx::StructureSettings s;
+  s.name = "curtain";
+  tickfx::ClothShape cloth;
+  cloth.origin = Eigen::Vector3d(-0.005 * side, 2.0, 0.0);
+  cloth.axisU = Eigen::Vector3d::UnitX();
+  cloth.axisV = Eigen::Vector3d(0.0, -0.6, 0.8);  // slanted, so it swings as it falls
+  cloth.width = side;
+  cloth.height = side;
+  cloth.spacing = 0.01;
+  cloth.pins = tickfx::ClothPins::TopEdge;
+  s.shape = cloth;
+  s.mass = 0.01;
+  s.stiffness = 5.0;
+  s.damping = 0.01;
+  return s;
+}
+
+std::unique_ptr<tickfx::ParticleSystem> makeSystem(int side, int threads) {
+  tickfx::SystemSettings settings;
+  settings.stepRateHz = kStepRateHz;
+  settings.integrator = "semi_implicit_euler";
+  settings.maxParticles = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+  settings.threads = threads;
+  tickfx::ForceSet forces;
+  forces.add(std::make_unique<tickfx::Gravity>(Eigen::Vector3f(0.0f, -9.81f, 0.0f)));
+  auto system = std::make_unique<tickfx::ParticleSystem>(
+      settings, std::vector<tickfx::EmitterSettings>{}, std::move(forces),
+      std::vector<tickfx::StructureSettings>{curtain(side)});
+  system->step();  // tick 0: the cloth is born
+  return system;
+}
+
+bool allFinite(const tickfx::ParticlePool& pool) {
+  const auto n = static_cast<Eigen::Index>(pool.size());
+  for (int c = 0; c < 3; ++c) {
+    if (!pool.position()[c].head(n).allFinite() || !pool.velocity()[c].head(n).allFinite())
+      return false;
+  }
+  return true;
+}
+
+double positionSum(const tickfx::ParticlePool& pool) {
+  const auto n = static_cast<Eigen::Index>(pool.size());
+  double sum = 0.0;
+  for (int c = 0; c < 3; ++c) sum += pool.position()[c].head(n).cast<double>().sum();
+  return sum;
+}
+
+// Keeps the compiler from treating stores that nothing reads inside the timed loop as dead.
+inline void escape(const void* p) {
+#if defined(__GNUC__) || defined(__clang__)
+  asm volatile("" : : "g"(p) : "memory");
+#else
+  static const void* volatile sink;
+  sink = p;
+#endif
+}
+
+// ---- timing ----------------------------------------------------------------------------------
+
+struct Case {
+  Case(std::string caseName, double evaluationsPerTick, int caseThreads,
+       std::function<void(std::int64_t)> runTicks)
+      : name(std::move(caseName)),
+        evaluations(evaluationsPerTick),
+        threads(caseThreads),
+        run(std::move(runTicks)) {}
+
+  std::string name;
+  double evaluations;  // force evaluations per tick (0: the case evaluates no spring)
+  int threads;
+  std::function<void(std::int64_t ticks)> run;
+  std::int64_t batch = 1;
+  std::vector<double> secondsPerTick;
+  double timed = 0.0;
+  double cpu = 0.0;  // process CPU seconds over the timed batches, all threads
+};
+
+// CPU seconds the process has used, summed over its threads.
+double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double timeBatch(Case& c, double* cpu = nullptr) {
+  const double cpu0 = processCpuSeconds();
+  const Clock::time_point start = Clock::now();
+  c.run(c.batch);
+  const double s = std::chrono::duration<double>(Clock::now() - start).count();
+  if (cpu != nullptr) *cpu += processCpuSeconds() - cpu0;
+  return s;
+}
+
+// Grows the batch until it takes `target` seconds; its runs are the warm-up.
+void calibrate(Case& c, double target) {
+  c.batch = 1;
+  for (;;) {
+    const double s = timeBatch(c);
+    if (s >= target) return;
+    const double grow = s > 0.0 ? std::min(10.0, 1.2 * target / s) : 10.0;
+    c.batch = std::max(c.batch + 1,
+                       static_cast<std::int64_t>(std::ceil(static_cast<double>(c.batch) * grow)));
+  }
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 == 1 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+struct Options {
+  int side = 256;
+  double minTime = 0.3;
+  int reps = 5;
+};
+
+std::string cpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const std::size_t colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(" \t", colon + 1));
+    }
+  }
+  return "unknown CPU";
+}
+
+void usage(const char* argv0) {
+  std::printf(
+      "usage: %s [--quick] [--side=N] [--min-time=SECONDS] [--reps=COUNT]\n"
+      "  --quick            smoke run: --side=64 --min-time=0.02\n"
+      "  --side=256         the cloth is side x side particles (default 256)\n"
+      "  --min-time=0.3     seconds each case is timed\n"
+      "  --reps=5           minimum number of timed batches per case (the median is reported)\n",
+      argv0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  bool quick = false;
+  std::optional<int> side;
+  std::optional<double> minTime;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    const auto value = [&](std::string_view prefix) -> std::optional<std::string> {
+      if (arg.substr(0, prefix.size()) != prefix) return std::nullopt;
+      return std::string(arg.substr(prefix.size()));
+    };
+    if (arg == "--quick") {
+      quick = true;
+    } else if (auto s = value("--side=")) {
+      side = std::atoi(s->c_str());
+      if (*side < 2 || *side > 1000) {
+        std::fprintf(stderr, "bad --side: %s (2 to 1000)\n", s->c_str());
+        return 2;
+      }
+    } else if (auto t = value("--min-time=")) {
+      minTime = std::atof(t->c_str());
+      if (!(*minTime > 0.0)) {
+        std::fprintf(stderr, "bad --min-time: %s\n", t->c_str());
+        return 2;
+      }
+    } else if (auto r = value("--reps=")) {
+      o.reps = std::atoi(r->c_str());
+      if (o.reps < 1) {
+        std::fprintf(stderr, "bad --reps: %s\n", r->c_str());
+        return 2;
+      }
+    } else if (arg == "--help" || arg == "-h") {
+      usage(argv[0]);
+      return 0;
+    } else {
+      std::fprintf(stderr, "unknown argument: %s\n", argv[i]);
+      usage(argv[0]);
+      return 2;
+    }
+  }
+  if (quick) {
+    o.side = 64;
+    o.minTime = 0.02;
+  }
+  if (side) o.side = *side;
+  if (minTime) o.minTime = *minTime;
+
+  std::printf(
+      "spring_bench: a %d x %d cloth (structural + shear + bend springs), gravity,\n"
+      "semi-implicit Euler at %lld Hz\n",
+      o.side, o.side, static_cast<long long>(kStepRateHz));
+  std::printf("machine: %s, %u hardware threads (TBB default %d)\n", cpuModel().c_str(),
+              std::thread::hardware_concurrency(), tbb::info::default_concurrency());
+  std::printf("build: %s, compiler %s\n", TICKFX_BENCH_CONFIG, __VERSION__);
+  if (std::string_view(TICKFX_BENCH_CONFIG) != "Release") {
+    std::printf("warning: not a Release build, the figures mean little\n");
+  }
+
+  // One system per case, so that no case's ticks move another's state.
+  std::unique_ptr<tickfx::ParticleSystem> step1 = makeSystem(o.side, 1);
+  std::unique_ptr<tickfx::ParticleSystem> step2 = makeSystem(o.side, 2);
+  std::unique_ptr<tickfx::ParticleSystem> eval = makeSystem(o.side, 1);
+  std::unique_ptr<tickfx::ParticleSystem> table = makeSystem(o.side, 1);
+  const std::size_t particles = step1->pool().size();
+  const std::size_t springs = step1->springs()->springs().size();
+  std::printf(
+      "particles: %zu, springs: %zu, spring evaluations per force evaluation: %zu (each\n"
+      "spring from both ends)\n",
+      particles, springs, 2 * springs);
+
+  // The bits do not depend on the thread count: one more tick on each, then compare.
+  step1->step();
+  step2->step();
+  const bool same = tickfx::stateHash(step1->pool()) == tickfx::stateHash(step2->pool());
+  std::printf("check after tick 1, 1 vs 2 threads: %s (hash %s)\n", same ? "same bits" : "MISMATCH",
+              tickfx::hashToHex(tickfx::stateHash(step1->pool())).c_str());
+
+  // The evaluate cases: the force pass an integrator runs, over the same blocks of rows.
+  tickfx::ParticlePool& evalPool = eval->pool();
+  const tickfx::ForceSet& evalForces = eval->forces();
+  tickfx::Vec3Column acceleration;
+  acceleration.resize(static_cast<Eigen::Index>(particles));
+  tbb::task_arena arena1(1), arena2(2);
+  const auto evaluate = [&](tbb::task_arena& arena, std::int64_t ticks) {
+    arena.execute([&] {
+      for (std::int64_t i = 0; i < ticks; ++i) {
+        const tickfx::ForceInput in{evalPool, tickfx::Vec3View::of(evalPool.position()),
+                                    tickfx::Vec3View::of(evalPool.velocity()), 0.0, 1};
+        tickfx::parallelForRows(particles, [&](std::size_t b, std::size_t e) {
+          tickfx::Vec3Rows a = tickfx::Vec3Rows::of(acceleration, tickfx::RowRange{b, e});
+          evalForces.evaluate(in, tickfx::RowRange{b, e}, a);
+        });
+        escape(acceleration.x.data());
+      }
+    });
+  };
+  eval->springs()->beginTick(evalPool, 1);  // the tables for the state evaluated
+
+  std::vector<Case> cases;
+  cases.emplace_back("step(), 1 thread", 1.0, 1, [&](std::int64_t ticks) {
+    for (std::int64_t i = 0; i < ticks; ++i) step1->step();
+  });
+  cases.emplace_back("step(), 2 threads", 1.0, 2, [&](std::int64_t ticks) {
+    for (std::int64_t i = 0; i < ticks; ++i) step2->step();
+  });
+  cases.emplace_back("evaluate, 1 thread", 1.0, 1,
+                     [&](std::int64_t ticks) { evaluate(arena1, ticks); });
+  cases.emplace_back("evaluate, 2 threads", 1.0, 2,
+                     [&](std::int64_t ticks) { evaluate(arena2, ticks); });
+  const std::int64_t tableTick = table->tickCount();
+  cases.emplace_back("beginTick alone", 0.0, 1, [&](std::int64_t ticks) {
+    // Idempotent on an unchanged state (no deaths, no breaks): it rebuilds the same tables.
+    for (std::int64_t i = 0; i < ticks; ++i) table->springs()->beginTick(table->pool(), tableTick);
+  });
+
+  const double target = o.minTime / o.reps;
+  for (Case& c : cases) calibrate(c, target);
+  const auto finished = [&](const Case& c) {
+    return static_cast<int>(c.secondsPerTick.size()) >= o.reps && c.timed >= o.minTime;
+  };
+  while (!std::all_of(cases.begin(), cases.end(), finished)) {
+    for (Case& c : cases) {
+      const double s = timeBatch(c, &c.cpu);
+      c.secondsPerTick.push_back(s / static_cast<double>(c.batch));
+      c.timed += s;
+    }
+  }
+
+  // "cores": CPU time over wall time while the case ran. A 2-thread case near 1.0 had only one
+  // core to itself (another process busy on the other), and its ratio says nothing of tickfx.
+  std::printf("\n%-22s %11s %11s %15s %13s %9s %6s  %s\n", "case", "ms/tick", "ticks/s",
+              "spring evals/s", "springs/s", "2t / 1t", "cores", "batches (min to max ms)");
+  std::vector<double> seconds;
+  for (const Case& c : cases) seconds.push_back(median(c.secondsPerTick));
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const Case& c = cases[i];
+    const double s = seconds[i];
+    const auto [lo, hi] = std::minmax_element(c.secondsPerTick.begin(), c.secondsPerTick.end());
+    const double perSpring = static_cast<double>(springs) / s;  // each spring once
+    char evals[32] = "-", ratio[16] = "";
+    if (c.evaluations > 0.0)
+      std::snprintf(evals, sizeof evals, "%.4g", 2.0 * c.evaluations * perSpring);
+    if (c.threads == 2) std::snprintf(ratio, sizeof ratio, "%.2f", seconds[i - 1] / s);
+    std::printf("%-22s %11.4f %11.1f %15s %13.4g %9s %6.2f  %zu x %lld (%.3f to %.3f)\n",
+                c.name.c_str(), 1e3 * s, 1.0 / s, evals, perSpring, ratio, c.cpu / c.timed,
+                c.secondsPerTick.size(), static_cast<long long>(c.batch), 1e3 * *lo, 1e3 * *hi);
+  }
+
+  const bool finite =
+      allFinite(step1->pool()) && allFinite(step2->pool()) && allFinite(eval->pool());
+  std::printf("\nticks run: %lld (1 thread), %lld (2 threads); cloth state finite: %s\n",
+              static_cast<long long>(step1->tickCount()),
+              static_cast<long long>(step2->tickCount()), finite ? "yes" : "NO");
+  std::printf("checksum of final positions: %.9g\n", positionSum(step1->pool()) +
+                                                         positionSum(step2->pool()) +
+                                                         static_cast<double>(acceleration.y.sum()));
+  if (!same) std::printf("CHECK FAILED: 1 and 2 threads disagree after one tick\n");
+  if (!finite) std::printf("CHECK FAILED: the cloth blew up; the figures time NaN arithmetic\n");
+  return same && finite ? 0 : 1;
+}
