@@ -47,7 +47,8 @@ std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
     if (*threadsOverride < 0) throw std::invalid_argument("threads must be >= 0");
     settings.threads = *threadsOverride;
   }
-  return std::make_unique<ParticleSystem>(settings, effect.emitters, buildForces(effect.forces));
+  return std::make_unique<ParticleSystem>(settings, effect.emitters, buildForces(effect.forces),
+                                          effect.structures);
 }
 
 }  // namespace tickfx::io

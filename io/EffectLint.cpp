@@ -68,11 +68,20 @@ void lintWind(const EffectSettings& effect, const WindSettings& wind, const std:
                   " Hz wind (use a step_rate of at least " + std::to_string(needed) + " Hz)"));
 }
 
+// The lightest particle mass of the effect (emitters' and structures'), or nothing.
+std::optional<double> lightestMass(const EffectSettings& effect) {
+  std::optional<double> mass;
+  for (const EmitterSettings& e : effect.emitters) mass = std::min(mass.value_or(e.mass), e.mass);
+  for (const StructureSettings& s : effect.structures)
+    mass = std::min(mass.value_or(s.mass), s.mass);
+  return mass;
+}
+
 void lintSpring(const EffectSettings& effect, const AnchorSpringSettings& spring,
                 const std::string& path, std::vector<Diagnostic>& out) {
-  if (effect.emitters.empty()) return;
-  double mass = effect.emitters.front().mass;
-  for (const EmitterSettings& e : effect.emitters) mass = std::min(mass, e.mass);
+  const std::optional<double> lightest = lightestMass(effect);
+  if (!lightest) return;
+  const double mass = *lightest;
   const std::string& integrator = effect.simulation.integrator;
   const std::int64_t stepRate = effect.simulation.stepRateHz;
   const double rate = static_cast<double>(stepRate);
@@ -137,6 +146,134 @@ void lintSpring(const EffectSettings& effect, const AnchorSpringSettings& spring
                             rounded(duration, 4) + " s of output) (" + fix + ")"));
 }
 
+// A stiffness or a rate to 4 significant digits, large ones as whole numbers ("20000", not
+// "2e+04").
+std::string quantity(double value) {
+  if (std::abs(value) >= 1e4 && std::abs(value) < 1e15) return std::to_string(std::llround(value));
+  return rounded(value, 4);
+}
+
+// 1 + the explicit-Euler energy factor's excess, written so that huge factors stay readable.
+std::string totalText(double total) {
+  return std::isfinite(total) ? "x" + rounded(total, 3) : "beyond x1e308";
+}
+
+}  // namespace
+
+StructureStiffness structureStiffness(const StructureSettings& structure) {
+  StructureStiffness out;
+  const double k = structure.stiffness;
+  if (const auto* cloth = std::get_if<ClothShape>(&structure.shape)) {
+    out.springFactor = 4.0 * (1.0 + cloth->shearStiffnessScale + cloth->bendStiffnessScale);
+    out.formula = "4k(1 + shear_scale + bend_scale)";
+  } else if (const auto* cluster = std::get_if<ClusterShape>(&structure.shape)) {
+    const double n = clusterNeighbours(*cluster);
+    out.neighbours = n;
+    const double spread = n + kClusterSpread * std::sqrt(n);
+    if (cluster->count <= 1) {
+      out.springFactor = 0.0;  // a lone particle: no springs
+      out.formula = "0";
+    } else if (std::max(spread, 4.0) >= cluster->count) {
+      out.springFactor = cluster->count;
+      out.formula = "count*k";
+    } else if (spread < 4.0) {
+      out.springFactor = 4.0;
+      out.formula = "4k";
+    } else {
+      out.springFactor = spread;
+      out.formula = "(n + 3*sqrt(n))*k";
+    }
+  } else {
+    out.springFactor = 4.0;
+    out.formula = "4k";
+  }
+  out.stiffness = out.springFactor * k;
+  return out;
+}
+
+namespace {
+
+// The stiffest structure (largest ω of its fastest vibration, anchor springs included) against
+// the integrator: past the stability limit, or, under explicit Euler, gaining energy each step.
+void lintStructures(const EffectSettings& effect, std::vector<Diagnostic>& out) {
+  double anchorK = 0.0, anchorC = 0.0;
+  for (const ForceSettings& f : effect.forces) {
+    if (const auto* a = std::get_if<AnchorSpringSettings>(&f)) {
+      anchorK += a->stiffness;
+      anchorC += a->damping;
+    }
+  }
+  std::optional<std::size_t> stiffest;
+  double stiffestOmega = 0.0;
+  for (std::size_t i = 0; i < effect.structures.size(); ++i) {
+    const StructureSettings& s = effect.structures[i];
+    if (structureStiffness(s).springFactor <= 0.0) continue;  // a lone particle: no springs
+    const double omega = std::sqrt((structureStiffness(s).stiffness + anchorK) / s.mass);
+    if (!stiffest || omega > stiffestOmega) {
+      stiffest = i;
+      stiffestOmega = omega;
+    }
+  }
+  if (!stiffest) return;
+  const StructureSettings& s = effect.structures[*stiffest];
+  const StructureStiffness stiffness = structureStiffness(s);
+  const std::string type(structureTypeName(s.shape));
+  const std::string where = structureKeyPath(effect, *stiffest) + ".stiffness";
+  const std::string& integrator = effect.simulation.integrator;
+  const std::int64_t stepRate = effect.simulation.stepRateHz;
+  const double rate = static_cast<double>(stepRate);
+  const double m = s.mass;
+  const double kTotal = stiffness.stiffness + anchorK;
+  const double cTotal = stiffness.springFactor * s.damping + anchorC;
+  const double omega = stiffestOmega;
+  const double omegaDt = omega / rate;
+
+  if (const std::optional<double> limit = springStabilityLimit(integrator);
+      limit && omegaDt >= *limit) {
+    const auto needed = static_cast<std::int64_t>(std::floor(omega / *limit)) + 1;
+    std::string keff = "k_eff = " + stiffness.formula;
+    if (anchorK > 0.0) keff += " + " + quantity(anchorK);
+    keff += " = " + quantity(kTotal) + " N/m for a " + type + "'s springs";
+    if (anchorK > 0.0) keff += " and the anchor springs";
+    if (stiffness.neighbours) {
+      keff += ", n = " + rounded(*stiffness.neighbours, 4) + " neighbours of a particle on average";
+    }
+    out.push_back(warning(
+        effect, where,
+        "omega*dt = " + rounded(omegaDt, 4) + " is past " + integrator + "'s stability limit of " +
+            rounded(*limit, 4) + " (omega = sqrt(k_eff/m) = " + quantity(omega) + " rad/s, " +
+            keff + ", m = " + rounded(m, 4) + " kg, and dt = 1/" + std::to_string(stepRate) +
+            " s): the " + type + "'s fastest vibration grows without bound (use a step_rate of " +
+            "at least " + std::to_string(needed) + " Hz)"));
+    return;
+  }
+  if (integrator != "explicit_euler" || cTotal >= kTotal / rate) return;
+  // The fastest vibration as one damped oscillator: energy × 1 + (k_eff·dt − c_eff)·dt/m a step.
+  const auto perStep = [=](double h) { return 1.0 + (kTotal / h - cTotal) / (m * h); };
+  const double duration = effect.output.durationSeconds();
+  const double budget = std::log(1.0 + kTolerableDrift);
+  const double total = std::exp(rate * duration * std::log(perStep(rate)));
+  // Each spring's damping counts springFactor times, like its stiffness.
+  const double neededDamping = (kTotal / rate - anchorC) / stiffness.springFactor;
+  const std::string dampingWhy = anchorK > 0.0 ? "k·dt with the anchor springs" : "k·dt";
+  std::string fix =
+      "use semi_implicit_euler, position_verlet or velocity_verlet, damping of at least " +
+      rounded(neededDamping, 4) + " N·s/m (" + dampingWhy + ")";
+  const std::optional<std::int64_t> needed = smallestStepRate(1, [&](double h) {
+    const double g = perStep(h);
+    return h * duration * std::log(g) > budget;
+  });
+  if (needed && *needed > stepRate) {
+    fix += ", or a step_rate of at least " + std::to_string(*needed) +
+           " Hz to keep the gain over the output under 1%";
+  }
+  out.push_back(warning(effect, where,
+                        "explicit_euler adds energy to this " + type + "'s springs every step (x" +
+                            factorText(perStep(rate)) + " per step, " + totalText(total) +
+                            " over the " + rounded(duration, 4) +
+                            " s of output, for its fastest vibration) (" + fix + ")"));
+}
+
 }  // namespace
 
 std::optional<double> springStabilityLimit(std::string_view integrator) {
@@ -159,6 +296,7 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect) {
       lintSpring(effect, *spring, path, out);
     }
   }
+  lintStructures(effect, out);
   sortDiagnostics(out);
   return out;
 }

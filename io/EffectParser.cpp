@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -54,6 +55,40 @@ const std::map<std::string, std::vector<std::string>>& forceKeys() {
       {"drag", {"k", "air_velocity"}},
       {"wind", {"direction", "base", "amplitude", "frequency", "phase"}},
       {"anchor_spring", {"rest", "stiffness", "damping"}}};
+  return keys;
+}
+
+// Keys every structure type reads, then each type's own, in the order "expected for" lists
+// them.
+const std::vector<std::string>& structureCommonKeys() {
+  static const std::vector<std::string> keys = {"name",    "time",        "mass",     "stiffness",
+                                                "damping", "break_ratio", "velocity", "lifetime"};
+  return keys;
+}
+
+const std::map<std::string, std::vector<std::string>>& structureKeys() {
+  static const std::map<std::string, std::vector<std::string>> keys = {
+      {"rope", {"start", "end", "count", "pin_start", "pin_end"}},
+      {"cloth",
+       {"origin", "axis_u", "axis_v", "width", "height", "spacing", "pins", "shear_scale",
+        "bend_scale"}},
+      {"cluster", {"center", "radius", "count", "link_radius"}}};
+  return keys;
+}
+
+// The keys of a particle emitter (type "particles"), its shapes' parameters included.
+const std::vector<std::string>& particleEmitterKeys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k = {"type",         "name",   "position", "shape",           "rate",
+                                  "start",        "stop",   "bursts",   "direction",       "speed",
+                                  "speed_jitter", "spread", "lifetime", "lifetime_jitter", "mass"};
+    for (const auto& [shape, own] : shapeKeys()) {
+      for (const std::string& key : own) {
+        if (std::find(k.begin(), k.end(), key) == k.end()) k.push_back(key);
+      }
+    }
+    return k;
+  }();
   return keys;
 }
 
@@ -493,9 +528,12 @@ std::map<std::string, std::string> notForShape(const std::string& shape) {
   return out;
 }
 
+std::map<std::string, std::string> notForStructureKeys();
+
 void readEmitter(Context& cx, const toml::table& table, std::size_t index,
                  std::int64_t maxParticles, EmitterSettings& e) {
   TableReader r(cx, table, childPath("emitters", index));
+  r.take("type");  // "particles" or absent: judged by readEmitterEntry
   e.name = "emitter_" + std::to_string(index);
   r.string("name", e.name, "a name: a non-empty string, unique among the emitters");
   r.vec3("position", e.position, kPositionText, Range{-kBig, kBig});
@@ -524,8 +562,256 @@ void readEmitter(Context& cx, const toml::table& table, std::size_t index,
 
   std::string shape = "point";
   if (const toml::node* s = table.get("shape")) shape = s->value_or<std::string>("");
-  r.finish(shapeKeys().count(shape) != 0 ? notForShape(shape)
-                                         : std::map<std::string, std::string>{});
+  std::map<std::string, std::string> notHere = notForStructureKeys();
+  if (shapeKeys().count(shape) != 0) notHere.merge(notForShape(shape));
+  r.finish(notHere);
+}
+
+// ---- structures: [[emitters]] of type "rope", "cloth" or "cluster" ----------------------------
+
+// The bound on springs one structure may make (a cloth of 10⁶ particles has about 6·10⁶).
+constexpr double kMaxSprings = 1e7;
+// Below this |û × v̂| a cloth's axes count as parallel (the core's own threshold).
+constexpr double kParallelSine = 1e-6;
+
+// Keys a particle emitter does not have, with the structure types that do.
+std::map<std::string, std::string> notForStructureKeys() {
+  const std::vector<std::string>& own = particleEmitterKeys();
+  std::map<std::string, std::vector<std::string>> owners;
+  for (const std::string& type : emitterTypeNames()) {
+    if (type == "particles") continue;
+    std::vector<std::string> keys = structureCommonKeys();
+    const std::vector<std::string>& extra = structureKeys().at(type);
+    keys.insert(keys.end(), extra.begin(), extra.end());
+    for (const std::string& k : keys) {
+      if (std::find(own.begin(), own.end(), k) == own.end()) owners[k].push_back(type);
+    }
+  }
+  std::map<std::string, std::string> out;
+  for (const auto& [key, types] : owners) {
+    std::string list;
+    for (std::size_t i = 0; i < types.size(); ++i) {
+      list += (i == 0 ? "" : (i + 1 == types.size() ? " or " : ", ")) + quote(types[i]);
+    }
+    out[key] = "does not apply to an emitter of type \"particles\" (expected type = " + list +
+               " for " + key + ")";
+  }
+  return out;
+}
+
+// The keys of structure type `type`, "type" first.
+std::vector<std::string> structureOwnKeys(const std::string& type) {
+  std::vector<std::string> keys = {"type"};
+  keys.insert(keys.end(), structureCommonKeys().begin(), structureCommonKeys().end());
+  const std::vector<std::string>& extra = structureKeys().at(type);
+  keys.insert(keys.end(), extra.begin(), extra.end());
+  return keys;
+}
+
+// Keys of particle emitters and of the other structure types, on a structure of `type`.
+std::map<std::string, std::string> notForStructure(const std::string& type) {
+  const std::vector<std::string> own = structureOwnKeys(type);
+  const std::string message = "does not apply to an emitter of type " + quote(type) +
+                              " (expected for a " + type + ": " + joinWords(own) + ")";
+  std::map<std::string, std::string> out;
+  const auto add = [&](const std::vector<std::string>& keys) {
+    for (const std::string& k : keys) {
+      if (std::find(own.begin(), own.end(), k) == own.end()) out[k] = message;
+    }
+  };
+  add(particleEmitterKeys());
+  for (const auto& [other, keys] : structureKeys()) add(keys);
+  return out;
+}
+
+// A particle count of a structure: from `min` to the smaller of 10⁶ and max_particles.
+struct CountLimit {
+  std::int64_t max;
+  std::string text;
+};
+
+CountLimit structureCountLimit(std::int64_t min, std::int64_t maxParticles,
+                               const std::string& what) {
+  constexpr std::int64_t kMaxStructure = 1'000'000;
+  if (maxParticles < kMaxStructure) {
+    return {maxParticles, what + ", an integer from " + std::to_string(min) +
+                              " to simulation.max_particles = " + std::to_string(maxParticles)};
+  }
+  return {kMaxStructure, what + ", an integer from " + std::to_string(min) + " to " +
+                             std::to_string(kMaxStructure)};
+}
+
+void readRope(Context& cx, TableReader& r, std::int64_t maxParticles, RopeShape& rope) {
+  const Range any{-kBig, kBig};
+  const bool startOk = r.vec3("start", rope.start, kPositionText, any);
+  const bool endOk = r.vec3("end", rope.end, kPositionText, any);
+  if (r.table().get("end") == nullptr) r.missing("end", kPositionText);
+  if (endOk && (startOk || r.table().get("start") == nullptr) && rope.end == rope.start) {
+    cx.error(cx.at(*r.table().get("end")), r.pathOf("end"),
+             "is the same point as start (expected [x, y, z] in metres, each from -1e9 to 1e9, "
+             "apart from start: a rope has a length)");
+  }
+  const CountLimit count = structureCountLimit(2, maxParticles, "particles");
+  r.integer("count", rope.count, count.text, 2, count.max, /*required=*/true);
+  r.boolean("pin_start", rope.pinStart);
+  r.boolean("pin_end", rope.pinEnd);
+}
+
+void readCloth(Context& cx, TableReader& r, std::int64_t maxParticles, ClothShape& cloth) {
+  const Range any{-kBig, kBig};
+  r.vec3("origin", cloth.origin, kPositionText, any);
+  const bool uOk = r.vec3("axis_u", cloth.axisU, kDirectionText, any, /*nonZero=*/true);
+  const bool vOk = r.vec3("axis_v", cloth.axisV, kDirectionText, any, /*nonZero=*/true);
+  const toml::node* uNode = r.table().get("axis_u");
+  const toml::node* vNode = r.table().get("axis_v");
+  if ((uOk || uNode == nullptr) && (vOk || vNode == nullptr) &&
+      cloth.axisU.normalized().cross(cloth.axisV.normalized()).norm() <= kParallelSine) {
+    // Shown at the later-written axis (the one a default cannot be blamed for).
+    const bool atV = vNode != nullptr;
+    const std::string other = atV ? "axis_u" : "axis_v";
+    cx.error(cx.at(atV ? *vNode : *uNode), r.pathOf(atV ? "axis_v" : "axis_u"),
+             "is parallel to " + other + " (expected a direction [x, y, z], each from -1e9 to " +
+                 "1e9, not parallel to " + other + ")");
+  }
+  const std::string sideText = "particles, an integer from 2 to 500000";
+  const bool widthOk = r.integer("width", cloth.width, sideText, 2, 500'000, /*required=*/true);
+  const bool heightOk = r.integer("height", cloth.height, sideText, 2, 500'000, /*required=*/true);
+  const std::int64_t most = structureCountLimit(1, maxParticles, "particles").max;
+  const std::int64_t total = static_cast<std::int64_t>(cloth.width) * cloth.height;
+  if (widthOk && heightOk && total > most) {
+    cx.error(
+        cx.at(*r.table().get("height")), r.pathOf("height"),
+        std::to_string(cloth.width) + " x " + std::to_string(cloth.height) + " = " +
+            std::to_string(total) + " particles are too many (expected width x height at most " +
+            (most < 1'000'000 ? "simulation.max_particles = " : "") + std::to_string(most) + ")");
+  }
+  r.number("spacing", cloth.spacing, "metres, a number > 0 and <= 1e9", Range{0.0, kBig, true},
+           /*required=*/true);
+  std::string pins;
+  if (r.choice("pins", pins, clothPinsNames(), "cloth pins")) {
+    for (const ClothPins p :
+         {ClothPins::None, ClothPins::TopCorners, ClothPins::TopEdge, ClothPins::AllCorners}) {
+      if (clothPinsName(p) == pins) cloth.pins = p;
+    }
+  }
+  const std::string scaleText = "times stiffness, a number from 0 to 100";
+  r.number("shear_scale", cloth.shearStiffnessScale, scaleText, Range{0.0, 100.0});
+  r.number("bend_scale", cloth.bendStiffnessScale, scaleText, Range{0.0, 100.0});
+}
+
+void readCluster(Context& cx, TableReader& r, std::int64_t maxParticles, ClusterShape& cluster) {
+  r.vec3("center", cluster.center, kPositionText, Range{-kBig, kBig});
+  const std::string lengthText = "metres, a number > 0 and <= 1e9";
+  const bool radiusOk =
+      r.number("radius", cluster.radius, lengthText, Range{0.0, kBig, true}, /*required=*/true);
+  const CountLimit count = structureCountLimit(1, maxParticles, "particles");
+  const bool countOk =
+      r.integer("count", cluster.count, count.text, 1, count.max, /*required=*/true);
+  const bool linkOk = r.number("link_radius", cluster.linkRadius, lengthText,
+                               Range{0.0, kBig, true}, /*required=*/true);
+  if (!(radiusOk && countOk && linkOk)) return;
+  // Expected springs: half the particles' neighbours.
+  const double springs = cluster.count * clusterNeighbours(cluster) / 2.0;
+  if (springs <= kMaxSprings) return;
+  // The largest link radius within the bound (bisection: the neighbours grow with it).
+  ClusterShape probe = cluster;
+  double lo = 0.0, hi = cluster.linkRadius;
+  for (int i = 0; i < 200; ++i) {
+    probe.linkRadius = 0.5 * (lo + hi);
+    (cluster.count * clusterNeighbours(probe) / 2.0 <= kMaxSprings ? lo : hi) = probe.linkRadius;
+  }
+  // Three significant digits, rounded down so that the figure given is within the bound.
+  const double unit = std::pow(10.0, std::floor(std::log10(lo)) - 2.0);
+  char largest[32];
+  std::snprintf(largest, sizeof largest, "%.3g", std::floor(lo / unit) * unit);
+  cx.error(cx.at(*r.table().get("link_radius")), r.pathOf("link_radius"),
+           formatNumber(cluster.linkRadius) + " m would join about " +
+               std::to_string(static_cast<std::int64_t>(std::llround(springs))) +
+               " pairs of particles (expected at most 10000000 springs: a link_radius of at most " +
+               largest + " m for this radius and count)");
+}
+
+void readStructure(Context& cx, const toml::table& table, std::size_t index,
+                   const std::string& type, std::int64_t maxParticles, StructureSettings& s) {
+  TableReader r(cx, table, childPath("emitters", index));
+  r.take("type");
+  s.name = type + "_" + std::to_string(index);
+  r.string("name", s.name, "a name: a non-empty string, unique among the emitters");
+  r.number("time", s.time, kSecondsText, Range{0.0, kBig});
+  r.number("mass", s.mass, "kilograms per particle, a number > 0 and <= 1e9",
+           Range{0.0, kBig, true});
+  r.number("stiffness", s.stiffness, "N/m, a number > 0 and <= 1e9", Range{0.0, kBig, true},
+           /*required=*/true);
+  r.number("damping", s.damping, "N·s/m, a number from 0 to 1e9", Range{0.0, kBig});
+  const std::string ratioText = "0 (never breaks) or a ratio of the rest length > 1 and <= 1e9";
+  double ratio = 0.0;
+  if (r.number("break_ratio", ratio, ratioText, Range{0.0, kBig})) {
+    if (ratio > 0.0 && ratio <= 1.0) {
+      cx.error(cx.at(*table.get("break_ratio")), r.pathOf("break_ratio"),
+               formatNumber(ratio) + " is out of range (expected " + ratioText + ")");
+    } else {
+      s.breakRatio = ratio;
+    }
+  }
+  r.vec3("velocity", s.velocity, "[x, y, z] in m/s, each from -1e9 to 1e9", Range{-kBig, kBig});
+  r.number("lifetime", s.lifetime, "seconds, a number > 0 and <= 1e9", Range{0.0, kBig, true});
+  if (type == "rope") {
+    RopeShape rope;
+    readRope(cx, r, maxParticles, rope);
+    s.shape = rope;
+  } else if (type == "cloth") {
+    ClothShape cloth;
+    readCloth(cx, r, maxParticles, cloth);
+    s.shape = cloth;
+  } else {
+    ClusterShape cluster;
+    readCluster(cx, r, maxParticles, cluster);
+    s.shape = cluster;
+  }
+  r.finish(notForStructure(type));
+}
+
+// One [[emitters]] entry: a particle emitter or, by its `type`, a structure.
+void readEmitterEntry(Context& cx, const toml::table& table, std::size_t index,
+                      std::int64_t maxParticles, EffectSettings& effect,
+                      std::map<std::string, std::size_t>& names) {
+  std::string type = "particles";
+  if (const toml::node* node = table.get("type")) {
+    const std::optional<std::string> known =
+        checkChoice(cx, *node, childPath(childPath("emitters", index), "type"), emitterTypeNames(),
+                    "emitter type");
+    if (!known) {
+      // Without a type no key can be judged but the unknown ones.
+      TableReader r(cx, table, childPath("emitters", index));
+      for (const std::string& k : particleEmitterKeys()) r.take(k);
+      for (const std::string& t : emitterTypeNames()) {
+        if (t != "particles") r.allow(structureOwnKeys(t));
+      }
+      r.finish();
+      return;
+    }
+    type = *known;
+  }
+  std::string name;
+  if (type == "particles") {
+    EmitterSettings e;
+    readEmitter(cx, table, index, maxParticles, e);
+    name = e.name;
+    effect.emitters.push_back(std::move(e));
+  } else {
+    StructureSettings s;
+    readStructure(cx, table, index, type, maxParticles, s);
+    name = s.name;
+    effect.structures.push_back(std::move(s));
+    effect.structureEntries.push_back(index);
+  }
+  if (const auto [it, fresh] = names.emplace(name, index); !fresh) {
+    const toml::node* nameNode = table.get("name");
+    cx.error(nameNode ? cx.at(*nameNode) : cx.at(table),
+             childPath(childPath("emitters", index), "name"),
+             quote(name) + " is already the name of emitters." + std::to_string(it->second) +
+                 " (expected a name unique among the emitters)");
+  }
 }
 
 std::optional<ForceSettings> readForce(Context& cx, const toml::table& table, std::size_t index) {
@@ -747,15 +1033,7 @@ EffectSettings readCurrentVersion(Context& cx, const toml::table& document) {
   const auto maxParticles = static_cast<std::int64_t>(effect.simulation.maxParticles);
   std::map<std::string, std::size_t> names;
   readEntries(cx, top, "emitters", /*required=*/true, [&](const toml::table& table, std::size_t i) {
-    EmitterSettings e;
-    readEmitter(cx, table, i, maxParticles, e);
-    if (const auto [it, fresh] = names.emplace(e.name, i); !fresh) {
-      const toml::node* name = table.get("name");
-      cx.error(name ? cx.at(*name) : cx.at(table), childPath(childPath("emitters", i), "name"),
-               quote(e.name) + " is already the name of emitters." + std::to_string(it->second) +
-                   " (expected a name unique among the emitters)");
-    }
-    effect.emitters.push_back(std::move(e));
+    readEmitterEntry(cx, table, i, maxParticles, effect, names);
   });
   readEntries(cx, top, "forces", /*required=*/false, [&](const toml::table& table, std::size_t i) {
     if (auto force = readForce(cx, table, i)) effect.forces.push_back(*force);

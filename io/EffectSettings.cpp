@@ -20,6 +20,52 @@ const std::vector<std::string>& forceTypeNames() {
   return names;
 }
 
+const std::vector<std::string>& emitterTypeNames() {
+  static const std::vector<std::string> names = {"particles", "rope", "cloth", "cluster"};
+  return names;
+}
+
+std::string_view structureTypeName(const StructureShape& shape) {
+  struct Name {
+    std::string_view operator()(const RopeShape&) const { return "rope"; }
+    std::string_view operator()(const ClothShape&) const { return "cloth"; }
+    std::string_view operator()(const ClusterShape&) const { return "cluster"; }
+  };
+  return std::visit(Name{}, shape);
+}
+
+const std::vector<std::string>& clothPinsNames() {
+  static const std::vector<std::string> names = {"none", "top_corners", "top_edge", "corners"};
+  return names;
+}
+
+std::string_view clothPinsName(ClothPins pins) {
+  switch (pins) {
+    case ClothPins::None:
+      return "none";
+    case ClothPins::TopCorners:
+      return "top_corners";
+    case ClothPins::TopEdge:
+      return "top_edge";
+    case ClothPins::AllCorners:
+      return "corners";
+  }
+  return "none";
+}
+
+double clusterNeighbours(const ClusterShape& cluster) {
+  const double x = cluster.linkRadius / cluster.radius;
+  const double fraction =
+      x >= 2.0 ? 1.0 : x * x * x - 9.0 * std::pow(x, 4) / 16.0 + std::pow(x, 6) / 32.0;
+  return (cluster.count - 1) * fraction;
+}
+
+std::string structureKeyPath(const EffectSettings& effect, std::size_t index) {
+  if (index < effect.structureEntries.size())
+    return "emitters." + std::to_string(effect.structureEntries[index]);
+  return "structures." + std::to_string(index);
+}
+
 std::string_view cacheFormatName(CacheFormat format) {
   return format == CacheFormat::Csv ? "csv" : "ply";
 }

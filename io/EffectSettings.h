@@ -14,6 +14,7 @@
 #include "particles/Clock.h"
 #include "particles/Emitter.h"
 #include "particles/ParticleSystem.h"
+#include "particles/Structure.h"
 
 namespace tickfx::io {
 
@@ -56,6 +57,22 @@ std::string_view forceTypeName(const ForceSettings& force);
 /// Every force type, in the order above.
 const std::vector<std::string>& forceTypeNames();
 
+/// The `type` of an [[emitters]] entry: "particles" (an EmitterSettings, the default when `type`
+/// is absent), "rope", "cloth" or "cluster" (a StructureSettings).
+const std::vector<std::string>& emitterTypeNames();
+/// "rope", "cloth" or "cluster".
+std::string_view structureTypeName(const StructureShape& shape);
+/// The `pins` of a cloth as written: "none", "top_corners", "top_edge" or "corners".
+std::string_view clothPinsName(ClothPins pins);
+/// Every cloth `pins` value, in the order of ClothPins.
+const std::vector<std::string>& clothPinsNames();
+
+/// The mean number of neighbours of a particle of `cluster`: the other count − 1 particles times
+/// the fraction of pairs of points uniform in a ball of radius R that lie within the link radius
+/// s of each other, x³ − 9x⁴/16 + x⁶/32 with x = s/R (1 for x >= 2). A cluster has about
+/// count · clusterNeighbours / 2 springs.
+double clusterNeighbours(const ClusterShape& cluster);
+
 enum class CacheFormat { Csv, Ply };
 /// "csv" or "ply".
 std::string_view cacheFormatName(CacheFormat format);
@@ -79,11 +96,24 @@ struct OutputSettings {
 struct EffectSettings {
   std::int64_t formatVersion = kEffectFormatVersion;  // after migration: always the current one
   SystemSettings simulation;
-  std::vector<EmitterSettings> emitters;  // at least one
+  /// The [[emitters]] entries of type "particles", in file order; an emitter's place here is its
+  /// index in the random keys (ParticleSystem numbers them so).
+  std::vector<EmitterSettings> emitters;
+  /// The [[emitters]] entries of type "rope", "cloth" or "cluster", in file order; a structure's
+  /// place here is its index among the structures (the core derives its random keys from it).
+  /// A file has at least one [[emitters]] entry of either kind.
+  std::vector<StructureSettings> structures;
+  /// The [[emitters]] entry each structure was read from (its key paths are "emitters.<entry>"),
+  /// one per structure; empty for settings made in code (see structureKeyPath).
+  std::vector<std::size_t> structureEntries;
   std::vector<ForceSettings> forces;
   OutputSettings output;
   /// Where each value was written (for lint findings); defaults are not recorded.
   SourceMap sources;
 };
+
+/// The key path of structure `index` of `effect`: "emitters.<entry>" when structureEntries says
+/// which entry it was read from, else "structures.<index>" (settings made in code).
+std::string structureKeyPath(const EffectSettings& effect, std::size_t index);
 
 }  // namespace tickfx::io

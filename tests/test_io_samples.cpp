@@ -16,7 +16,7 @@ namespace tickfx::io {
 namespace {
 
 const std::vector<std::string> kSamples = {
-    "fountain", "oscillator", "wind_aliasing", "wind_aliasing_fixed", "smoke_drift", "burst"};
+    "fountain", "oscillator", "wind_aliasing", "wind_aliasing_fixed", "smoke_drift", "burst", "rope_swing", "flag", "jelly"};
 
 std::filesystem::path samplePath(const std::string& name) {
   return std::filesystem::path(TICKFX_SOURCE_DIR) / "samples" / (name + ".toml");
@@ -32,7 +32,7 @@ class ioSamples : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ioSamples, LoadsBuildsAndRuns) {
   const EffectSettings effect = loadSample(GetParam());
-  ASSERT_FALSE(effect.emitters.empty());
+  ASSERT_FALSE(effect.emitters.empty() && effect.structures.empty());
   const std::vector<Diagnostic> warnings = lintEffect(effect);
   if (GetParam() == "wind_aliasing") {
     ASSERT_EQ(warnings.size(), 1u);
