@@ -22,20 +22,16 @@
 //                   parallel passes).
 // Each of step() and evaluate runs with 1 and with 2 threads; the table gives the ratio 2 / 1.
 //
-// Timing as in tick_bench: each case runs in batches of ticks sized to take min-time/reps
-// seconds; the cases take turns batch by batch until each has at least `reps` batches and
-// `min-time` seconds; a case's figure is the median over its batches of the time per tick.
+// Timing as in tick_bench (BenchHarness.h): batches of ticks sized to min-time/reps seconds, the
+// cases taking turns batch by batch; a case's figure is the median over its batches of the time
+// per tick.
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -45,6 +41,7 @@
 #include <utility>
 #include <vector>
 
+#include "BenchHarness.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/SpringNetwork.h"
@@ -53,13 +50,9 @@
 #include "particles/StateHash.h"
 #include "particles/Structure.h"
 
-#ifndef TICKFX_BENCH_CONFIG
-#define TICKFX_BENCH_CONFIG "unknown"
-#endif
-
 namespace {
 
-using Clock = std::chrono::steady_clock;
+namespace bench = tickfx::bench;
 
 constexpr std::int64_t kStepRateHz = 60;
 
@@ -111,94 +104,24 @@ bool allFinite(const tickfx::ParticlePool& pool) {
   return true;
 }
 
-double positionSum(const tickfx::ParticlePool& pool) {
-  const auto n = static_cast<Eigen::Index>(pool.size());
-  double sum = 0.0;
-  for (int c = 0; c < 3; ++c) sum += pool.position()[c].head(n).cast<double>().sum();
-  return sum;
-}
-
-// Keeps the compiler from treating stores that nothing reads inside the timed loop as dead.
-inline void escape(const void* p) {
-#if defined(__GNUC__) || defined(__clang__)
-  asm volatile("" : : "g"(p) : "memory");
-#else
-  static const void* volatile sink;
-  sink = p;
-#endif
-}
-
 // ---- timing ----------------------------------------------------------------------------------
 
-struct Case {
+// What the table needs beyond the timing: the spring columns and the 2-thread / 1-thread ratio.
+struct Case : bench::Case {
   Case(std::string caseName, double evaluationsPerTick, int caseThreads,
        std::function<void(std::int64_t)> runTicks)
-      : name(std::move(caseName)),
+      : bench::Case(std::move(caseName), std::move(runTicks)),
         evaluations(evaluationsPerTick),
-        threads(caseThreads),
-        run(std::move(runTicks)) {}
+        threads(caseThreads) {}
 
-  std::string name;
   double evaluations;  // force evaluations per tick (0: the case evaluates no spring)
   int threads;
-  std::function<void(std::int64_t ticks)> run;
-  std::int64_t batch = 1;
-  std::vector<double> secondsPerTick;
-  double timed = 0.0;
-  double cpu = 0.0;  // process CPU seconds over the timed batches, all threads
 };
-
-// CPU seconds the process has used, summed over its threads.
-double processCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-double timeBatch(Case& c, double* cpu = nullptr) {
-  const double cpu0 = processCpuSeconds();
-  const Clock::time_point start = Clock::now();
-  c.run(c.batch);
-  const double s = std::chrono::duration<double>(Clock::now() - start).count();
-  if (cpu != nullptr) *cpu += processCpuSeconds() - cpu0;
-  return s;
-}
-
-// Grows the batch until it takes `target` seconds; its runs are the warm-up.
-void calibrate(Case& c, double target) {
-  c.batch = 1;
-  for (;;) {
-    const double s = timeBatch(c);
-    if (s >= target) return;
-    const double grow = s > 0.0 ? std::min(10.0, 1.2 * target / s) : 10.0;
-    c.batch = std::max(c.batch + 1,
-                       static_cast<std::int64_t>(std::ceil(static_cast<double>(c.batch) * grow)));
-  }
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 == 1 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
 
 struct Options {
   int side = 256;
-  double minTime = 0.3;
-  int reps = 5;
+  bench::Timing timing;
 };
-
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      const std::size_t colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(line.find_first_not_of(" \t", colon + 1));
-    }
-  }
-  return "unknown CPU";
-}
 
 void usage(const char* argv0) {
   std::printf(
@@ -213,62 +136,33 @@ void usage(const char* argv0) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options o;
-  bool quick = false;
   std::optional<int> side;
-  std::optional<double> minTime;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    const auto value = [&](std::string_view prefix) -> std::optional<std::string> {
-      if (arg.substr(0, prefix.size()) != prefix) return std::nullopt;
-      return std::string(arg.substr(prefix.size()));
-    };
-    if (arg == "--quick") {
-      quick = true;
-    } else if (auto s = value("--side=")) {
-      side = std::atoi(s->c_str());
-      if (*side < 2 || *side > 1000) {
-        std::fprintf(stderr, "bad --side: %s (2 to 1000)\n", s->c_str());
-        return 2;
-      }
-    } else if (auto t = value("--min-time=")) {
-      minTime = std::atof(t->c_str());
-      if (!(*minTime > 0.0)) {
-        std::fprintf(stderr, "bad --min-time: %s\n", t->c_str());
-        return 2;
-      }
-    } else if (auto r = value("--reps=")) {
-      o.reps = std::atoi(r->c_str());
-      if (o.reps < 1) {
-        std::fprintf(stderr, "bad --reps: %s\n", r->c_str());
-        return 2;
-      }
-    } else if (arg == "--help" || arg == "-h") {
-      usage(argv[0]);
-      return 0;
-    } else {
-      std::fprintf(stderr, "unknown argument: %s\n", argv[i]);
-      usage(argv[0]);
-      return 2;
+  bench::CommandLine cl;
+  const auto own = [&](std::string_view arg) {
+    const std::optional<std::string> s = bench::valueOf(arg, "--side=");
+    if (!s) return bench::Arg::kNotMine;
+    side = std::atoi(s->c_str());
+    if (*side < 2 || *side > 1000) {
+      std::fprintf(stderr, "bad --side: %s (2 to 1000)\n", s->c_str());
+      return bench::Arg::kBad;
     }
+    return bench::Arg::kTaken;
+  };
+  if (const std::optional<int> exitCode = bench::parseCommandLine(argc, argv, cl, usage, own)) {
+    return *exitCode;
   }
-  if (quick) {
-    o.side = 64;
-    o.minTime = 0.02;
-  }
+  Options o;
+  o.timing = cl.timing;
+  if (cl.quick) o.side = 64;
   if (side) o.side = *side;
-  if (minTime) o.minTime = *minTime;
 
   std::printf(
       "spring_bench: a %d x %d cloth (structural + shear + bend springs), gravity,\n"
       "semi-implicit Euler at %lld Hz\n",
       o.side, o.side, static_cast<long long>(kStepRateHz));
-  std::printf("machine: %s, %u hardware threads (TBB default %d)\n", cpuModel().c_str(),
+  std::printf("machine: %s, %u hardware threads (TBB default %d)\n", bench::cpuModel().c_str(),
               std::thread::hardware_concurrency(), tbb::info::default_concurrency());
-  std::printf("build: %s, compiler %s\n", TICKFX_BENCH_CONFIG, __VERSION__);
-  if (std::string_view(TICKFX_BENCH_CONFIG) != "Release") {
-    std::printf("warning: not a Release build, the figures mean little\n");
-  }
+  bench::printBuild();
 
   // One system per case, so that no case's ticks move another's state.
   std::unique_ptr<tickfx::ParticleSystem> step1 = makeSystem(o.side, 1);
@@ -304,7 +198,7 @@ int main(int argc, char** argv) {
           tickfx::Vec3Rows a = tickfx::Vec3Rows::of(acceleration, tickfx::RowRange{b, e});
           evalForces.evaluate(in, tickfx::RowRange{b, e}, a);
         });
-        escape(acceleration.x.data());
+        bench::escape(acceleration.x.data());
       }
     });
   };
@@ -327,25 +221,14 @@ int main(int argc, char** argv) {
     for (std::int64_t i = 0; i < ticks; ++i) table->springs()->beginTick(table->pool(), tableTick);
   });
 
-  const double target = o.minTime / o.reps;
-  for (Case& c : cases) calibrate(c, target);
-  const auto finished = [&](const Case& c) {
-    return static_cast<int>(c.secondsPerTick.size()) >= o.reps && c.timed >= o.minTime;
-  };
-  while (!std::all_of(cases.begin(), cases.end(), finished)) {
-    for (Case& c : cases) {
-      const double s = timeBatch(c, &c.cpu);
-      c.secondsPerTick.push_back(s / static_cast<double>(c.batch));
-      c.timed += s;
-    }
-  }
+  bench::timeCases(cases, o.timing);
 
   // "cores": CPU time over wall time while the case ran. A 2-thread case near 1.0 had only one
   // core to itself (another process busy on the other), and its ratio says nothing of tickfx.
   std::printf("\n%-22s %11s %11s %15s %13s %9s %6s  %s\n", "case", "ms/tick", "ticks/s",
               "spring evals/s", "springs/s", "2t / 1t", "cores", "batches (min to max ms)");
   std::vector<double> seconds;
-  for (const Case& c : cases) seconds.push_back(median(c.secondsPerTick));
+  for (const Case& c : cases) seconds.push_back(bench::median(c.secondsPerTick));
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
     const double s = seconds[i];
@@ -365,8 +248,8 @@ int main(int argc, char** argv) {
   std::printf("\nticks run: %lld (1 thread), %lld (2 threads); cloth state finite: %s\n",
               static_cast<long long>(step1->tickCount()),
               static_cast<long long>(step2->tickCount()), finite ? "yes" : "NO");
-  std::printf("checksum of final positions: %.9g\n", positionSum(step1->pool()) +
-                                                         positionSum(step2->pool()) +
+  std::printf("checksum of final positions: %.9g\n", bench::positionSum(step1->pool()) +
+                                                         bench::positionSum(step2->pool()) +
                                                          static_cast<double>(acceleration.y.sum()));
   if (!same) std::printf("CHECK FAILED: 1 and 2 threads disagree after one tick\n");
   if (!finite) std::printf("CHECK FAILED: the cloth blew up; the figures time NaN arithmetic\n");

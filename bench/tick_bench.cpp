@@ -17,30 +17,25 @@
 // Each tickfx case runs with 1 thread and with all threads, so the table separates the gain of
 // the layout from the gain of threading.
 //
-// Timing: each case runs in batches of ticks sized to take min-time/reps seconds; the cases of
-// one size take turns batch by batch (so a burst of outside load hits them all alike) until each
-// has at least `reps` batches and `min-time` seconds. A case's figure is the median over its
-// batches of the time per tick.
+// Timing (BenchHarness.h): batches of ticks sized to min-time/reps seconds, the cases of one size
+// taking turns batch by batch; a case's figure is the median over its batches of the time per tick.
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <thread>
-#include <utility>
 #include <vector>
 
+#include "BenchHarness.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
@@ -48,13 +43,9 @@
 #include "integrators/SemiImplicitEuler.h"
 #include "particles/ParticleSystem.h"
 
-#ifndef TICKFX_BENCH_CONFIG
-#define TICKFX_BENCH_CONFIG "unknown"
-#endif
-
 namespace {
 
-using Clock = std::chrono::steady_clock;
+namespace bench = tickfx::bench;
 
 // ---- the scene, shared by both sides ----------------------------------------------------------
 
@@ -112,16 +103,6 @@ Particle initialParticle(std::size_t i) {
                           5.0f * symmetricUnit(k + 5))};
 }
 
-// Keeps the compiler from treating stores that nothing reads inside the timed loop as dead.
-inline void escape(const void* p) {
-#if defined(__GNUC__) || defined(__clang__)
-  asm volatile("" : : "g"(p) : "memory");
-#else
-  static const void* volatile sink;
-  sink = p;
-#endif
-}
-
 // ---- the hand-written baseline ---------------------------------------------------------------
 
 class HandWrittenLoop {
@@ -148,7 +129,7 @@ class HandWrittenLoop {
       q.position += q.velocity * dt;
     }
     ++tick_;
-    escape(particles_.data());
+    bench::escape(particles_.data());
   }
 
   const std::vector<Particle>& particles() const { return particles_; }
@@ -218,55 +199,13 @@ double positionSum(const HandWrittenLoop& aos) {
   return sum;
 }
 
-double positionSum(const tickfx::ParticlePool& pool) {
-  const auto n = static_cast<Eigen::Index>(pool.size());
-  double sum = 0.0;
-  for (int c = 0; c < 3; ++c) sum += pool.position()[c].head(n).cast<double>().sum();
-  return sum;
-}
+using bench::positionSum;  // one overload set, so the checksum line reads alike for every side
 
-// ---- timing ----------------------------------------------------------------------------------
-
-struct Case {
-  Case(std::string caseName, std::function<void(std::int64_t)> runTicks)
-      : name(std::move(caseName)), run(std::move(runTicks)) {}
-
-  std::string name;
-  std::function<void(std::int64_t ticks)> run;
-  std::int64_t batch = 1;
-  std::vector<double> secondsPerTick;
-  double timed = 0.0;
-};
-
-double timeBatch(Case& c) {
-  const Clock::time_point start = Clock::now();
-  c.run(c.batch);
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// Grows the batch until it takes `target` seconds. Its runs are not recorded, so they are also
-// the warm-up (first-touch page faults of scratch columns, caches, TBB workers waking up).
-void calibrate(Case& c, double target) {
-  c.batch = 1;
-  for (;;) {
-    const double s = timeBatch(c);
-    if (s >= target) return;
-    const double grow = s > 0.0 ? std::min(10.0, 1.2 * target / s) : 10.0;
-    c.batch = std::max(c.batch + 1,
-                       static_cast<std::int64_t>(std::ceil(static_cast<double>(c.batch) * grow)));
-  }
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 == 1 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
+// ---- the run ----------------------------------------------------------------------------------
 
 struct Options {
   std::vector<std::size_t> sizes{10'000, 1'000'000, 10'000'000};
-  double minTime = 0.3;
-  int reps = 5;
+  bench::Timing timing;
 };
 
 struct Row {
@@ -314,7 +253,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
     });
   };
 
-  std::vector<Case> cases;
+  std::vector<bench::Case> cases;
   cases.emplace_back("AoS loop, 1 thread", [&](std::int64_t ticks) {
     for (std::int64_t i = 0; i < ticks; ++i) aos.tick();
   });
@@ -337,22 +276,11 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
     });
   }
 
-  const double target = o.minTime / o.reps;
-  for (Case& c : cases) calibrate(c, target);
-  const auto finished = [&](const Case& c) {
-    return static_cast<int>(c.secondsPerTick.size()) >= o.reps && c.timed >= o.minTime;
-  };
-  while (!std::all_of(cases.begin(), cases.end(), finished)) {
-    for (Case& c : cases) {
-      const double s = timeBatch(c);
-      c.secondsPerTick.push_back(s / static_cast<double>(c.batch));
-      c.timed += s;
-    }
-  }
+  bench::timeCases(cases, o.timing);
 
-  const double aosSeconds = median(cases.front().secondsPerTick);
-  for (const Case& c : cases) {
-    const double s = median(c.secondsPerTick);
+  const double aosSeconds = bench::median(cases.front().secondsPerTick);
+  for (const bench::Case& c : cases) {
+    const double s = bench::median(c.secondsPerTick);
     const auto [lo, hi] = std::minmax_element(c.secondsPerTick.begin(), c.secondsPerTick.end());
     std::printf("  %-30s %10.4f ms/tick  (median of %zu batches of %lld ticks; %.4f to %.4f)\n",
                 c.name.c_str(), 1e3 * s, c.secondsPerTick.size(), static_cast<long long>(c.batch),
@@ -363,18 +291,6 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 
   checksum += positionSum(aos) + positionSum(one->pool()) + (all ? positionSum(all->pool()) : 0.0);
   return d.withinRoundOff;
-}
-
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      const std::size_t colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(line.find_first_not_of(" \t", colon + 1));
-    }
-  }
-  return "unknown CPU";
 }
 
 void usage(const char* argv0) {
@@ -407,61 +323,32 @@ std::optional<std::vector<std::size_t>> parseSizes(std::string_view list) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options o;
-  bool quick = false;
   std::optional<std::vector<std::size_t>> sizes;
-  std::optional<double> minTime;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    const auto value = [&](std::string_view prefix) -> std::optional<std::string> {
-      if (arg.substr(0, prefix.size()) != prefix) return std::nullopt;
-      return std::string(arg.substr(prefix.size()));
-    };
-    if (arg == "--quick") {
-      quick = true;
-    } else if (auto v = value("--sizes=")) {
-      sizes = parseSizes(*v);
-      if (!sizes) {
-        std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
-        return 2;
-      }
-    } else if (auto t = value("--min-time=")) {
-      minTime = std::atof(t->c_str());
-      if (!(*minTime > 0.0)) {
-        std::fprintf(stderr, "bad --min-time: %s\n", t->c_str());
-        return 2;
-      }
-    } else if (auto r = value("--reps=")) {
-      o.reps = std::atoi(r->c_str());
-      if (o.reps < 1) {
-        std::fprintf(stderr, "bad --reps: %s\n", r->c_str());
-        return 2;
-      }
-    } else if (arg == "--help" || arg == "-h") {
-      usage(argv[0]);
-      return 0;
-    } else {
-      std::fprintf(stderr, "unknown argument: %s\n", argv[i]);
-      usage(argv[0]);
-      return 2;
+  bench::CommandLine cl;
+  const auto own = [&](std::string_view arg) {
+    const std::optional<std::string> v = bench::valueOf(arg, "--sizes=");
+    if (!v) return bench::Arg::kNotMine;
+    sizes = parseSizes(*v);
+    if (!sizes) {
+      std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
+      return bench::Arg::kBad;
     }
+    return bench::Arg::kTaken;
+  };
+  if (const std::optional<int> exitCode = bench::parseCommandLine(argc, argv, cl, usage, own)) {
+    return *exitCode;
   }
-  if (quick) {
-    o.sizes = {10'000, 100'000};
-    o.minTime = 0.02;
-  }
+  Options o;
+  o.timing = cl.timing;
+  if (cl.quick) o.sizes = {10'000, 100'000};
   if (sizes) o.sizes = *sizes;
-  if (minTime) o.minTime = *minTime;
 
   const int allThreads = tbb::info::default_concurrency();
   std::printf("tick_bench: one tick of gravity + wind + drag, semi-implicit Euler, %lld Hz\n",
               static_cast<long long>(kStepRateHz));
-  std::printf("machine: %s, %u hardware threads (TBB uses %d)\n", cpuModel().c_str(),
+  std::printf("machine: %s, %u hardware threads (TBB uses %d)\n", bench::cpuModel().c_str(),
               std::thread::hardware_concurrency(), allThreads);
-  std::printf("build: %s, compiler %s\n", TICKFX_BENCH_CONFIG, __VERSION__);
-  if (std::string_view(TICKFX_BENCH_CONFIG) != "Release") {
-    std::printf("warning: not a Release build, the figures mean little\n");
-  }
+  bench::printBuild();
 
   std::vector<Row> rows;
   double checksum = 0.0;
