@@ -44,20 +44,24 @@ std::optional<std::string> Arguments::value(const std::string& name) {
 
 std::vector<std::string> Arguments::positionals(std::size_t count, const std::string& what) {
   for (const std::string& a : args_) {
-    if (a.size() > 1 && a[0] == '-') throw UsageError(command_ + ": unknown option '" + a + "' (see tickfx " + command_ + " --help)");
+    if (a.size() > 1 && a[0] == '-')
+      throw UsageError(command_ + ": unknown option '" + a + "' (see tickfx " + command_ +
+                       " --help)");
   }
   if (args_.size() != count) {
-    throw UsageError(command_ + ": expected " + what + (args_.size() > count ? ", got extra arguments" : ""));
+    throw UsageError(command_ + ": expected " + what +
+                     (args_.size() > count ? ", got extra arguments" : ""));
   }
   return args_;
 }
 
-long long parseInteger(const std::string& text, const std::string& option, long long min, long long max) {
+long long parseInteger(const std::string& text, const std::string& option, long long min,
+                       long long max) {
   long long value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (ec != std::errc() || end != text.data() + text.size() || value < min || value > max) {
-    throw UsageError(option + ": '" + text + "' is not a whole number in [" + std::to_string(min) + ", " +
-                     std::to_string(max) + "]");
+    throw UsageError(option + ": '" + text + "' is not a whole number in [" + std::to_string(min) +
+                     ", " + std::to_string(max) + "]");
   }
   return value;
 }

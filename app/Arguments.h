@@ -38,7 +38,8 @@ class Arguments {
 };
 
 /// Parses a whole number in [min, max]; UsageError naming `option` otherwise.
-long long parseInteger(const std::string& text, const std::string& option, long long min, long long max);
+long long parseInteger(const std::string& text, const std::string& option, long long min,
+                       long long max);
 /// Parses a finite number in [min, max]; UsageError naming `option` otherwise.
 double parseNumber(const std::string& text, const std::string& option, double min, double max);
 

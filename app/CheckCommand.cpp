@@ -12,8 +12,10 @@ int checkCommand(Arguments& args) {
     std::fputs(
         "usage: tickfx check EFFECT.toml [--set key.path=value]...\n"
         "\n"
-        "Validates EFFECT.toml (with the same overrides `tickfx run` takes) and prints every error\n"
-        "and lint warning as FILE:LINE:COL: severity: key.path: message. Exit code 2 when there is\n"
+        "Validates EFFECT.toml (with the same overrides `tickfx run` takes) and prints every "
+        "error\n"
+        "and lint warning as FILE:LINE:COL: severity: key.path: message. Exit code 2 when there "
+        "is\n"
         "an error, 0 otherwise (warnings do not fail).\n",
         stdout);
     return kExitOk;

@@ -30,13 +30,16 @@ std::vector<DriveCase> standardDriveCases(Flicks total, const std::vector<int>& 
                                           const std::optional<std::vector<Flicks>>& recorded) {
   std::vector<DriveCase> cases;
   const std::pair<const char*, FrameRate> rates[] = {
-      {"24 fps", {24, 1}}, {"25 fps", {25, 1}}, {"30 fps", {30, 1}}, {"30000/1001 fps", {30000, 1001}},
+      {"24 fps", {24, 1}}, {"25 fps", {25, 1}},
+      {"30 fps", {30, 1}}, {"30000/1001 fps", {30000, 1001}},
       {"60 fps", {60, 1}}, {"144 fps", {144, 1}}};
-  for (const auto& [label, rate] : rates) cases.push_back({label, io::fixedRateFrames(rate, total), 1});
+  for (const auto& [label, rate] : rates)
+    cases.push_back({label, io::fixedRateFrames(rate, total), 1});
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     cases.push_back({"jitter " + std::to_string(seed), io::jitteredFrames(seed, total), 1});
   }
-  cases.push_back({recorded ? "frame-times file" : "recorded frames", recorded ? *recorded : irregularFrames(total), 1});
+  cases.push_back({recorded ? "frame-times file" : "recorded frames",
+                   recorded ? *recorded : irregularFrames(total), 1});
   for (int threads : threadCounts) {
     if (threads == 1) continue;
     cases.push_back({"60 fps", io::fixedRateFrames({60, 1}, total), threads});
@@ -54,13 +57,16 @@ DriveTrace traceDrive(const io::EffectSettings& effect, const DriveCase& drive,
   trace.label = drive.label;
   trace.threads = drive.threads;
   system->setTickObserver([&](const ParticleSystem& s) {
-    if (!onlyTicks.empty() && !std::binary_search(onlyTicks.begin(), onlyTicks.end(), s.tickCount())) return;
+    if (!onlyTicks.empty() &&
+        !std::binary_search(onlyTicks.begin(), onlyTicks.end(), s.tickCount()))
+      return;
     trace.ticks.push_back(s.tickCount());
     trace.hashes.push_back(stateHash(s.pool()));
   });
   const auto start = std::chrono::steady_clock::now();
   for (Flicks frame : drive.frames) trace.ticksDropped += system->advance(frame).ticksDropped;
-  trace.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  trace.wallSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return trace;
 }
 

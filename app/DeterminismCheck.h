@@ -13,7 +13,7 @@ namespace tickfx::app {
 
 /// One way to drive an effect: its frame durations (summing to the run's length) and threads.
 struct DriveCase {
-  std::string label;          // "24 fps", "jitter 2", ...
+  std::string label;  // "24 fps", "jitter 2", ...
   std::vector<Flicks> frames;
   int threads = 1;
 };
@@ -22,8 +22,9 @@ struct DriveCase {
 /// 30000/1001, 60 and 144 fps, seeded jitter 1, 2 and 3, and an irregular recorded sequence (or
 /// the frames of `recorded` when given). Every schedule runs on 1 thread; 60 fps and jitter 1 also
 /// run on each of `threadCounts`.
-std::vector<DriveCase> standardDriveCases(Flicks total, const std::vector<int>& threadCounts,
-                                          const std::optional<std::vector<Flicks>>& recorded = std::nullopt);
+std::vector<DriveCase> standardDriveCases(
+    Flicks total, const std::vector<int>& threadCounts,
+    const std::optional<std::vector<Flicks>>& recorded = std::nullopt);
 
 /// What one drive produced: the state hash after each tick (or only after the ticks asked for).
 struct DriveTrace {

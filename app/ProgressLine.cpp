@@ -1,22 +1,26 @@
 #include "app/ProgressLine.h"
 
-#include <cstdio>
 #include <unistd.h>
+#include <cstdio>
 
 namespace tickfx::app {
 
-ProgressLine::ProgressLine() : enabled_(::isatty(STDERR_FILENO) == 1), start_(Clock::now()), last_(start_) {}
+ProgressLine::ProgressLine()
+    : enabled_(::isatty(STDERR_FILENO) == 1), start_(Clock::now()), last_(start_) {}
 
 ProgressLine::~ProgressLine() { finish(); }
 
-void ProgressLine::update(std::int64_t frame, std::int64_t frames, double simSeconds, std::size_t particles) {
+void ProgressLine::update(std::int64_t frame, std::int64_t frames, double simSeconds,
+                          std::size_t particles) {
   if (!enabled_) return;
   const Clock::time_point now = Clock::now();
-  if (now - start_ < std::chrono::seconds(1) || now - last_ < std::chrono::milliseconds(100)) return;
+  if (now - start_ < std::chrono::seconds(1) || now - last_ < std::chrono::milliseconds(100))
+    return;
   last_ = now;
   shown_ = true;
-  std::fprintf(stderr, "\r\033[Kframe %lld/%lld  t = %.3f s  particles: %zu", static_cast<long long>(frame),
-               static_cast<long long>(frames), simSeconds, particles);
+  std::fprintf(stderr, "\r\033[Kframe %lld/%lld  t = %.3f s  particles: %zu",
+               static_cast<long long>(frame), static_cast<long long>(frames), simSeconds,
+               particles);
   std::fflush(stderr);
 }
 

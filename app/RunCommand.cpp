@@ -35,7 +35,8 @@ constexpr const char* kHelp =
     "  --seconds S           run for S seconds (the last frame is shortened to end exactly at S)\n"
     "  --frames N            run for N frames\n"
     "  --fps F               frames of 1/F s; F an integer or a ratio such as 30000/1001\n"
-    "  --jitter SEED         seeded random frame durations in [1/240 s, 1/10 s] ending exactly at S\n"
+    "  --jitter SEED         seeded random frame durations in [1/240 s, 1/10 s] ending exactly at "
+    "S\n"
     "  --frame-times FILE    one frame duration in seconds a line\n"
     "Output:\n"
     "  --out DIR             cache directory (default: the effect's output.directory)\n"
@@ -50,7 +51,8 @@ constexpr const char* kHelp =
     "  --resume FILE         continue from a checkpoint of this effect (same --set and frame\n"
     "                        options as the run that wrote it); reaches the same state hash\n"
     "Simulation:\n"
-    "  --set key.path=value  override a key of the effect (repeatable), e.g. simulation.integrator=rk4\n"
+    "  --set key.path=value  override a key of the effect (repeatable), e.g. "
+    "simulation.integrator=rk4\n"
     "  --threads N           worker threads (default: the effect's, 0 = all cores)\n"
     "  --quiet               no summary (errors, warnings and --hash lines still print)\n";
 
@@ -78,13 +80,16 @@ struct FramePlan {
 };
 
 FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::string>& seconds,
-                     const std::optional<std::string>& frames, const std::optional<std::string>& fps,
+                     const std::optional<std::string>& frames,
+                     const std::optional<std::string>& fps,
                      const std::optional<std::string>& jitter,
                      const std::optional<std::string>& frameTimes) {
   if (seconds && frames) throw UsageError("run: give --seconds or --frames, not both");
   if (jitter && frameTimes) throw UsageError("run: give --jitter or --frame-times, not both");
-  if ((jitter || frameTimes) && fps) throw UsageError("run: --fps does not go with --jitter or --frame-times");
-  if (frameTimes && (seconds || frames)) throw UsageError("run: --frame-times sets the length; drop --seconds/--frames");
+  if ((jitter || frameTimes) && fps)
+    throw UsageError("run: --fps does not go with --jitter or --frame-times");
+  if (frameTimes && (seconds || frames))
+    throw UsageError("run: --frame-times sets the length; drop --seconds/--frames");
   if (jitter && frames) throw UsageError("run: --jitter needs a length in --seconds, not --frames");
 
   FramePlan plan;
@@ -102,18 +107,22 @@ FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::
     }
   }
   const double defaultSeconds = output.durationSeconds();
-  const double length = seconds ? parseNumber(*seconds, "run: --seconds", 0.0, 1.0e6) : defaultSeconds;
+  const double length =
+      seconds ? parseNumber(*seconds, "run: --seconds", 0.0, 1.0e6) : defaultSeconds;
   const Flicks total = flicksFromSeconds(length);
   if (jitter) {
-    const auto seed = static_cast<std::uint64_t>(parseInteger(*jitter, "run: --jitter", 0, INT64_MAX));
+    const auto seed =
+        static_cast<std::uint64_t>(parseInteger(*jitter, "run: --jitter", 0, INT64_MAX));
     plan.frames = io::jitteredFrames(seed, total);
     plan.description = "jittered frames (seed " + *jitter + ")";
     return plan;
   }
-  const std::string rateText = std::to_string(rate.numerator) +
-                               (rate.denominator == 1 ? "" : "/" + std::to_string(rate.denominator));
+  const std::string rateText =
+      std::to_string(rate.numerator) +
+      (rate.denominator == 1 ? "" : "/" + std::to_string(rate.denominator));
   if (frames) {
-    plan.frames = io::fixedRateFrameCount(rate, parseInteger(*frames, "run: --frames", 0, 100'000'000));
+    plan.frames =
+        io::fixedRateFrameCount(rate, parseInteger(*frames, "run: --frames", 0, 100'000'000));
   } else if (seconds) {
     plan.frames = io::fixedRateFrames(rate, total);
   } else {
@@ -123,7 +132,8 @@ FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::
   return plan;
 }
 
-std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t frame, const char* extension) {
+std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t frame,
+                                const char* extension) {
   char name[64];
   std::snprintf(name, sizeof name, "frame_%04" PRId64 ".%s", frame, extension);
   return dir / name;
@@ -136,7 +146,8 @@ std::filesystem::path checkpointPath(const std::filesystem::path& dir, std::int6
 }
 
 // The effect as a checkpoint knows it: the file's bytes and every override, in order.
-std::uint64_t effectFingerprint(const std::string& path, const std::vector<std::string>& overrides) {
+std::uint64_t effectFingerprint(const std::string& path,
+                                const std::vector<std::string>& overrides) {
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (const std::string& o : overrides) bytes += '\0' + o;
@@ -173,9 +184,11 @@ int runCommand(Arguments& args) {
   for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
   if (!load.ok()) return kExitUsage;
   const io::EffectSettings& effect = *load.effect;
-  for (const io::Diagnostic& d : io::lintEffect(effect)) std::fprintf(stderr, "%s\n", d.format().c_str());
+  for (const io::Diagnostic& d : io::lintEffect(effect))
+    std::fprintf(stderr, "%s\n", d.format().c_str());
 
-  const std::vector<io::CacheFormat> formats = format ? parseFormats(*format) : effect.output.formats;
+  const std::vector<io::CacheFormat> formats =
+      format ? parseFormats(*format) : effect.output.formats;
   const std::filesystem::path outDir = out ? *out : effect.output.directory;
   std::optional<int> threadOverride;
   if (threads) threadOverride = static_cast<int>(parseInteger(*threads, "run: --threads", 0, 256));
@@ -189,9 +202,12 @@ int runCommand(Arguments& args) {
   }
 
   std::int64_t every = 0;
-  if (checkpointEvery) every = parseInteger(*checkpointEvery, "run: --checkpoint-every", 1, 1'000'000'000);
-  if (checkpointDir && !checkpointEvery) throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
-  const std::filesystem::path checkpoints = checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
+  if (checkpointEvery)
+    every = parseInteger(*checkpointEvery, "run: --checkpoint-every", 1, 1'000'000'000);
+  if (checkpointDir && !checkpointEvery)
+    throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
+  const std::filesystem::path checkpoints =
+      checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
   const std::uint64_t effectHash = effectFingerprint(effectPath, overrides);
 
   const auto system = io::buildSystem(effect, threadOverride);
@@ -207,15 +223,17 @@ int runCommand(Arguments& args) {
       return kExitUsage;
     }
     Flicks planned = 0;
-    for (std::int64_t f = 0; f < info.frame && f < static_cast<std::int64_t>(plan.frames.size()); ++f) {
+    for (std::int64_t f = 0; f < info.frame && f < static_cast<std::int64_t>(plan.frames.size());
+         ++f) {
       planned += plan.frames[static_cast<std::size_t>(f)];
     }
     if (info.frame > static_cast<std::int64_t>(plan.frames.size()) || planned != info.elapsed) {
-      std::fprintf(stderr,
-                   "%s: error: the checkpoint is at frame %lld (%.9g s) but this run's frame %lld ends at "
-                   "%.9g s (give the frame options of the run that wrote it)\n",
-                   resume->c_str(), static_cast<long long>(info.frame), secondsFromFlicks(info.elapsed),
-                   static_cast<long long>(info.frame), secondsFromFlicks(planned));
+      std::fprintf(
+          stderr,
+          "%s: error: the checkpoint is at frame %lld (%.9g s) but this run's frame %lld ends at "
+          "%.9g s (give the frame options of the run that wrote it)\n",
+          resume->c_str(), static_cast<long long>(info.frame), secondsFromFlicks(info.elapsed),
+          static_cast<long long>(info.frame), secondsFromFlicks(planned));
       return kExitUsage;
     }
     firstFrame = info.frame + 1;
@@ -223,7 +241,9 @@ int runCommand(Arguments& args) {
   }
   std::vector<std::pair<std::int64_t, std::uint64_t>> tickHashes;
   if (trace) {
-    system->setTickObserver([&](const ParticleSystem& s) { tickHashes.emplace_back(s.tickCount(), stateHash(s.pool())); });
+    system->setTickObserver([&](const ParticleSystem& s) {
+      tickHashes.emplace_back(s.tickCount(), stateHash(s.pool()));
+    });
   }
   if (!formats.empty()) std::filesystem::create_directories(outDir);
   if (every > 0) std::filesystem::create_directories(checkpoints);
@@ -245,12 +265,14 @@ int runCommand(Arguments& args) {
       }
     }
     if (every > 0 && f % every == 0) {
-      io::writeCheckpoint(checkpointPath(checkpoints, f), *system, io::CheckpointInfo{effectHash, f, elapsed});
+      io::writeCheckpoint(checkpointPath(checkpoints, f), *system,
+                          io::CheckpointInfo{effectHash, f, elapsed});
     }
     progress.update(f, frameCount, secondsFromFlicks(elapsed), system->pool().size());
   }
   progress.finish();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
 
   if (dump) io::writeStateDump(system->pool(), *dump);
   if (trace) {
@@ -261,15 +283,17 @@ int runCommand(Arguments& args) {
   }
   const ParticlePool& pool = system->pool();
   if (!quiet) {
-    std::printf("%s: %lld ticks at %lld Hz (%s), %lld frames %s, %.6g s simulated\n", effectPath.c_str(),
-                static_cast<long long>(system->tickCount()), static_cast<long long>(effect.simulation.stepRateHz),
+    std::printf("%s: %lld ticks at %lld Hz (%s), %lld frames %s, %.6g s simulated\n",
+                effectPath.c_str(), static_cast<long long>(system->tickCount()),
+                static_cast<long long>(effect.simulation.stepRateHz),
                 effect.simulation.integrator.c_str(), static_cast<long long>(frameCount),
                 plan.description.c_str(), secondsFromFlicks(elapsed));
-    std::printf("particles alive: %zu (emitted %llu, refused by max_particles: %llu)\n", pool.size(),
-                static_cast<unsigned long long>(pool.nextId() + pool.droppedSpawns()),
+    std::printf("particles alive: %zu (emitted %llu, refused by max_particles: %llu)\n",
+                pool.size(), static_cast<unsigned long long>(pool.nextId() + pool.droppedSpawns()),
                 static_cast<unsigned long long>(pool.droppedSpawns()));
     std::printf("ticks dropped by the cap (max_ticks_per_frame = %lld): %lld\n",
-                static_cast<long long>(effect.simulation.maxTicksPerFrame), static_cast<long long>(ticksDropped));
+                static_cast<long long>(effect.simulation.maxTicksPerFrame),
+                static_cast<long long>(ticksDropped));
     std::printf("wall time: %.3f s\n", wall);
     if (!formats.empty() && frameCount > 0) {
       std::printf("caches: %s (frame_0001 to frame_%04lld)\n", outDir.string().c_str(),

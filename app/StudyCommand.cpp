@@ -25,7 +25,8 @@ int studyCommand(Arguments& args) {
   const StudyResults results = runIntegratorStudy();
   printStudy(results, stdout);
   std::printf("\n");
-  for (const auto& path : writeStudyCsv(results, dir)) std::printf("wrote %s\n", path.string().c_str());
+  for (const auto& path : writeStudyCsv(results, dir))
+    std::printf("wrote %s\n", path.string().c_str());
   return kExitOk;
 }
 

@@ -36,7 +36,9 @@ struct ConstVec3Rows {
 
   ConstVec3Rows(const float* px, const float* py, const float* pz, Eigen::Index n)
       : x(px, n), y(py, n), z(pz, n) {}
-  const Eigen::Map<const FloatColumn>& operator[](int c) const { return c == 0 ? x : (c == 1 ? y : z); }
+  const Eigen::Map<const FloatColumn>& operator[](int c) const {
+    return c == 0 ? x : (c == 1 ? y : z);
+  }
 };
 
 /// A vector quantity an integrator hands to the forces: row r is at index r − base of each
@@ -67,9 +69,9 @@ struct Vec3View {
 /// from `pool`, indexed by pool row.
 struct ForceInput {
   const ParticlePool& pool;
-  Vec3View position;    // metres
-  Vec3View velocity;    // metres per second
-  double time = 0.0;    // seconds since tick 0, for the stage asked (t, t + dt/2, t + dt)
+  Vec3View position;      // metres
+  Vec3View velocity;      // metres per second
+  double time = 0.0;      // seconds since tick 0, for the stage asked (t, t + dt/2, t + dt)
   std::int64_t tick = 0;  // the tick being integrated
 };
 

@@ -24,7 +24,8 @@ void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& accelerat
   // would have formed, while folding a uniform module after a per-row one would reorder it.
   Eigen::Vector3f uniform = Eigen::Vector3f::Zero();
   std::size_t next = 0;
-  for (Eigen::Vector3f a; next < modules_.size() && modules_[next]->uniformAcceleration(in, a); ++next) {
+  for (Eigen::Vector3f a; next < modules_.size() && modules_[next]->uniformAcceleration(in, a);
+       ++next) {
     uniform.x() += a.x();
     uniform.y() += a.y();
     uniform.z() += a.z();

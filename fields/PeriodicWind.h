@@ -14,10 +14,10 @@ class PeriodicWind final : public ForceModule {
  public:
   struct Settings {
     Eigen::Vector3f direction = Eigen::Vector3f(1.0f, 0.0f, 0.0f);  // normalised on construction
-    float base = 0.0f;                                                // m/s²
-    float amplitude = 1.0f;                                           // m/s²
-    double frequency = 1.0;                                           // Hz
-    double phase = 0.0;                                               // radians
+    float base = 0.0f;                                              // m/s²
+    float amplitude = 1.0f;                                         // m/s²
+    double frequency = 1.0;                                         // Hz
+    double phase = 0.0;                                             // radians
   };
 
   explicit PeriodicWind(const Settings& settings);

@@ -41,7 +41,8 @@ void SpringNetwork::beginTick(const ParticlePool& pool, std::int64_t /*tick*/) {
     const std::uint32_t rb = rowOf(pool.id(), n, spring.b);
     if (ra == kMissing || rb == kMissing) {
       // An end not born yet keeps the spring; an end that died removes it.
-      const bool died = (ra == kMissing && spring.a < pool.nextId()) || (rb == kMissing && spring.b < pool.nextId());
+      const bool died = (ra == kMissing && spring.a < pool.nextId()) ||
+                        (rb == kMissing && spring.b < pool.nextId());
       if (!died) springs_[kept++] = spring;
       continue;
     }
@@ -89,7 +90,8 @@ void SpringNetwork::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& ac
       const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
       if (!(length > 0.0f)) continue;  // coincident ends: no direction, no force
       const float ux = dx / length, uy = dy / length, uz = dz / length;
-      const float closing = (vj.x() - vi.x()) * ux + (vj.y() - vi.y()) * uy + (vj.z() - vi.z()) * uz;
+      const float closing =
+          (vj.x() - vi.x()) * ux + (vj.y() - vi.y()) * uy + (vj.z() - vi.z()) * uz;
       const float f = s.stiffness * (length - s.restLength) + s.damping * closing;
       fx += f * ux;
       fy += f * uy;

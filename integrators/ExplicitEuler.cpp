@@ -8,20 +8,21 @@ void ExplicitEuler::step(ParticlePool& pool, const ForceSet& forces, const StepT
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const double t0 = time.at(0.0);
-  runPasses(pool.size(), forces.isLocal(), scratch_,
-            {[&](const Tile& tile) {
-               Vec3Rows a = tile.stage(0);
-               forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, tile.rows(), a);
-             },
-             [&](const Tile& tile) {
-               Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                        old = rowsOf(prev, tile.rows());
-               for (int c = 0; c < 3; ++c) {
-                 old[c] = pr[c];
-                 pr[c] += vr[c] * dt;
-                 vr[c] += a[c] * dt;
-               }
-             }});
+  runPasses(
+      pool.size(), forces.isLocal(), scratch_,
+      {[&](const Tile& tile) {
+         Vec3Rows a = tile.stage(0);
+         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, tile.rows(), a);
+       },
+       [&](const Tile& tile) {
+         Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                  old = rowsOf(prev, tile.rows());
+         for (int c = 0; c < 3; ++c) {
+           old[c] = pr[c];
+           pr[c] += vr[c] * dt;
+           vr[c] += a[c] * dt;
+         }
+       }});
 }
 
 }  // namespace tickfx

@@ -11,8 +11,8 @@
 namespace tickfx {
 
 const std::vector<std::string>& integratorNames() {
-  static const std::vector<std::string> names = {"explicit_euler", "semi_implicit_euler",
-                                                 "midpoint",       "position_verlet",
+  static const std::vector<std::string> names = {"explicit_euler",  "semi_implicit_euler",
+                                                 "midpoint",        "position_verlet",
                                                  "velocity_verlet", "rk4"};
   return names;
 }

@@ -41,7 +41,9 @@ void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
     for (int c = 0; c < 3; ++c) stage[k][c] = scratch.column(k)[c].data();
   }
   for (const RowPass& pass : passes) {
-    parallelForRows(rows, [&](std::size_t b, std::size_t e) { pass(Tile(RowRange{b, e}, stage, count, 0)); });
+    parallelForRows(rows, [&](std::size_t b, std::size_t e) {
+      pass(Tile(RowRange{b, e}, stage, count, 0));
+    });
   }
 }
 

@@ -13,34 +13,35 @@ void VelocityVerlet::step(ParticlePool& pool, const ForceSet& forces, const Step
   const std::size_t fresh = pool.firstUnstepped();
   const std::size_t n = pool.size();
   const double t0 = time.at(0.0), t1 = time.at(1.0);
-  runPasses(n, forces.isLocal(), scratch_,
-            {[&](const Tile& tile) {
-               // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
-               const RowRange started = intersect(tile.rows(), fresh, n);
-               if (started.count() == 0) return;
-               Vec3Rows out = rowsOf(a, started);
-               forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, started, out);
-             },
-             [&](const Tile& tile) {
-               Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                        ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
-               for (int c = 0; c < 3; ++c) {
-                 old[c] = pr[c];
-                 pr[c] += vr[c] * dt + ar[c] * halfDt2;
-                 vPred[c] = vr[c] + ar[c] * dt;
-               }
-             },
-             [&](const Tile& tile) {
-               Vec3Rows aNew = tile.stage(1);
-               forces.evaluate({pool, Vec3View::of(p), tile.view(0), t1, time.tick}, tile.rows(), aNew);
-             },
-             [&](const Tile& tile) {
-               Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
-               for (int c = 0; c < 3; ++c) {
-                 vr[c] += (ar[c] + aNew[c]) * halfDt;
-                 ar[c] = aNew[c];
-               }
-             }});
+  runPasses(
+      n, forces.isLocal(), scratch_,
+      {[&](const Tile& tile) {
+         // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
+         const RowRange started = intersect(tile.rows(), fresh, n);
+         if (started.count() == 0) return;
+         Vec3Rows out = rowsOf(a, started);
+         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, started, out);
+       },
+       [&](const Tile& tile) {
+         Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                  ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
+         for (int c = 0; c < 3; ++c) {
+           old[c] = pr[c];
+           pr[c] += vr[c] * dt + ar[c] * halfDt2;
+           vPred[c] = vr[c] + ar[c] * dt;
+         }
+       },
+       [&](const Tile& tile) {
+         Vec3Rows aNew = tile.stage(1);
+         forces.evaluate({pool, Vec3View::of(p), tile.view(0), t1, time.tick}, tile.rows(), aNew);
+       },
+       [&](const Tile& tile) {
+         Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
+         for (int c = 0; c < 3; ++c) {
+           vr[c] += (ar[c] + aNew[c]) * halfDt;
+           ar[c] = aNew[c];
+         }
+       }});
 }
 
 }  // namespace tickfx

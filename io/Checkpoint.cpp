@@ -154,7 +154,8 @@ class Reader {
 
 // Everything the file says, parsed and checked but not yet applied; the columns still point
 // into the file's bytes.
-// A spring on file: ids a and b, then rest length, stiffness, damping and break ratio as float bits.
+// A spring on file: ids a and b, then rest length, stiffness, damping and break ratio as float
+// bits.
 constexpr std::size_t kSpringBytes = 8 + 8 + 4 * 4;
 
 struct Parsed {
@@ -207,7 +208,8 @@ Parsed parsePayload(std::string_view payload) {
   for (Spring& spring : p.springs) {
     spring.a = r.u64("a spring");
     spring.b = r.u64("a spring");
-    const std::uint32_t fields[4] = {r.u32("a spring"), r.u32("a spring"), r.u32("a spring"), r.u32("a spring")};
+    const std::uint32_t fields[4] = {r.u32("a spring"), r.u32("a spring"), r.u32("a spring"),
+                                     r.u32("a spring")};
     std::memcpy(&spring.restLength, &fields[0], 4);
     std::memcpy(&spring.stiffness, &fields[1], 4);
     std::memcpy(&spring.damping, &fields[2], 4);

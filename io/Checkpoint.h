@@ -44,7 +44,8 @@ inline constexpr std::uint32_t kCheckpointVersion = 1;
 ///              u64[n] id   i64[n] birth tick
 ///              per attribute: str name, f32[n] values
 ///              u64 spring count s   u64 springs broken so far
-///              s × (u64 id a, u64 id b, f32 rest length, f32 stiffness, f32 damping, f32 break ratio)
+///              s × (u64 id a, u64 id b, f32 rest length, f32 stiffness, f32 damping, f32 break
+///              ratio)
 ///     trailer  u64 checksum: fingerprint() of every byte before it
 ///
 /// where str is a u32 byte count followed by that many UTF-8 bytes.
@@ -56,10 +57,11 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
 /// The whole file is read and verified before `system` is touched: magic, version, length,
 /// checksum, `expectedEffectHash`, then that `system` was built from matching settings (step
 /// rate, integrator, max particles, max ticks per frame, overrun policy, the same attribute
-/// names, springs only where the effect has structures). Only then are the pool (every column and attribute, size, next id, dropped spawns),
-/// the spring network, the driver (ticks issued, ticks dropped, remainder) and the tick count replaced, so `system`
-/// continues exactly as the system that wrote the file would have. ParticleSystem::alpha() is
-/// not part of the state: it is that of the next advance().
+/// names, springs only where the effect has structures). Only then are the pool (every column and
+/// attribute, size, next id, dropped spawns), the spring network, the driver (ticks issued, ticks
+/// dropped, remainder) and the tick count replaced, so `system` continues exactly as the system
+/// that wrote the file would have. ParticleSystem::alpha() is not part of the state: it is that of
+/// the next advance().
 ///
 /// On any refusal throws std::runtime_error "PATH: error: what (expected)", e.g.
 /// "ckpt.bin: error: checkpoint is truncated (expected 5120 bytes, found 1000)", and `system` is

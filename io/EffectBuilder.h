@@ -17,9 +17,9 @@ namespace tickfx::io {
 ForceSet buildForces(const std::vector<ForceSettings>& forces);
 
 /// A new system for `effect`: its [simulation] settings (with `threadsOverride`, when given, in
-/// place of simulation.threads), its emitters, its structures and its forces. The caller owns the system; the
-/// effect is not referenced after the call. Throws std::invalid_argument as ParticleSystem does
-/// for settings out of range: settings from parseEffect() never are.
+/// place of simulation.threads), its emitters, its structures and its forces. The caller owns the
+/// system; the effect is not referenced after the call. Throws std::invalid_argument as
+/// ParticleSystem does for settings out of range: settings from parseEffect() never are.
 std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
                                             std::optional<int> threadsOverride = std::nullopt);
 

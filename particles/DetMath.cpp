@@ -58,10 +58,14 @@ double sin(double x) {
   if (!std::isfinite(x)) return std::nan("");
   const Reduced red = reduce(x);
   switch (red.quadrant & 3) {
-    case 0: return sinKernel(red.r);
-    case 1: return cosKernel(red.r);
-    case 2: return -sinKernel(red.r);
-    default: return -cosKernel(red.r);
+    case 0:
+      return sinKernel(red.r);
+    case 1:
+      return cosKernel(red.r);
+    case 2:
+      return -sinKernel(red.r);
+    default:
+      return -cosKernel(red.r);
   }
 }
 
@@ -69,10 +73,14 @@ double cos(double x) {
   if (!std::isfinite(x)) return std::nan("");
   const Reduced red = reduce(x);
   switch (red.quadrant & 3) {
-    case 0: return cosKernel(red.r);
-    case 1: return -sinKernel(red.r);
-    case 2: return -cosKernel(red.r);
-    default: return sinKernel(red.r);
+    case 0:
+      return cosKernel(red.r);
+    case 1:
+      return -sinKernel(red.r);
+    case 2:
+      return -cosKernel(red.r);
+    default:
+      return sinKernel(red.r);
   }
 }
 

@@ -45,10 +45,12 @@ Emitter::Emitter(EmitterSettings settings, std::uint32_t index, std::int64_t ste
           "emitter rate must be in [0, 1e9] particles per second");
   require(std::isfinite(s_.start) && s_.start >= 0.0, "emitter start must be a time >= 0");
   require(!std::isnan(s_.stop) && s_.stop >= s_.start, "emitter stop must not be before start");
-  require(s_.direction.allFinite() && s_.direction.norm() > 0.0, "emitter direction must not be zero");
+  require(s_.direction.allFinite() && s_.direction.norm() > 0.0,
+          "emitter direction must not be zero");
   require(std::isfinite(s_.speed) && s_.speed >= 0.0, "emitter speed must be >= 0");
   require(s_.speedJitter >= 0.0 && s_.speedJitter <= 1.0, "speed jitter must be in [0, 1]");
-  require(s_.spreadDegrees >= 0.0 && s_.spreadDegrees <= 180.0, "spread must be in [0, 180] degrees");
+  require(s_.spreadDegrees >= 0.0 && s_.spreadDegrees <= 180.0,
+          "spread must be in [0, 180] degrees");
   require(s_.lifetime > 0.0, "lifetime must be > 0");
   require(s_.lifetimeJitter >= 0.0 && s_.lifetimeJitter < 1.0, "lifetime jitter must be in [0, 1)");
   require(s_.mass > 0.0, "mass must be > 0");
@@ -73,7 +75,8 @@ std::uint64_t Emitter::rateCountBefore(std::int64_t tick) const {
   const std::int64_t end = std::min(tick, stopTick_);
   if (end <= startTick_ || rateMicros_ == 0) return 0;
   const __int128 active = end - startTick_;
-  return static_cast<std::uint64_t>(active * rateMicros_ / (static_cast<__int128>(stepRate_) * kMicros));
+  return static_cast<std::uint64_t>(active * rateMicros_ /
+                                    (static_cast<__int128>(stepRate_) * kMicros));
 }
 
 std::uint64_t Emitter::serialBefore(std::int64_t tick) const {
@@ -87,7 +90,8 @@ std::uint64_t Emitter::serialBefore(std::int64_t tick) const {
 std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick) const {
   const std::uint64_t first = serialBefore(tick);
   const std::uint64_t last = serialBefore(tick + 1);
-  for (std::uint64_t serial = first; serial < last; ++serial) pool.spawn(sample(seed, serial), tick);
+  for (std::uint64_t serial = first; serial < last; ++serial)
+    pool.spawn(sample(seed, serial), tick);
   return last - first;
 }
 
@@ -102,11 +106,13 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
     const double z = 1.0 - 2.0 * uniform(RandomPurpose::PositionU);
     const double rxy = std::sqrt(std::max(0.0, 1.0 - z * z));
     const double phi = kTwoPi * uniform(RandomPurpose::PositionV);
-    const double r = sphere->surface ? sphere->radius
-                                     : sphere->radius * det::cbrt(uniform(RandomPurpose::PositionW));
+    const double r = sphere->surface
+                         ? sphere->radius
+                         : sphere->radius * det::cbrt(uniform(RandomPurpose::PositionW));
     offset = r * Eigen::Vector3d(rxy * det::cos(phi), rxy * det::sin(phi), z);
   } else if (const auto* box = std::get_if<BoxShape>(&s_.shape)) {
-    offset = Eigen::Vector3d(uniform(RandomPurpose::PositionU) - 0.5, uniform(RandomPurpose::PositionV) - 0.5,
+    offset = Eigen::Vector3d(uniform(RandomPurpose::PositionU) - 0.5,
+                             uniform(RandomPurpose::PositionV) - 0.5,
                              uniform(RandomPurpose::PositionW) - 0.5)
                  .cwiseProduct(box->size);
   } else if (const auto* disc = std::get_if<DiscShape>(&s_.shape)) {
@@ -128,7 +134,8 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
     const double phi = kTwoPi * uniform(RandomPurpose::DirectionV);
     dir = (sinT * det::cos(phi)) * b1 + (sinT * det::sin(phi)) * b2 + cosT * s_.direction;
   }
-  const double speed = s_.speed * (1.0 + s_.speedJitter * (2.0 * uniform(RandomPurpose::Speed) - 1.0));
+  const double speed =
+      s_.speed * (1.0 + s_.speedJitter * (2.0 * uniform(RandomPurpose::Speed) - 1.0));
   const double life =
       s_.lifetime * (1.0 + s_.lifetimeJitter * (2.0 * uniform(RandomPurpose::Lifetime) - 1.0));
 

@@ -44,13 +44,13 @@ struct EmitterSettings {
   EmitterShape shape = PointShape{};
   /// Particles per second while active; resolved to 10⁻⁶ particle/s and counted exactly.
   double rate = 0.0;
-  double start = 0.0;                                   // seconds: rate emission begins
+  double start = 0.0;                                     // seconds: rate emission begins
   double stop = std::numeric_limits<double>::infinity();  // seconds: rate emission ends
   std::vector<Burst> bursts;
-  Eigen::Vector3d direction = Eigen::Vector3d::UnitY();  // initial direction (normalised)
-  double speed = 0.0;                                    // m/s
-  double speedJitter = 0.0;                              // fraction: speed · (1 ± jitter)
-  double spreadDegrees = 0.0;                            // half-angle of the cone, in [0, 180]
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitY();       // initial direction (normalised)
+  double speed = 0.0;                                         // m/s
+  double speedJitter = 0.0;                                   // fraction: speed · (1 ± jitter)
+  double spreadDegrees = 0.0;                                 // half-angle of the cone, in [0, 180]
   double lifetime = std::numeric_limits<double>::infinity();  // seconds
   double lifetimeJitter = 0.0;                                // fraction: lifetime · (1 ± jitter)
   double mass = 1.0;                                          // kilograms

@@ -18,7 +18,8 @@ AdvanceResult FixedStepDriver::advance(Flicks frame) {
   if (frame < 0) throw std::invalid_argument("frame duration must be >= 0");
   // One tick is exactly kFlicksPerSecond units of (flick · Hz); 128 bits keep a long frame at a
   // high step rate from overflowing before the division.
-  const __int128 total = static_cast<__int128>(remainder_) + static_cast<__int128>(frame) * stepRate_;
+  const __int128 total =
+      static_cast<__int128>(remainder_) + static_cast<__int128>(frame) * stepRate_;
   const __int128 whole = total / kFlicksPerSecond;
   AdvanceResult result;
   result.ticks = whole > maxTicks_ ? maxTicks_ : static_cast<std::int64_t>(whole);
@@ -29,7 +30,8 @@ AdvanceResult FixedStepDriver::advance(Flicks frame) {
     remainder_ = static_cast<std::int64_t>(total % kFlicksPerSecond);
   } else {
     result.ticksPending = static_cast<std::int64_t>(excess);
-    remainder_ = static_cast<std::int64_t>(total - static_cast<__int128>(result.ticks) * kFlicksPerSecond);
+    remainder_ =
+        static_cast<std::int64_t>(total - static_cast<__int128>(result.ticks) * kFlicksPerSecond);
   }
   ticksIssued_ += result.ticks;
   result.alpha = alpha();

@@ -1,8 +1,8 @@
 #include "particles/ParallelFor.h"
 
-#include <algorithm>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <algorithm>
 
 namespace tickfx {
 

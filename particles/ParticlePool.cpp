@@ -13,14 +13,16 @@ namespace {
 
 // Moves the kept rows of [first, size) down over the removed ones, in order.
 template <typename Column>
-void compact(Column& column, const std::vector<std::uint8_t>& dead, std::size_t first, std::size_t size) {
+void compact(Column& column, const std::vector<std::uint8_t>& dead, std::size_t first,
+             std::size_t size) {
   std::size_t w = first;
   for (std::size_t i = first; i < size; ++i) {
     if (dead[i] == 0) column[static_cast<Eigen::Index>(w++)] = column[static_cast<Eigen::Index>(i)];
   }
 }
 
-void compact(Vec3Column& column, const std::vector<std::uint8_t>& dead, std::size_t first, std::size_t size) {
+void compact(Vec3Column& column, const std::vector<std::uint8_t>& dead, std::size_t first,
+             std::size_t size) {
   compact(column.x, dead, first, size);
   compact(column.y, dead, first, size);
   compact(column.z, dead, first, size);
@@ -60,7 +62,8 @@ void ParticlePool::reserve(std::size_t rows) {
 
 void ParticlePool::grow(std::size_t rows) {
   const auto n = static_cast<Eigen::Index>(rows);
-  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_}) c->conservativeResize(n);
+  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_})
+    c->conservativeResize(n);
   for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_}) c->conservativeResize(n);
   id_.resize(rows);
   birthTick_.resize(rows);
@@ -114,29 +117,36 @@ void ParticlePool::updateAges(std::int64_t tick, std::int64_t stepRateHz) {
   parallelForRows(size_, [=](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const auto lived = static_cast<std::uint64_t>(tick - birth[i]);
-      age[i] = static_cast<float>((std::bit_cast<double>(lived | 0x4330000000000000ULL) - 0x1p52) * secondsPerTick);
+      age[i] = static_cast<float>((std::bit_cast<double>(lived | 0x4330000000000000ULL) - 0x1p52) *
+                                  secondsPerTick);
     }
     // Deaths are rare in any one block: a vectorised test first, the byte flags only if needed.
     int expired = 0;
     for (std::size_t i = b; i < e; ++i) expired |= static_cast<int>(age[i] >= life[i]);
     if (expired == 0) return;
-    for (std::size_t i = b; i < e; ++i) dead[i] = static_cast<std::uint8_t>(dead[i] | (age[i] >= life[i] ? 1 : 0));
+    for (std::size_t i = b; i < e; ++i)
+      dead[i] = static_cast<std::uint8_t>(dead[i] | (age[i] >= life[i] ? 1 : 0));
   });
 }
 
 std::size_t ParticlePool::removeDead() {
   // Most ticks nobody dies: find that out with one byte scan and touch nothing else.
-  const auto firstDead = std::find_if(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_),
-                                      [](std::uint8_t d) { return d != 0; });
+  const auto firstDead =
+      std::find_if(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_),
+                   [](std::uint8_t d) { return d != 0; });
   const auto first = static_cast<std::size_t>(firstDead - dead_.begin());
   if (first == size_) return 0;
-  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_}) compact(*c, dead_, first, size_);
-  for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_}) compact(*c, dead_, first, size_);
+  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_})
+    compact(*c, dead_, first, size_);
+  for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_})
+    compact(*c, dead_, first, size_);
   compact(id_, dead_, first, size_);
   compact(birthTick_, dead_, first, size_);
   for (NamedColumn& a : attributes_) compact(a.values, dead_, first, size_);
-  const std::size_t kept = first + static_cast<std::size_t>(std::count(dead_.begin() + static_cast<std::ptrdiff_t>(first),
-                                                                       dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0}));
+  const std::size_t kept =
+      first + static_cast<std::size_t>(
+                  std::count(dead_.begin() + static_cast<std::ptrdiff_t>(first),
+                             dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0}));
   std::fill(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(kept), std::uint8_t{0});
   const std::size_t removed = size_ - kept;
   size_ = kept;
@@ -147,7 +157,8 @@ std::size_t ParticlePool::removeDead() {
 std::size_t ParticlePool::addAttribute(const std::string& name, float initial) {
   const std::size_t existing = findAttribute(name);
   if (existing != npos) return existing;
-  NamedColumn column{name, initial, FloatColumn::Constant(static_cast<Eigen::Index>(storageRows_), initial)};
+  NamedColumn column{name, initial,
+                     FloatColumn::Constant(static_cast<Eigen::Index>(storageRows_), initial)};
   attributes_.push_back(std::move(column));
   return attributes_.size() - 1;
 }
@@ -162,8 +173,8 @@ std::size_t ParticlePool::findAttribute(const std::string& name) const {
 void ParticlePool::resizeForRestore(std::size_t size, std::uint64_t nextId,
                                     std::uint64_t droppedSpawns) {
   if (size > maxParticles_) {
-    throw std::invalid_argument("restored particle count " + std::to_string(size) + " exceeds max_particles " +
-                                std::to_string(maxParticles_));
+    throw std::invalid_argument("restored particle count " + std::to_string(size) +
+                                " exceeds max_particles " + std::to_string(maxParticles_));
   }
   reserve(size);
   size_ = size;

@@ -1,9 +1,9 @@
 #include "particles/ParticleSystem.h"
 
-#include <stdexcept>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
+#include <stdexcept>
 
 #include "particles/Clock.h"
 #include "particles/ParallelFor.h"
@@ -66,7 +66,8 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
     const Flicks at = flicksFromSeconds(structures[i].time);
     const auto tick = static_cast<std::int64_t>(
-        (static_cast<__int128>(at) * settings.stepRateHz + kFlicksPerSecond - 1) / kFlicksPerSecond);
+        (static_cast<__int128>(at) * settings.stepRateHz + kFlicksPerSecond - 1) /
+        kFlicksPerSecond);
     structures_.push_back(PendingStructure{structures[i], tick, static_cast<std::uint32_t>(i)});
   }
 }
@@ -131,7 +132,8 @@ void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
   parallelForRows(n, [&](std::size_t b, std::size_t e) {
     const auto i = static_cast<Eigen::Index>(b), m = static_cast<Eigen::Index>(e - b);
     for (int c = 0; c < 3; ++c) {
-      out[c].segment(i, m) = prev[c].segment(i, m) + (p[c].segment(i, m) - prev[c].segment(i, m)) * alpha;
+      out[c].segment(i, m) =
+          prev[c].segment(i, m) + (p[c].segment(i, m) - prev[c].segment(i, m)) * alpha;
     }
   });
 }

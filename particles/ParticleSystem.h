@@ -18,13 +18,13 @@ namespace tickfx {
 
 /// Settings of a whole simulation (the [simulation] table of an effect file).
 struct SystemSettings {
-  std::int64_t stepRateHz = 60;                          // ticks per second
-  std::string integrator = "semi_implicit_euler";        // see integratorNames()
-  std::uint64_t seed = 0;                                // the effect seed of every random number
-  std::size_t maxParticles = 1'000'000;                  // spawns past this are dropped, counted
-  std::int64_t maxTicksPerFrame = 16;                    // cap on ticks per advance()
+  std::int64_t stepRateHz = 60;                    // ticks per second
+  std::string integrator = "semi_implicit_euler";  // see integratorNames()
+  std::uint64_t seed = 0;                          // the effect seed of every random number
+  std::size_t maxParticles = 1'000'000;            // spawns past this are dropped, counted
+  std::int64_t maxTicksPerFrame = 16;              // cap on ticks per advance()
   OverrunPolicy overrunPolicy = OverrunPolicy::DropExcess;
-  int threads = 0;                                       // 0: all cores
+  int threads = 0;  // 0: all cores
 };
 
 /// The simulation. One tick does, in this order: emit the tick's particles, let the forces
@@ -56,7 +56,9 @@ class ParticleSystem {
   /// Ticks completed so far: the state is the state after tick tickCount() − 1 (or the initial
   /// state for 0), at time tickCount() / stepRate seconds.
   std::int64_t tickCount() const { return tick_; }
-  double timeSeconds() const { return static_cast<double>(tick_) / static_cast<double>(settings_.stepRateHz); }
+  double timeSeconds() const {
+    return static_cast<double>(tick_) / static_cast<double>(settings_.stepRateHz);
+  }
   /// α of the last advance(): where the last frame lies between the previous and current tick.
   float alpha() const { return alpha_; }
 
@@ -76,7 +78,9 @@ class ParticleSystem {
   SpringNetwork* springs() { return springs_; }
   /// Calls `observer` after every tick, with the state after that tick (a trace of per-tick
   /// hashes, a debugger's breakpoint). An empty function removes it. It runs on the driving thread.
-  void setTickObserver(std::function<void(const ParticleSystem&)> observer) { tickObserver_ = std::move(observer); }
+  void setTickObserver(std::function<void(const ParticleSystem&)> observer) {
+    tickObserver_ = std::move(observer);
+  }
   /// Restores the tick counter (with the pool and the driver, a saved state is complete).
   void restoreTickCount(std::int64_t tick) { tick_ = tick; }
 

@@ -39,8 +39,8 @@ std::uint64_t stateHash(const ParticlePool& pool) {
   h.add(pool.droppedSpawns());
   for (std::size_t i = 0; i < n; ++i) h.add(pool.id()[i]);
   for (std::size_t i = 0; i < n; ++i) h.add(static_cast<std::uint64_t>(pool.birthTick()[i]));
-  for (const Vec3Column* c : {&pool.position(), &pool.velocity(), &pool.previousPosition(),
-                              &pool.acceleration()}) {
+  for (const Vec3Column* c :
+       {&pool.position(), &pool.velocity(), &pool.previousPosition(), &pool.acceleration()}) {
     for (int k = 0; k < 3; ++k) h.addFloats((*c)[k], n);
   }
   for (const FloatColumn* c : {&pool.age(), &pool.lifetime(), &pool.mass(), &pool.inverseMass()}) {

@@ -32,9 +32,11 @@ struct Builder {
     out.particles.push_back(init);
   }
   // Rest length from the positions as built (in double), so a structure starts unstressed.
-  void spring(std::size_t a, std::size_t b, double stiffness, const Eigen::Vector3d& pa, const Eigen::Vector3d& pb) {
-    out.springs.push_back(Spring{a, b, static_cast<float>((pb - pa).norm()), static_cast<float>(stiffness),
-                                 static_cast<float>(s.damping), static_cast<float>(s.breakRatio)});
+  void spring(std::size_t a, std::size_t b, double stiffness, const Eigen::Vector3d& pa,
+              const Eigen::Vector3d& pb) {
+    out.springs.push_back(Spring{a, b, static_cast<float>((pb - pa).norm()),
+                                 static_cast<float>(stiffness), static_cast<float>(s.damping),
+                                 static_cast<float>(s.breakRatio)});
   }
 };
 
@@ -44,7 +46,8 @@ void buildRope(Builder& b, const RopeShape& rope) {
           "rope start and end must be distinct finite points");
   std::vector<Eigen::Vector3d> at;
   for (int i = 0; i < rope.count; ++i) {
-    at.push_back(rope.start + (rope.end - rope.start) * (static_cast<double>(i) / (rope.count - 1)));
+    at.push_back(rope.start +
+                 (rope.end - rope.start) * (static_cast<double>(i) / (rope.count - 1)));
     b.particle(at.back(), (i == 0 && rope.pinStart) || (i == rope.count - 1 && rope.pinEnd));
   }
   for (int i = 0; i + 1 < rope.count; ++i) b.spring(i, i + 1, b.s.stiffness, at[i], at[i + 1]);
@@ -54,8 +57,9 @@ void buildCloth(Builder& b, const ClothShape& c) {
   require(c.width >= 2 && c.height >= 2 && static_cast<long long>(c.width) * c.height <= 1'000'000,
           "cloth width and height must be >= 2 with at most 1000000 particles");
   require(c.spacing > 0.0 && std::isfinite(c.spacing), "cloth spacing must be > 0");
-  require(c.axisU.allFinite() && c.axisV.allFinite() && c.axisU.norm() > 0.0 && c.axisV.norm() > 0.0,
-          "cloth axes must not be zero");
+  require(
+      c.axisU.allFinite() && c.axisV.allFinite() && c.axisU.norm() > 0.0 && c.axisV.norm() > 0.0,
+      "cloth axes must not be zero");
   const Eigen::Vector3d u = c.axisU.normalized(), v = c.axisV.normalized();
   require(u.cross(v).norm() > 1e-6, "cloth axes must not be parallel");
   const int w = c.width, h = c.height;
@@ -65,17 +69,20 @@ void buildCloth(Builder& b, const ClothShape& c) {
     for (int col = 0; col < w; ++col) {
       at.push_back(c.origin + u * (col * c.spacing) + v * (row * c.spacing));
       const bool corner = (col == 0 || col == w - 1) && (row == 0 || row == h - 1);
-      const bool pinned = (c.pins == ClothPins::TopEdge && row == 0) ||
-                          (c.pins == ClothPins::TopCorners && row == 0 && (col == 0 || col == w - 1)) ||
-                          (c.pins == ClothPins::AllCorners && corner);
+      const bool pinned =
+          (c.pins == ClothPins::TopEdge && row == 0) ||
+          (c.pins == ClothPins::TopCorners && row == 0 && (col == 0 || col == w - 1)) ||
+          (c.pins == ClothPins::AllCorners && corner);
       b.particle(at.back(), pinned);
     }
   }
-  const double k = b.s.stiffness, shear = k * c.shearStiffnessScale, bend = k * c.bendStiffnessScale;
+  const double k = b.s.stiffness, shear = k * c.shearStiffnessScale,
+               bend = k * c.bendStiffnessScale;
   auto join = [&](int c0, int r0, int c1, int r1, double stiffness) {
     // Both ends: index(w, row) is a valid index (the next row's first particle), so a spring
     // off the grid's edge would silently wrap instead of failing.
-    const bool inside = c0 >= 0 && c0 < w && r0 >= 0 && r0 < h && c1 >= 0 && c1 < w && r1 >= 0 && r1 < h;
+    const bool inside =
+        c0 >= 0 && c0 < w && r0 >= 0 && r0 < h && c1 >= 0 && c1 < w && r1 >= 0 && r1 < h;
     if (!inside || stiffness <= 0.0) return;
     b.spring(index(c0, r0), index(c1, r1), stiffness, at[index(c0, r0)], at[index(c1, r1)]);
   };
@@ -109,7 +116,8 @@ void buildCluster(Builder& b, const ClusterShape& c, std::uint64_t seed, std::ui
   std::vector<Eigen::Vector3d> at;
   for (int i = 0; i < c.count; ++i) {
     auto uniform = [&](RandomPurpose purpose) {
-      return randomUniform(RandomKey{seed, kStructureKeySpace | index, static_cast<std::uint64_t>(i),
+      return randomUniform(RandomKey{seed, kStructureKeySpace | index,
+                                     static_cast<std::uint64_t>(i),
                                      static_cast<std::uint32_t>(purpose)});
     };
     const double z = 1.0 - 2.0 * uniform(RandomPurpose::PositionU);
@@ -125,7 +133,8 @@ void buildCluster(Builder& b, const ClusterShape& c, std::uint64_t seed, std::ui
   std::map<Cell, std::vector<int>> cells;
   auto cellOf = [&](const Eigen::Vector3d& q) {
     const Eigen::Vector3d t = (q - c.center) / c.linkRadius;
-    return Cell{static_cast<long long>(std::floor(t.x())), static_cast<long long>(std::floor(t.y())),
+    return Cell{static_cast<long long>(std::floor(t.x())),
+                static_cast<long long>(std::floor(t.y())),
                 static_cast<long long>(std::floor(t.z()))};
   };
   for (int i = 0; i < c.count; ++i) cells[cellOf(at[i])].push_back(i);
@@ -150,17 +159,22 @@ void buildCluster(Builder& b, const ClusterShape& c, std::uint64_t seed, std::ui
 
 }  // namespace
 
-StructureBuild buildStructure(const StructureSettings& settings, std::uint64_t seed, std::uint32_t index) {
+StructureBuild buildStructure(const StructureSettings& settings, std::uint64_t seed,
+                              std::uint32_t index) {
   require(settings.mass > 0.0 && std::isfinite(settings.mass), "structure mass must be > 0");
-  require(settings.stiffness >= 0.0 && std::isfinite(settings.stiffness), "structure stiffness must be >= 0");
-  require(settings.damping >= 0.0 && std::isfinite(settings.damping), "structure damping must be >= 0");
-  require(settings.breakRatio == 0.0 || settings.breakRatio > 1.0, "break ratio must be 0 (never) or > 1");
+  require(settings.stiffness >= 0.0 && std::isfinite(settings.stiffness),
+          "structure stiffness must be >= 0");
+  require(settings.damping >= 0.0 && std::isfinite(settings.damping),
+          "structure damping must be >= 0");
+  require(settings.breakRatio == 0.0 || settings.breakRatio > 1.0,
+          "break ratio must be 0 (never) or > 1");
   require(settings.lifetime > 0.0, "structure lifetime must be > 0");
   require(settings.velocity.allFinite(), "structure velocity must be finite");
   Builder b{settings, {}};
   if (const auto* rope = std::get_if<RopeShape>(&settings.shape)) buildRope(b, *rope);
   if (const auto* cloth = std::get_if<ClothShape>(&settings.shape)) buildCloth(b, *cloth);
-  if (const auto* cluster = std::get_if<ClusterShape>(&settings.shape)) buildCluster(b, *cluster, seed, index);
+  if (const auto* cluster = std::get_if<ClusterShape>(&settings.shape))
+    buildCluster(b, *cluster, seed, index);
   return std::move(b.out);
 }
 

@@ -61,7 +61,7 @@ struct StructureSettings {
   double stiffness = 100.0;  // k of its springs
   double damping = 0.0;      // c of its springs
   double breakRatio = 0.0;   // springs break past breakRatio · rest length; 0: never
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          // initial, of every free particle
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();         // initial, of every free particle
   double lifetime = std::numeric_limits<double>::infinity();  // seconds
 };
 
@@ -73,6 +73,7 @@ struct StructureBuild {
 
 /// Builds `settings` (a pure function of the settings, the effect seed and the structure's index,
 /// which keys its random numbers). Throws std::invalid_argument for settings out of range.
-StructureBuild buildStructure(const StructureSettings& settings, std::uint64_t seed, std::uint32_t index);
+StructureBuild buildStructure(const StructureSettings& settings, std::uint64_t seed,
+                              std::uint32_t index);
 
 }  // namespace tickfx

@@ -42,8 +42,10 @@ int main() {
     const ParticlePool& pool = system.pool();
     const auto n = static_cast<Eigen::Index>(pool.size());
     const float maxY = n > 0 ? pool.position().y.head(n).maxCoeff() : 0.0f;
-    const Eigen::ArrayXf speed = (pool.velocity().x.head(n).square() + pool.velocity().y.head(n).square() +
-                                  pool.velocity().z.head(n).square()).sqrt();
+    const Eigen::ArrayXf speed =
+        (pool.velocity().x.head(n).square() + pool.velocity().y.head(n).square() +
+         pool.velocity().z.head(n).square())
+            .sqrt();
     std::printf("%6d %8lld %10zu %10.3f %12.3f\n", f, static_cast<long long>(system.tickCount()),
                 pool.size(), maxY, n > 0 ? speed.mean() : 0.0f);
   }

@@ -33,8 +33,9 @@ class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("tickfx_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-            "_" + std::to_string(::getpid()));
+           ("tickfx_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -43,8 +44,8 @@ class Cli : public ::testing::Test {
   // Runs `tickfx ARGS` from the source tree (so samples/... resolve), stdin closed.
   Result run(const std::string& args) const {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = "cd '" TICKFX_SOURCE_DIR "' && '" TICKFX_CLI "' " + args + " </dev/null >'" +
-                                out.string() + "' 2>'" + err.string() + "'";
+    const std::string command = "cd '" TICKFX_SOURCE_DIR "' && '" TICKFX_CLI "' " + args +
+                                " </dev/null >'" + out.string() + "' 2>'" + err.string() + "'";
     const int status = std::system(command.c_str());
     Result r;
     r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -81,20 +82,26 @@ TEST_F(Cli, HelpOnEveryCommandExitsZero) {
 }
 
 TEST_F(Cli, RunWritesOneCachePerFrameAndReportsTheHash) {
-  const Result r = run("run samples/fountain.toml --seconds 1 --fps 24 --format csv,ply --out " + path("c") + " --hash");
+  const Result r = run("run samples/fountain.toml --seconds 1 --fps 24 --format csv,ply --out " +
+                       path("c") + " --hash");
   ASSERT_EQ(r.exit, 0) << r.err;
   EXPECT_TRUE(fs::exists(path("c/frame_0024.csv")));
   EXPECT_TRUE(fs::exists(path("c/frame_0024.ply")));
   EXPECT_FALSE(fs::exists(path("c/frame_0025.csv")));
-  EXPECT_NE(r.out.find("ticks dropped by the cap (max_ticks_per_frame = 16): 0"), std::string::npos) << r.out;
-  EXPECT_EQ(r.err.find('\r'), std::string::npos) << "no progress line when stderr is not a terminal";
+  EXPECT_NE(r.out.find("ticks dropped by the cap (max_ticks_per_frame = 16): 0"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos)
+      << "no progress line when stderr is not a terminal";
   // 1 s at 120 Hz is 120 ticks, and a second run gives the same bits.
   EXPECT_EQ(hashOf(r).substr(17), "120");
-  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 1 --fps 24 --format none --hash")), hashOf(r));
+  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 1 --fps 24 --format none --hash")),
+            hashOf(r));
 }
 
 TEST_F(Cli, CsvAndPlyCachesHoldTheSameBits) {
-  ASSERT_EQ(run("run samples/burst.toml --frames 12 --fps 24 --format csv,ply --out " + path("c")).exit, 0);
+  ASSERT_EQ(
+      run("run samples/burst.toml --frames 12 --fps 24 --format csv,ply --out " + path("c")).exit,
+      0);
   const tickfx::io::FrameData csv = tickfx::io::readCsvCache(path("c/frame_0012.csv"));
   const tickfx::io::FrameData ply = tickfx::io::readPlyCache(path("c/frame_0012.ply"));
   ASSERT_GT(csv.size(), 0u);
@@ -107,7 +114,8 @@ TEST_F(Cli, CsvAndPlyCachesHoldTheSameBits) {
   }
   EXPECT_TRUE((csv.age == ply.age).all());
   EXPECT_TRUE((csv.life == ply.life).all());
-  EXPECT_EQ(readAll(path("c/frame_0012.ply")).rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+  EXPECT_EQ(readAll(path("c/frame_0012.ply")).rfind("ply\nformat binary_little_endian 1.0\n", 0),
+            0u);
 }
 
 TEST_F(Cli, OscillatorDumpAgreesWithMinusCosT) {
@@ -115,8 +123,9 @@ TEST_F(Cli, OscillatorDumpAgreesWithMinusCosT) {
   for (const auto& [integrator, tolerance] :
        std::vector<std::pair<std::string, double>>{{"velocity_verlet", 3e-4}, {"rk4", 2e-5}}) {
     const std::string dump = path("dump_" + integrator + ".csv");
-    const Result r = run("run samples/oscillator.toml --seconds 20 --format none --set simulation.integrator=" +
-                         integrator + " --dump " + dump);
+    const Result r =
+        run("run samples/oscillator.toml --seconds 20 --format none --set simulation.integrator=" +
+            integrator + " --dump " + dump);
     ASSERT_EQ(r.exit, 0) << r.err;
     std::istringstream rows(readAll(dump));
     std::string header, row;
@@ -124,7 +133,9 @@ TEST_F(Cli, OscillatorDumpAgreesWithMinusCosT) {
     std::getline(rows, row);
     EXPECT_EQ(header, "id,px,py,pz,vx,vy,vz,age");
     double id, px, py, pz, vx, vy, vz, age;
-    ASSERT_EQ(std::sscanf(row.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &id, &px, &py, &pz, &vx, &vy, &vz, &age), 8);
+    ASSERT_EQ(std::sscanf(row.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &id, &px, &py, &pz, &vx,
+                          &vy, &vz, &age),
+              8);
     EXPECT_NEAR(px, -std::cos(20.0), tolerance) << integrator;
     EXPECT_NEAR(vx, std::sin(20.0), tolerance) << integrator;
     EXPECT_EQ(age, 20.0);
@@ -132,13 +143,19 @@ TEST_F(Cli, OscillatorDumpAgreesWithMinusCosT) {
 }
 
 TEST_F(Cli, JitteredAndRecordedFrameTimesReachTheSameTickState) {
-  const std::string reference = hashOf(run("run samples/fountain.toml --seconds 2 --fps 60 --format none --hash"));
-  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 2 --jitter 7 --format none --hash")), reference);
-  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 2 --fps 30000/1001 --format none --hash")), reference);
+  const std::string reference =
+      hashOf(run("run samples/fountain.toml --seconds 2 --fps 60 --format none --hash"));
+  EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 2 --jitter 7 --format none --hash")),
+            reference);
+  EXPECT_EQ(
+      hashOf(run("run samples/fountain.toml --seconds 2 --fps 30000/1001 --format none --hash")),
+      reference);
   std::string times;
   for (int i = 0; i < 40; ++i) times += (i % 2 == 0 ? "0.03\n" : "0.07\n");  // 40 frames, 2 s
   const std::string file = writeFile("times.txt", "# alternating frames\n" + times);
-  EXPECT_EQ(hashOf(run("run samples/fountain.toml --frame-times " + file + " --format none --hash")), reference);
+  EXPECT_EQ(
+      hashOf(run("run samples/fountain.toml --frame-times " + file + " --format none --hash")),
+      reference);
 }
 
 TEST_F(Cli, CheckWarnsAboutTheAliasedWindWithTheStepRateNeeded) {
@@ -162,13 +179,17 @@ TEST_F(Cli, EffectErrorsExitTwoAndWriteNothing) {
                                        "[[emitters]]\n"
                                        "rate = 10.0\n");
   for (const std::string command : {"run", "check"}) {
-    const Result r = run(command + " " + effect + (command == "run" ? " --out " + path("never") : ""));
+    const Result r =
+        run(command + " " + effect + (command == "run" ? " --out " + path("never") : ""));
     EXPECT_EQ(r.exit, 2) << command;
-    EXPECT_NE(r.err.find(effect + ":3:13: error: simulation.step_rate:"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(effect + ":4:14: error: simulation.integrator:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(effect + ":3:13: error: simulation.step_rate:"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find(effect + ":4:14: error: simulation.integrator:"), std::string::npos)
+        << r.err;
     EXPECT_FALSE(fs::exists(path("never")));
   }
-  const Result set = run("run samples/fountain.toml --set simulation.step_rate=-5 --out " + path("never"));
+  const Result set =
+      run("run samples/fountain.toml --set simulation.step_rate=-5 --out " + path("never"));
   EXPECT_EQ(set.exit, 2);
   EXPECT_NE(set.err.find("--set simulation.step_rate"), std::string::npos) << set.err;
   EXPECT_FALSE(fs::exists(path("never")));
@@ -189,9 +210,11 @@ TEST_F(Cli, UsageErrorsExitTwoAndWriteNothing) {
   const Result missing = run("run samples/no_such_effect.toml" + out);
   EXPECT_EQ(missing.exit, 2);
   EXPECT_NE(missing.err.find("samples/no_such_effect.toml"), std::string::npos);
-  const Result badTimes = run("run samples/fountain.toml --frame-times " + writeFile("t.txt", "0.1\nsoon\n") + out);
+  const Result badTimes =
+      run("run samples/fountain.toml --frame-times " + writeFile("t.txt", "0.1\nsoon\n") + out);
   EXPECT_EQ(badTimes.exit, 2);
-  EXPECT_NE(badTimes.err.find("t.txt:2: error: 'soon' is not a frame duration"), std::string::npos) << badTimes.err;
+  EXPECT_NE(badTimes.err.find("t.txt:2: error: 'soon' is not a frame duration"), std::string::npos)
+      << badTimes.err;
 }
 
 TEST_F(Cli, FailureAtRunTimeExitsOne) {
@@ -206,16 +229,25 @@ TEST_F(Cli, DeterminismPrintsTheTableAndAVerdict) {
   EXPECT_EQ(r.exit, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("30000/1001 fps"), std::string::npos);
   EXPECT_NE(r.out.find("jitter 3"), std::string::npos);
-  EXPECT_NE(r.out.find("verdict: all 12 runs agree bit for bit after every one of 120 ticks"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("verdict: all 12 runs agree bit for bit after every one of 120 ticks"),
+            std::string::npos)
+      << r.out;
   // The same hash as a plain run of the same length.
-  const std::string plain = hashOf(run("run samples/fountain.toml --seconds 1 --format none --hash"));
+  const std::string plain =
+      hashOf(run("run samples/fountain.toml --seconds 1 --format none --hash"));
   EXPECT_NE(r.out.find("(state-hash " + plain.substr(0, 16) + ")"), std::string::npos) << r.out;
   EXPECT_EQ(run("determinism samples/fountain.toml --threads 0").exit, 2);
 }
 
 TEST_F(Cli, TracesOfTwoFrameRatesAreIdenticalTickForTick) {
-  ASSERT_EQ(run("run samples/burst.toml --seconds 2 --fps 24 --format none --trace " + path("a.csv")).exit, 0);
-  ASSERT_EQ(run("run samples/burst.toml --seconds 2 --jitter 5 --format none --trace " + path("b.csv")).exit, 0);
+  ASSERT_EQ(
+      run("run samples/burst.toml --seconds 2 --fps 24 --format none --trace " + path("a.csv"))
+          .exit,
+      0);
+  ASSERT_EQ(
+      run("run samples/burst.toml --seconds 2 --jitter 5 --format none --trace " + path("b.csv"))
+          .exit,
+      0);
   const std::string a = readAll(path("a.csv"));
   EXPECT_EQ(a.rfind("tick,state_hash\n1,", 0), 0u) << a.substr(0, 40);
   EXPECT_NE(a.find("\n240,"), std::string::npos) << "2 s at 120 Hz";
@@ -226,7 +258,8 @@ TEST_F(Cli, AResumedRunReachesTheUninterruptedHash) {
   const std::string args = "run samples/smoke_drift.toml --seconds 3 --fps 24 --format none --hash";
   const Result whole = run(args + " --checkpoint-every 20 --checkpoint-dir " + path("ck"));
   ASSERT_EQ(whole.exit, 0) << whole.err;
-  for (const char* f : {"checkpoint_000020.tfxc", "checkpoint_000040.tfxc", "checkpoint_000060.tfxc"}) {
+  for (const char* f :
+       {"checkpoint_000020.tfxc", "checkpoint_000040.tfxc", "checkpoint_000060.tfxc"}) {
     EXPECT_TRUE(fs::exists(path(std::string("ck/") + f))) << f;
   }
   EXPECT_FALSE(fs::exists(path("ck/checkpoint_000080.tfxc")));
@@ -236,16 +269,21 @@ TEST_F(Cli, AResumedRunReachesTheUninterruptedHash) {
     EXPECT_EQ(hashOf(resumed), hashOf(whole)) << from;
   }
   // The caches of a resumed run carry on with the frame numbers of the uninterrupted one.
-  ASSERT_EQ(run("run samples/smoke_drift.toml --seconds 3 --fps 24 --format csv --out " + path("c") +
-                " --resume " + path("ck/checkpoint_000060.tfxc")).exit, 0);
+  ASSERT_EQ(run("run samples/smoke_drift.toml --seconds 3 --fps 24 --format csv --out " +
+                path("c") + " --resume " + path("ck/checkpoint_000060.tfxc"))
+                .exit,
+            0);
   EXPECT_FALSE(fs::exists(path("c/frame_0060.csv")));
   EXPECT_TRUE(fs::exists(path("c/frame_0061.csv")));
   EXPECT_TRUE(fs::exists(path("c/frame_0072.csv")));
 }
 
 TEST_F(Cli, BadCheckpointsAreRefusedAndNothingIsWritten) {
-  ASSERT_EQ(run("run samples/burst.toml --seconds 1 --fps 24 --format none --checkpoint-every 12 --checkpoint-dir " +
-                path("ck")).exit, 0);
+  ASSERT_EQ(run("run samples/burst.toml --seconds 1 --fps 24 --format none --checkpoint-every 12 "
+                "--checkpoint-dir " +
+                path("ck"))
+                .exit,
+            0);
   const std::string good = path("ck/checkpoint_000012.tfxc");
   const std::string bytes = readAll(good);
   std::string flipped = bytes;
@@ -260,15 +298,18 @@ TEST_F(Cli, BadCheckpointsAreRefusedAndNothingIsWritten) {
            {"run samples/burst.toml --seconds 1 --fps 24 --resume " + corrupted,
             corrupted + ": error: checksum mismatch"},
            {"run samples/burst.toml --seconds 1 --fps 24 --resume " + truncated,
-            truncated + ": error: checkpoint is truncated (expected " + std::to_string(bytes.size()) + " bytes, found " +
-                std::to_string(bytes.size() - 1) + ")"},
+            truncated + ": error: checkpoint is truncated (expected " +
+                std::to_string(bytes.size()) + " bytes, found " + std::to_string(bytes.size() - 1) +
+                ")"},
            {"run samples/fountain.toml --seconds 1 --fps 24 --resume " + good,
             good + ": error: checkpoint was written for another effect"},
            {"run samples/burst.toml --seconds 1 --fps 24 --set simulation.seed=8 --resume " + good,
             good + ": error: checkpoint was written for another effect"},
            {"run samples/burst.toml --seconds 1 --fps 30 --resume " + good,
-            good + ": error: the checkpoint is at frame 12 (0.5 s) but this run's frame 12 ends at 0.4 s"},
-           {"run samples/burst.toml --seconds 1 --fps 24 --resume " + path("missing.tfxc"), path("missing.tfxc")}}) {
+            good + ": error: the checkpoint is at frame 12 (0.5 s) but this run's frame 12 ends at "
+                   "0.4 s"},
+           {"run samples/burst.toml --seconds 1 --fps 24 --resume " + path("missing.tfxc"),
+            path("missing.tfxc")}}) {
     const Result r = run(c.args + out);
     EXPECT_EQ(r.exit, 2) << c.args << "\n" << r.err;
     EXPECT_EQ(r.err.rfind(c.message, 0), 0u) << r.err;
@@ -301,56 +342,70 @@ struct BadEffect {
 };
 
 const BadEffect kBadEffects[] = {
-    {"empty",
-     "",
-     ":1:1: error: format_version: missing (expected format_version = 1)"},
+    {"empty", "", ":1:1: error: format_version: missing (expected format_version = 1)"},
     {"wrong_type",
-     "format_version = 1\n[simulation]\nstep_rate = 60\nintegrator = 42\n[[emitters]]\nrate = 10.0\n",
-     ":4:14: error: simulation.integrator: got the integer 42 (expected integrator, one of: explicit_euler, semi_implicit_euler, midpoint, position_verlet, velocity_verlet, rk4)"},
+     "format_version = 1\n[simulation]\nstep_rate = 60\nintegrator = 42\n[[emitters]]\nrate = "
+     "10.0\n",
+     ":4:14: error: simulation.integrator: got the integer 42 (expected integrator, one of: "
+     "explicit_euler, semi_implicit_euler, midpoint, position_verlet, velocity_verlet, rk4)"},
     {"missing_step_rate",
      "format_version = 1\n[simulation]\nintegrator = \"rk4\"\n[[emitters]]\nrate = 1.0\n",
-     ":2:1: error: simulation.step_rate: missing (expected ticks per second (Hz), an integer from 1 to 1000000)"},
+     ":2:1: error: simulation.step_rate: missing (expected ticks per second (Hz), an integer from "
+     "1 to 1000000)"},
     {"unknown_key",
      "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\nsped = 3.0\n",
      ":6:1: error: emitters.0.sped: unknown key \"sped\" (did you mean \"speed\"?)"},
     {"negative_rate",
      "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = -5.0\n",
-     ":5:8: error: emitters.0.rate: -5 is out of range (expected particles per second, a number from 0 to 1e9)"},
+     ":5:8: error: emitters.0.rate: -5 is out of range (expected particles per second, a number "
+     "from 0 to 1e9)"},
     {"zero_step_rate",
      "format_version = 1\n[simulation]\nstep_rate = 0\n[[emitters]]\nrate = 1.0\n",
-     ":3:13: error: simulation.step_rate: 0 is out of range (expected ticks per second (Hz), an integer from 1 to 1000000)"},
-    {"nan",
-     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = nan\n",
-     ":5:8: error: emitters.0.rate: nan is not a finite number (expected particles per second, a number from 0 to 1e9)"},
-    {"inf",
-     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nspeed = inf\n",
-     ":5:9: error: emitters.0.speed: inf is not a finite number (expected metres per second, a number from 0 to 1e9)"},
+     ":3:13: error: simulation.step_rate: 0 is out of range (expected ticks per second (Hz), an "
+     "integer from 1 to 1000000)"},
+    {"nan", "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = nan\n",
+     ":5:8: error: emitters.0.rate: nan is not a finite number (expected particles per second, a "
+     "number from 0 to 1e9)"},
+    {"inf", "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nspeed = inf\n",
+     ":5:9: error: emitters.0.speed: inf is not a finite number (expected metres per second, a "
+     "number from 0 to 1e9)"},
     {"absurd_count",
-     "format_version = 1\n[simulation]\nstep_rate = 60\nmax_particles = 100000000000\n[[emitters]]\nrate = 10.0\n",
-     ":4:17: error: simulation.max_particles: 100000000000 is out of range (expected an integer from 1 to 1000000000)"},
-    {"malformed",
-     "format_version = 1\n[simulation\nstep_rate = 60\n",
+     "format_version = 1\n[simulation]\nstep_rate = 60\nmax_particles = "
+     "100000000000\n[[emitters]]\nrate = 10.0\n",
+     ":4:17: error: simulation.max_particles: 100000000000 is out of range (expected an integer "
+     "from 1 to 1000000000)"},
+    {"malformed", "format_version = 1\n[simulation\nstep_rate = 60\n",
      ":2:12: error: Error while parsing table header: expected ']', saw '\\n'"},
     {"misspelt_integrator",
-     "format_version = 1\n[simulation]\nstep_rate = 60\nintegrator = \"semi_implict_euler\"\n[[emitters]]\nrate = 10.0\n",
-     ":4:14: error: simulation.integrator: unknown integrator \"semi_implict_euler\" (did you mean \"semi_implicit_euler\"?)"},
+     "format_version = 1\n[simulation]\nstep_rate = 60\nintegrator = "
+     "\"semi_implict_euler\"\n[[emitters]]\nrate = 10.0\n",
+     ":4:14: error: simulation.integrator: unknown integrator \"semi_implict_euler\" (did you mean "
+     "\"semi_implicit_euler\"?)"},
     {"unknown_force",
-     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\n[[forces]]\ntype = \"gravty\"\n",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = "
+     "10.0\n[[forces]]\ntype = \"gravty\"\n",
      ":7:8: error: forces.0.type: unknown force type \"gravty\" (did you mean \"gravity\"?)"},
     {"unknown_shape",
-     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\nshape = \"cube\"\n",
-     ":6:9: error: emitters.0.shape: unknown shape \"cube\" (expected one of: point, sphere, box, disc)"},
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\nshape = "
+     "\"cube\"\n",
+     ":6:9: error: emitters.0.shape: unknown shape \"cube\" (expected one of: point, sphere, box, "
+     "disc)"},
     {"absurd_burst",
-     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nbursts = [{ time = 0.0, count = 20000000000 }]\n",
-     ":5:33: error: emitters.0.bursts.0.count: 20000000000 is out of range (expected particles, an integer from 1 to simulation.max_particles = 1000000)"},
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nbursts = [{ time = 0.0, "
+     "count = 20000000000 }]\n",
+     ":5:33: error: emitters.0.bursts.0.count: 20000000000 is out of range (expected particles, an "
+     "integer from 1 to simulation.max_particles = 1000000)"},
     {"bad_fps",
-     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\n[output]\nfps = \"30000/0\"\n",
-     ":7:7: error: output.fps: \"30000/0\" is out of range (expected frames per second, an integer from 1 to 1000000 or a ratio string like \"30000/1001\")"},
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\n[output]\nfps = "
+     "\"30000/0\"\n",
+     ":7:7: error: output.fps: \"30000/0\" is out of range (expected frames per second, an integer "
+     "from 1 to 1000000 or a ratio string like \"30000/1001\")"},
     {"future_version",
      "format_version = 7\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 1.0\n",
      ":1:18: error: format_version: version 7 is not one this build reads (expected 1)"},
     {"wind_without_frequency",
-     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = 10.0\n[[forces]]\ntype = \"wind\"\namplitude = 1.0\n",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = "
+     "10.0\n[[forces]]\ntype = \"wind\"\namplitude = 1.0\n",
      ":6:1: error: forces.0.frequency: missing (expected hertz, a number from 0 to 1000000)"},
 };
 
@@ -360,7 +415,8 @@ TEST_P(CliBadEffect, ExitsTwoWithTheMessageAndWritesNothing) {
   const BadEffect& bad = GetParam();
   const std::string file = writeFile(std::string(bad.name) + ".toml", bad.text);
   for (const std::string command : {"run", "check"}) {
-    const Result r = run(command + " " + file + (command == "run" ? " --out " + path("never") : ""));
+    const Result r =
+        run(command + " " + file + (command == "run" ? " --out " + path("never") : ""));
     EXPECT_EQ(r.exit, 2) << command;
     EXPECT_EQ(r.err.substr(0, r.err.find('\n')), file + bad.firstMessage) << command;
     EXPECT_EQ(r.out, "") << command;
@@ -369,6 +425,8 @@ TEST_P(CliBadEffect, ExitsTwoWithTheMessageAndWritesNothing) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, CliBadEffect, ::testing::ValuesIn(kBadEffects),
-                         [](const ::testing::TestParamInfo<BadEffect>& p) { return std::string(p.param.name); });
+                         [](const ::testing::TestParamInfo<BadEffect>& p) {
+                           return std::string(p.param.name);
+                         });
 
 }  // namespace

@@ -54,11 +54,14 @@ TEST_P(EverySample, HashesAt1s2s5sAgreeUnderEveryFrameSchedule) {
   }
   ASSERT_EQ(traces.size(), 10u);
   const Divergence d = firstDivergence(traces);
-  EXPECT_EQ(d.tick, -1) << "runs part at tick " << d.tick << ", first: " << traces[d.runs.empty() ? 0 : d.runs[0]].label;
+  EXPECT_EQ(d.tick, -1) << "runs part at tick " << d.tick
+                        << ", first: " << traces[d.runs.empty() ? 0 : d.runs[0]].label;
 }
 
 INSTANTIATE_TEST_SUITE_P(Samples, EverySample, ::testing::ValuesIn(sampleEffects()),
-                         [](const ::testing::TestParamInfo<fs::path>& p) { return p.param.stem().string(); });
+                         [](const ::testing::TestParamInfo<fs::path>& p) {
+                           return p.param.stem().string();
+                         });
 
 // Adds nothing; remembers which threads evaluated forces, to prove the thread count was real.
 class ThreadRecorder final : public ForceModule {
@@ -111,7 +114,8 @@ TEST(Threads, OneTwoThreeAndEightThreadsGiveTheSameBitsAfterEveryTick) {
       EXPECT_EQ(recorder->distinctThreads(), 1u);
     }
   }
-  for (std::size_t i = 1; i < traces.size(); ++i) EXPECT_EQ(traces[i], traces[0]) << "thread set " << i;
+  for (std::size_t i = 1; i < traces.size(); ++i)
+    EXPECT_EQ(traces[i], traces[0]) << "thread set " << i;
 }
 
 // A frame that two schedules both render shows the same bits: t = 1 s and 2 s at 24, 60 and
@@ -128,8 +132,12 @@ TEST(InterpolatedCaches, AFrameTwoSchedulesShareIsBitwiseIdentical) {
     ASSERT_GT(a.size(), 0u) << what;
     ASSERT_EQ(a.id, b.id) << what;
     for (int c = 0; c < 3; ++c) {
-      EXPECT_EQ(std::memcmp(a.position[c].data(), b.position[c].data(), a.size() * sizeof(float)), 0) << what;
-      EXPECT_EQ(std::memcmp(a.velocity[c].data(), b.velocity[c].data(), a.size() * sizeof(float)), 0) << what;
+      EXPECT_EQ(std::memcmp(a.position[c].data(), b.position[c].data(), a.size() * sizeof(float)),
+                0)
+          << what;
+      EXPECT_EQ(std::memcmp(a.velocity[c].data(), b.velocity[c].data(), a.size() * sizeof(float)),
+                0)
+          << what;
     }
     EXPECT_EQ(std::memcmp(a.age.data(), b.age.data(), a.size() * sizeof(float)), 0) << what;
   };
@@ -139,7 +147,8 @@ TEST(InterpolatedCaches, AFrameTwoSchedulesShareIsBitwiseIdentical) {
     expectSame(at24, frameAt({120, 1}, t), "24 vs 120 fps");
   }
   // 0.2 s is 24 ticks at 120 Hz plus nothing: and at 25 fps vs 50 fps an α of 0 on both sides.
-  expectSame(frameAt({25, 1}, kFlicksPerSecond / 5), frameAt({50, 1}, kFlicksPerSecond / 5), "25 vs 50 fps");
+  expectSame(frameAt({25, 1}, kFlicksPerSecond / 5), frameAt({50, 1}, kFlicksPerSecond / 5),
+             "25 vs 50 fps");
 }
 
 TEST(FirstDivergence, NamesTheFirstTickAndTheRunsThatDiffer) {

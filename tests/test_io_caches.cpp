@@ -92,7 +92,8 @@ TEST_F(Caches, PlyRoundTripIsBitExactWithHeaderAndMetadata) {
   // Header, then exactly 8 + 10·4 bytes per particle (double id, ten floats).
   const std::string expectedHeader =
       "ply\nformat binary_little_endian 1.0\ncomment tickfx frame 3\ncomment time 0.125\n"
-      "element vertex " + std::to_string(frame.size()) +
+      "element vertex " +
+      std::to_string(frame.size()) +
       "\nproperty double id\nproperty float x\nproperty float y\nproperty float z\n"
       "property float vx\nproperty float vy\nproperty float vz\nproperty float age\n"
       "property float life\nproperty float mass\nproperty float heat\nend_header\n";
@@ -112,7 +113,8 @@ TEST_F(Caches, TruncatedOrForeignFilesAreRefusedByName) {
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), (dir_ / "f.ply").string() + ": truncated body");
   }
-  std::ofstream(dir_ / "bad.csv") << "id,px,py,pz,vx,vy,vz,age,life,mass\n0,1,2,3,4,5,6,7,8,9\n1,1,2,x,4,5,6,7,8,9\n";
+  std::ofstream(dir_ / "bad.csv")
+      << "id,px,py,pz,vx,vy,vz,age,life,mass\n0,1,2,3,4,5,6,7,8,9\n1,1,2,x,4,5,6,7,8,9\n";
   try {
     readCsvCache(dir_ / "bad.csv");
     FAIL() << "a malformed CSV was read";

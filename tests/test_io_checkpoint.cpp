@@ -343,9 +343,9 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
   const std::size_t n = pool.size();
   ASSERT_GT(n, 0u);
 
-  const std::size_t payload =
-      8 + (4 + 15) + 68 + 3 * 8 + 4 + n * (16 * 4 + 8 + 8) + (4 + 4 + 4 * n) * 2  // "heat", "spin"
-      + 8 + 8;                                                                   // no springs
+  const std::size_t payload = 8 + (4 + 15) + 68 + 3 * 8 + 4 + n * (16 * 4 + 8 + 8) +
+                              (4 + 4 + 4 * n) * 2  // "heat", "spin"
+                              + 8 + 8;             // no springs
   ASSERT_EQ(bytes.size(), 32 + payload + 8);
   EXPECT_EQ(bytes.substr(0, 8), "TICKFXCK");
   EXPECT_EQ(bytes.substr(8, 8), std::string("\x01\0\0\0\0\0\0\0", 8));
@@ -775,14 +775,16 @@ TEST(ioCheckpointSprings, AResumedStructureReachesTheUninterruptedHash) {
     cloth.stiffness = 200.0;
     ForceSet forces;
     forces.add(std::make_unique<Gravity>());
-    return std::make_unique<ParticleSystem>(settings, std::vector<EmitterSettings>{}, std::move(forces),
+    return std::make_unique<ParticleSystem>(settings, std::vector<EmitterSettings>{},
+                                            std::move(forces),
                                             std::vector<StructureSettings>{rope, cloth});
   };
   auto whole = make();
   whole->stepTicks(240);
   ASSERT_GT(whole->springs()->brokenCount(), 0u) << "the test wants broken springs in the state";
 
-  const fs::path path = fs::temp_directory_path() / ("tickfx_ckpt_springs_" + std::to_string(::getpid()));
+  const fs::path path =
+      fs::temp_directory_path() / ("tickfx_ckpt_springs_" + std::to_string(::getpid()));
   auto first = make();
   first->stepTicks(60);
   ASSERT_GT(first->springs()->brokenCount(), 0u);

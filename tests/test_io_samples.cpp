@@ -16,7 +16,8 @@ namespace tickfx::io {
 namespace {
 
 const std::vector<std::string> kSamples = {
-    "fountain", "oscillator", "wind_aliasing", "wind_aliasing_fixed", "smoke_drift", "burst", "rope_swing", "flag", "jelly"};
+    "fountain",   "oscillator", "wind_aliasing", "wind_aliasing_fixed", "smoke_drift", "burst",
+    "rope_swing", "flag",       "jelly"};
 
 std::filesystem::path samplePath(const std::string& name) {
   return std::filesystem::path(TICKFX_SOURCE_DIR) / "samples" / (name + ".toml");

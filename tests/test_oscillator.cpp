@@ -116,13 +116,16 @@ TEST_P(OscillatorEnergy, VelocityVerletConservesItsModifiedEnergy) {
 TEST_P(OscillatorEnergy, MidpointLosesEnergyByItsDeterminantEveryStep) {
   const std::vector<test::Sample> r = run("midpoint");
   const double h = dt();
-  auto q = [h](const test::Sample& s) { return (1.0 - h * h / 2.0) * s.p * s.p + h / 2.0 * s.p * s.v + s.v * s.v; };
+  auto q = [h](const test::Sample& s) {
+    return (1.0 - h * h / 2.0) * s.p * s.p + h / 2.0 * s.p * s.v + s.v * s.v;
+  };
   const double q0 = q(r[0]);
   for (const test::Sample& s : r) {
     const double model = std::pow(1.0 - h * h / 2.0, static_cast<double>(s.ticks));
     ASSERT_NEAR(q(s) / q0 / model, 1.0, roundOff(s.ticks)) << "after " << s.ticks << " ticks";
   }
-  EXPECT_LT(energy(r.back()), 0.5 * std::pow(1.0 - h * h / 2.0, static_cast<double>(r.back().ticks)) * 1.1);
+  EXPECT_LT(energy(r.back()),
+            0.5 * std::pow(1.0 - h * h / 2.0, static_cast<double>(r.back().ticks)) * 1.1);
 }
 
 // RK4's step polynomial 1 + z + z²/2 + z³/6 + z⁴/24 has |·|² = 1 − dt⁶/72 + dt⁸/576: it loses

@@ -60,8 +60,7 @@ TEST_P(PassScheduling, FusedSplitAndThreadCountsGiveTheSameBits) {
   EXPECT_EQ(runHash(GetParam(), 2, true), reference);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllIntegrators, PassScheduling,
-                         ::testing::ValuesIn(integratorNames()),
+INSTANTIATE_TEST_SUITE_P(AllIntegrators, PassScheduling, ::testing::ValuesIn(integratorNames()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace
