@@ -9,6 +9,7 @@ TICKFX_PACKAGES=(
   cmake ninja-build g++ clang pkg-config
   libeigen3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopenvdb-dev libopenvdb-tools libboost-dev libboost-iostreams-dev zlib1g-dev
 )
 
 # Installs the packages that are missing. As root it runs apt-get itself (with one update first,

@@ -1,0 +1,189 @@
+#include "fields/AnalyticField.h"
+
+#include <openvdb/openvdb.h>
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "particles/DetMath.h"
+
+namespace tickfx {
+
+namespace {
+
+Eigen::Vector3d unit(const Eigen::Vector3d& v, const char* what) {
+  const double n = v.norm();
+  if (!(n > 0.0) || !std::isfinite(n))
+    throw std::invalid_argument(std::string(what) + " must not be zero");
+  return v / n;
+}
+
+Eigen::Matrix3d cross(const Eigen::Vector3d& a) {  // [a]×, so that [a]×·x = a × x
+  Eigen::Matrix3d m;
+  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return m;
+}
+
+/// splitmix64: the noise parameters are a pure function of (seed, counter).
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+/// A double in [0, 1) from 53 bits.
+double uniform01(std::uint64_t seed, std::uint64_t counter) {
+  return static_cast<double>(mix(seed ^ mix(counter)) >> 11) * 0x1p-53;
+}
+
+}  // namespace
+
+AnalyticField AnalyticField::uniform(const Eigen::Vector3d& u) {
+  AnalyticField f;
+  f.u0_ = u;
+  return f;
+}
+
+AnalyticField AnalyticField::vortex(const Eigen::Vector3d& centre, const Eigen::Vector3d& axis,
+                                    double omega) {
+  AnalyticField f;
+  f.c_ = centre;
+  f.m_ = omega * cross(unit(axis, "vortex axis"));
+  return f;
+}
+
+AnalyticField AnalyticField::shear(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                   const Eigen::Vector3d& gradient, double rate) {
+  AnalyticField f;
+  f.c_ = origin;
+  f.m_ = rate * unit(direction, "shear direction") * unit(gradient, "shear gradient").transpose();
+  return f;
+}
+
+AnalyticField AnalyticField::curlNoise(std::uint64_t seed, double frequency, double amplitude,
+                                       int octaves) {
+  if (!(frequency > 0.0) || octaves < 1) {
+    throw std::invalid_argument("curl noise needs a positive frequency and at least one octave");
+  }
+  AnalyticField f;
+  std::uint64_t counter = 0;
+  const double scale = amplitude / (frequency * std::sqrt(3.0 * octaves));
+  for (int component = 0; component < 3; ++component) {
+    for (int o = 0; o < octaves; ++o) {
+      Term t;
+      t.component = component;
+      const double z = 2.0 * uniform01(seed, counter++) - 1.0;
+      const double azimuth = 2.0 * det::kPi * uniform01(seed, counter++);
+      const double s = std::sqrt(1.0 - z * z);
+      t.k = frequency * Eigen::Vector3d(s * det::cos(azimuth), s * det::sin(azimuth), z);
+      t.phase = 2.0 * det::kPi * uniform01(seed, counter++);
+      t.a = scale * (0.5 + 0.5 * uniform01(seed, counter++));
+      f.terms_.push_back(t);
+    }
+  }
+  return f;
+}
+
+Eigen::Vector3d AnalyticField::at(const Eigen::Vector3d& x) const {
+  if (terms_.empty()) return u0_ + m_ * (x - c_);
+  // ∇×(ψ_i e_i) = ∇ψ_i × e_i, and ∇ψ_i = a·cos(k·x + φ)·k.
+  Eigen::Vector3d u = Eigen::Vector3d::Zero();
+  for (const Term& t : terms_) {
+    const double g = t.a * det::cos(t.k.dot(x) + t.phase);
+    u += g * t.k.cross(Eigen::Vector3d::Unit(t.component));
+  }
+  return u;
+}
+
+AnalyticField AnalyticField::materialAcceleration() const {
+  if (!isAffine()) throw std::logic_error("materialAcceleration: only for affine fields");
+  AnalyticField f;
+  f.u0_ = m_ * u0_;
+  f.m_ = m_ * m_;
+  f.c_ = c_;
+  return f;
+}
+
+double AnalyticField::curvatureBound() const {
+  double bound = 0.0;
+  for (const Term& t : terms_) {
+    const double k = t.k.norm();
+    bound += std::abs(t.a) * k * k * k;
+  }
+  return bound;
+}
+
+AnalyticForce::AnalyticForce(AnalyticField field, Mode mode, float gain)
+    : field_(std::move(field)), mode_(mode), gain_(gain) {}
+
+void AnalyticForce::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& a) const {
+  const ConstVec3Rows p = in.position.rows(rows);
+  const ConstVec3Rows v = in.velocity.rows(rows);
+  for (Eigen::Index j = 0; j < rows.count(); ++j) {
+    // float → double widening is exact; the field value is rounded to float once.
+    const Eigen::Vector3d x(p.x[j], p.y[j], p.z[j]);
+    const Eigen::Vector3f u = field_.at(x).cast<float>();
+    if (mode_ == Mode::Force) {
+      a.x[j] += gain_ * u.x();
+      a.y[j] += gain_ * u.y();
+      a.z[j] += gain_ * u.z();
+    } else {
+      a.x[j] += gain_ * (u.x() - v.x[j]);
+      a.y[j] += gain_ * (u.y() - v.y[j]);
+      a.z[j] += gain_ * (u.z() - v.z[j]);
+    }
+  }
+}
+
+void bakeField(const AnalyticField& field, const BakeSettings& s, const std::string& path) {
+  if (!(s.voxelSize > 0.0)) throw std::invalid_argument("bake: voxel size must be positive");
+  if (s.gridName.empty()) throw std::invalid_argument("bake: the grid needs a name");
+  const double h = s.voxelSize;
+  openvdb::Coord lo, hi;
+  for (int c = 0; c < 3; ++c) {
+    lo[c] = static_cast<openvdb::Int32>(std::ceil(s.min[c] / h));
+    hi[c] = static_cast<openvdb::Int32>(std::floor(s.max[c] / h));
+    if (lo[c] > hi[c]) throw std::invalid_argument("bake: the box holds no voxel centre");
+  }
+  openvdb::initialize();
+  const openvdb::Vec3f background(s.background.x(), s.background.y(), s.background.z());
+  openvdb::Vec3fGrid::Ptr grid = openvdb::Vec3fGrid::create(background);
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
+  grid->setName(s.gridName);
+  grid->setGridClass(s.staggered ? openvdb::GRID_STAGGERED : openvdb::GRID_UNKNOWN);
+  auto acc = grid->getAccessor();
+  const openvdb::math::Transform& xform = grid->transform();
+  for (openvdb::Int32 i = lo.x(); i <= hi.x(); ++i) {
+    for (openvdb::Int32 j = lo.y(); j <= hi.y(); ++j) {
+      for (openvdb::Int32 k = lo.z(); k <= hi.z(); ++k) {
+        const openvdb::Coord ijk(i, j, k);
+        openvdb::Vec3f value;
+        if (s.staggered) {
+          for (int c = 0; c < 3; ++c) {
+            openvdb::Vec3d face = ijk.asVec3d();
+            face[c] -= 0.5;
+            const openvdb::Vec3d w = xform.indexToWorld(face);
+            value[c] = static_cast<float>(field.at(Eigen::Vector3d(w.x(), w.y(), w.z()))[c]);
+          }
+        } else {
+          const openvdb::Vec3d w = xform.indexToWorld(ijk);
+          const Eigen::Vector3f u = field.at(Eigen::Vector3d(w.x(), w.y(), w.z())).cast<float>();
+          value = openvdb::Vec3f(u.x(), u.y(), u.z());
+        }
+        acc.setValueOn(ijk, value);
+      }
+    }
+  }
+  try {
+    openvdb::io::File file(path);
+    file.write(openvdb::GridCPtrVec{grid});
+    file.close();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": cannot write grid '" + s.gridName + "': " + e.what());
+  }
+}
+
+}  // namespace tickfx

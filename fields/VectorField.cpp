@@ -1,0 +1,329 @@
+#include "fields/VectorField.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Interpolation.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace tickfx {
+
+namespace {
+
+std::string framePath(const VectorField::Settings& s, int frame) {
+  if (!(s.fps > 0.0)) return s.file;
+  std::string number = std::to_string(frame < 0 ? -frame : frame);
+  if (number.size() < static_cast<std::size_t>(s.framePadding)) {
+    number.insert(0, static_cast<std::size_t>(s.framePadding) - number.size(), '0');
+  }
+  if (frame < 0) number.insert(0, 1, '-');
+  std::string path = s.file;
+  const std::string key = "{frame}";
+  const std::size_t at = path.find(key);
+  if (at == std::string::npos) {
+    throw std::invalid_argument(s.file + ": a field sequence needs {frame} in the file name");
+  }
+  path.replace(at, key.size(), number);
+  return path;
+}
+
+std::string where(const std::string& path, const std::string& grid) {
+  return path + ": grid '" + grid + "'";
+}
+
+/// Checks, before OpenVDB reads any grid data, that every grid of the file ends within the file.
+/// OpenVDB 10 reads a file cut inside its grid data with garbage sizes (it may hang or fail at
+/// random), so the byte ranges in the grid descriptors are compared with the file size first.
+/// Layout (io::Archive::readHeader, MetaMap::readMeta, GridDescriptor::read): magic (8),
+/// format version (4), library major and minor (4 + 4), has-offsets flag (1), [compression flag
+/// (1) before format 222], UUID (36); file metadata: count (4), then per entry name and type
+/// strings and a byte-counted value; grid count (4); per grid: name, type, [instance parent
+/// from format 216] strings, then grid, block and end offsets (8 each), the next descriptor
+/// at the end offset. Strings are a 4-byte length and the bytes.
+void checkExtent(const std::string& path, const std::string& name) {
+  std::ifstream is(path, std::ios::binary);
+  std::error_code ec;
+  const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path, ec));
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(where(path, name) + ": cannot read the grid (" + what + ")");
+  };
+  auto u32 = [&]() {
+    std::uint32_t v = 0;
+    if (!is.read(reinterpret_cast<char*>(&v), sizeof v)) fail("the file is truncated");
+    return v;
+  };
+  auto i64 = [&]() {
+    std::int64_t v = 0;
+    if (!is.read(reinterpret_cast<char*>(&v), sizeof v)) fail("the file is truncated");
+    return v;
+  };
+  auto skip = [&](std::int64_t bytes) {
+    if (bytes < 0 || static_cast<std::int64_t>(is.tellg()) + bytes > size) {
+      fail("the file is truncated");
+    }
+    is.seekg(bytes, std::ios::cur);
+  };
+  auto skipString = [&]() { skip(u32()); };
+  i64();  // magic (checked by OpenVDB already)
+  const std::uint32_t version = u32();
+  u32();
+  u32();
+  char hasOffsets = 0;
+  if (!is.read(&hasOffsets, 1)) fail("the file is truncated");
+  if (!hasOffsets) return;  // nothing to check against
+  if (version < 222) skip(1);
+  skip(36);
+  const std::uint32_t metadata = u32();
+  for (std::uint32_t i = 0; i < metadata; ++i) {
+    skipString();
+    skipString();
+    skip(u32());
+  }
+  const std::uint32_t grids = u32();
+  for (std::uint32_t i = 0; i < grids; ++i) {
+    skipString();
+    skipString();
+    if (version >= 216) skipString();
+    const std::int64_t gridPos = i64(), blockPos = i64(), endPos = i64();
+    if (!(0 < gridPos && gridPos <= blockPos && blockPos <= endPos) || endPos > size) {
+      fail("the file is truncated: a grid ends at byte " + std::to_string(endPos) + " of " +
+           std::to_string(size));
+    }
+    is.seekg(endPos);
+  }
+}
+
+/// Reads grid `name` from `path` completely (no delayed loading: the file may change or vanish
+/// later, and a lazy read in the hot loop would need a lock).
+openvdb::GridBase::Ptr readGrid(const std::string& path, const std::string& name) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw std::runtime_error(where(path, name) + ": no such file");
+  }
+  openvdb::initialize();
+  openvdb::io::File file(path);
+  try {
+    file.open(/*delayLoad=*/false);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(where(path, name) + ": cannot open the file as OpenVDB (" + e.what() +
+                             ")");
+  }
+  openvdb::GridBase::Ptr grid;
+  try {
+    checkExtent(path, name);
+    if (!file.hasGrid(name)) {
+      std::string names;
+      for (auto it = file.beginName(); it != file.endName(); ++it) {
+        names += (names.empty() ? "" : ", ") + it.gridName();
+      }
+      file.close();
+      throw std::runtime_error(where(path, name) + ": no such grid (" +
+                               (names.empty()
+                                    ? std::string("the file holds no grids: empty or truncated")
+                                    : "the file has: " + names) +
+                               ")");
+    }
+    grid = file.readGrid(name);
+    file.close();
+  } catch (const std::runtime_error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(where(path, name) + ": cannot read the grid (" + e.what() + ")");
+  }
+  if (!grid) throw std::runtime_error(where(path, name) + ": cannot read the grid");
+  return grid;
+}
+
+Eigen::Vector3f toFloat(const openvdb::Vec3f& v) { return {v.x(), v.y(), v.z()}; }
+Eigen::Vector3f toFloat(const openvdb::Vec3d& v) {
+  return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
+}
+
+}  // namespace
+
+/// The grids, their precision hidden behind one virtual call per accumulate().
+struct VectorField::Impl {
+  virtual ~Impl() = default;
+  virtual void run(const VectorField::Settings& s, const ForceInput& in, RowRange rows, Vec3Rows* a,
+                   Eigen::Vector3f* single, std::uint8_t* dead) const = 0;
+  std::string valueType;
+  bool staggered = false;
+  int frames = 1;
+};
+
+namespace {
+
+template <class GridT>
+struct ImplT final : VectorField::Impl {
+  using ValueT = typename GridT::ValueType;
+  using Accessor = typename GridT::ConstAccessor;
+  std::vector<typename GridT::ConstPtr> grids;
+
+  // One frame: a grid's accessor (built per call) and its transform.
+  struct Frame {
+    Accessor acc;
+    const openvdb::math::Transform* xform;
+  };
+
+  template <class Sampler>
+  static Eigen::Vector3f at(Frame& f, const openvdb::Vec3d& world, bool zeroOutside) {
+    const openvdb::Vec3d index = f.xform->worldToIndex(world);
+    if (zeroOutside && !f.acc.isValueOn(openvdb::Coord::round(index))) {
+      return Eigen::Vector3f::Zero();
+    }
+    ValueT u;
+    Sampler::sample(f.acc, index, u);
+    return toFloat(u);
+  }
+
+  template <class Sampler>
+  void kernel(const VectorField::Settings& s, const ForceInput& in, RowRange rows, Vec3Rows* a,
+              Eigen::Vector3f* single, std::uint8_t* dead, std::size_t f0, std::size_t f1,
+              float w) const {
+    Frame first{grids[f0]->getConstAccessor(), &grids[f0]->transform()};
+    Frame second{grids[f1]->getConstAccessor(), &grids[f1]->transform()};
+    const bool blend = f1 != f0 && w != 0.0f;
+    const bool zero = s.outside == VectorField::Outside::Zero;
+    const float one = 1.0f - w;
+    const ConstVec3Rows p = in.position.rows(rows);
+    const ConstVec3Rows v = in.velocity.rows(rows);
+    for (Eigen::Index j = 0; j < rows.count(); ++j) {
+      // float → double is exact; the sample is rounded to float once.
+      const openvdb::Vec3d world(p.x[j], p.y[j], p.z[j]);
+      if (dead != nullptr) {
+        const openvdb::Vec3d index = first.xform->worldToIndex(world);
+        if (!first.acc.isValueOn(openvdb::Coord::round(index))) {
+          dead[rows.begin + static_cast<std::size_t>(j)] = 1;
+        }
+        continue;
+      }
+      Eigen::Vector3f u = at<Sampler>(first, world, zero);
+      if (blend) {
+        const Eigen::Vector3f u1 = at<Sampler>(second, world, zero);
+        u = Eigen::Vector3f(one * u.x() + w * u1.x(), one * u.y() + w * u1.y(),
+                            one * u.z() + w * u1.z());
+      }
+      if (single != nullptr) {
+        *single = u;
+        return;
+      }
+      if (s.mode == VectorField::Mode::Force) {
+        a->x[j] += s.scale * u.x();
+        a->y[j] += s.scale * u.y();
+        a->z[j] += s.scale * u.z();
+      } else {
+        a->x[j] += s.scale * (u.x() - v.x[j]);
+        a->y[j] += s.scale * (u.y() - v.y[j]);
+        a->z[j] += s.scale * (u.z() - v.z[j]);
+      }
+    }
+  }
+
+  void run(const VectorField::Settings& s, const ForceInput& in, RowRange rows, Vec3Rows* a,
+           Eigen::Vector3f* single, std::uint8_t* dead) const override {
+    // The frames around in.time and the blend weight: once per call, in double, rounded once.
+    std::size_t f0 = 0, f1 = 0;
+    float w = 0.0f;
+    if (grids.size() > 1) {
+      const double x = in.time * s.fps;
+      const double last = static_cast<double>(grids.size() - 1);
+      if (x >= last) {
+        f0 = f1 = grids.size() - 1;
+      } else if (x > 0.0) {
+        const double base = std::floor(x);
+        f0 = static_cast<std::size_t>(base);
+        f1 = f0 + 1;
+        w = static_cast<float>(x - base);
+      }
+    }
+    namespace vt = openvdb::tools;
+    const bool quadratic = s.interpolation == VectorField::Interpolation::Quadratic;
+    if (staggered) {
+      if (quadratic) {
+        kernel<vt::StaggeredQuadraticSampler>(s, in, rows, a, single, dead, f0, f1, w);
+      } else {
+        kernel<vt::StaggeredBoxSampler>(s, in, rows, a, single, dead, f0, f1, w);
+      }
+    } else if (quadratic) {
+      kernel<vt::QuadraticSampler>(s, in, rows, a, single, dead, f0, f1, w);
+    } else {
+      kernel<vt::BoxSampler>(s, in, rows, a, single, dead, f0, f1, w);
+    }
+  }
+};
+
+template <class GridT>
+std::unique_ptr<VectorField::Impl> load(const VectorField::Settings& s,
+                                        std::vector<openvdb::GridBase::Ptr>& raw,
+                                        const char* typeName) {
+  auto impl = std::make_unique<ImplT<GridT>>();
+  impl->valueType = typeName;
+  impl->staggered = raw.front()->getGridClass() == openvdb::GRID_STAGGERED;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    auto grid = openvdb::gridPtrCast<GridT>(raw[i]);
+    const std::string path = framePath(s, s.firstFrame + static_cast<int>(i));
+    if (!grid) {
+      throw std::runtime_error(where(path, s.grid) + ": holds " + raw[i]->valueType() +
+                               " values, unlike the first frame (" + typeName + ")");
+    }
+    if ((grid->getGridClass() == openvdb::GRID_STAGGERED) != impl->staggered) {
+      throw std::runtime_error(where(path, s.grid) + ": staggered or not, unlike the first frame");
+    }
+    impl->grids.push_back(grid);
+  }
+  impl->frames = static_cast<int>(raw.size());
+  return impl;
+}
+
+}  // namespace
+
+VectorField::VectorField(const Settings& settings) : s_(settings) {
+  if (s_.fps > 0.0 && s_.lastFrame < s_.firstFrame) {
+    throw std::invalid_argument(s_.file + ": a field sequence needs lastFrame >= firstFrame");
+  }
+  const int last = s_.fps > 0.0 ? s_.lastFrame : s_.firstFrame;
+  std::vector<openvdb::GridBase::Ptr> raw;
+  for (int f = s_.firstFrame; f <= last; ++f) {
+    const std::string path = framePath(s_, f);
+    openvdb::GridBase::Ptr grid = readGrid(path, s_.grid);
+    if (!grid->isType<openvdb::Vec3fGrid>() && !grid->isType<openvdb::Vec3dGrid>()) {
+      throw std::runtime_error(where(path, s_.grid) + ": holds " + grid->valueType() + " values (" +
+                               grid->type() + "); a vector field needs vec3s or vec3d");
+    }
+    raw.push_back(grid);
+  }
+  if (raw.front()->isType<openvdb::Vec3fGrid>()) {
+    impl_ = load<openvdb::Vec3fGrid>(s_, raw, "vec3s");
+  } else {
+    impl_ = load<openvdb::Vec3dGrid>(s_, raw, "vec3d");
+  }
+}
+
+VectorField::~VectorField() = default;
+
+void VectorField::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
+  impl_->run(s_, in, rows, &acceleration, nullptr, nullptr);
+}
+
+Eigen::Vector3f VectorField::sample(const Eigen::Vector3f& x, double t) const {
+  ParticlePool none(0);
+  const float px = x.x(), py = x.y(), pz = x.z();
+  const ForceInput in{none, Vec3View{&px, &py, &pz, 0}, Vec3View{&px, &py, &pz, 0}, t, 0};
+  Eigen::Vector3f u = Eigen::Vector3f::Zero();
+  impl_->run(s_, in, RowRange{0, 1}, nullptr, &u, nullptr);
+  return u;
+}
+
+void VectorField::flagOutside(const ForceInput& in, RowRange rows, std::uint8_t* dead) const {
+  impl_->run(s_, in, rows, nullptr, nullptr, dead);
+}
+
+const std::string& VectorField::valueType() const { return impl_->valueType; }
+bool VectorField::staggered() const { return impl_->staggered; }
+int VectorField::frameCount() const { return impl_->frames; }
+
+}  // namespace tickfx
