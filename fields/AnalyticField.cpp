@@ -4,9 +4,11 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 #include <utility>
 
+#include "fields/VectorFieldGrids.h"
 #include "particles/DetMath.h"
 
 namespace tickfx {
@@ -64,7 +66,7 @@ AnalyticField AnalyticField::shear(const Eigen::Vector3d& origin, const Eigen::V
 }
 
 AnalyticField AnalyticField::curlNoise(std::uint64_t seed, double frequency, double amplitude,
-                                       int octaves) {
+                                       int octaves, double evolution) {
   if (!(frequency > 0.0) || octaves < 1) {
     throw std::invalid_argument("curl noise needs a positive frequency and at least one octave");
   }
@@ -81,18 +83,21 @@ AnalyticField AnalyticField::curlNoise(std::uint64_t seed, double frequency, dou
       t.k = frequency * Eigen::Vector3d(s * det::cos(azimuth), s * det::sin(azimuth), z);
       t.phase = 2.0 * det::kPi * uniform01(seed, counter++);
       t.a = scale * (0.5 + 0.5 * uniform01(seed, counter++));
+      // Drift rates come from a counter space of their own, so that a steady field (evolution
+      // 0) keeps the terms it had before fields could evolve.
+      t.omega = evolution * (2.0 * uniform01(~seed, f.terms_.size()) - 1.0);
       f.terms_.push_back(t);
     }
   }
   return f;
 }
 
-Eigen::Vector3d AnalyticField::at(const Eigen::Vector3d& x) const {
+Eigen::Vector3d AnalyticField::at(const Eigen::Vector3d& x, double time) const {
   if (terms_.empty()) return u0_ + m_ * (x - c_);
-  // ∇×(ψ_i e_i) = ∇ψ_i × e_i, and ∇ψ_i = a·cos(k·x + φ)·k.
+  // ∇×(ψ_i e_i) = ∇ψ_i × e_i, and ∇ψ_i = a·cos(k·x + φ + ωt)·k.
   Eigen::Vector3d u = Eigen::Vector3d::Zero();
   for (const Term& t : terms_) {
-    const double g = t.a * det::cos(t.k.dot(x) + t.phase);
+    const double g = t.a * det::cos(t.k.dot(x) + (t.phase + t.omega * time));
     u += g * t.k.cross(Eigen::Vector3d::Unit(t.component));
   }
   return u;
@@ -119,14 +124,23 @@ double AnalyticField::curvatureBound() const {
 AnalyticForce::AnalyticForce(AnalyticField field, Mode mode, float gain)
     : field_(std::move(field)), mode_(mode), gain_(gain) {}
 
+void AnalyticForce::accumulateVelocity(const ForceInput& in, RowRange rows,
+                                       Vec3Rows& velocity) const {
+  if (mode_ == Mode::Advect) add(in, rows, velocity);
+}
+
 void AnalyticForce::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& a) const {
+  if (mode_ != Mode::Advect) add(in, rows, a);
+}
+
+void AnalyticForce::add(const ForceInput& in, RowRange rows, Vec3Rows& a) const {
   const ConstVec3Rows p = in.position.rows(rows);
   const ConstVec3Rows v = in.velocity.rows(rows);
   for (Eigen::Index j = 0; j < rows.count(); ++j) {
     // float → double widening is exact; the field value is rounded to float once.
     const Eigen::Vector3d x(p.x[j], p.y[j], p.z[j]);
-    const Eigen::Vector3f u = field_.at(x).cast<float>();
-    if (mode_ == Mode::Force) {
+    const Eigen::Vector3f u = field_.at(x, in.time).cast<float>();
+    if (mode_ != Mode::Drag) {
       a.x[j] += gain_ * u.x();
       a.y[j] += gain_ * u.y();
       a.z[j] += gain_ * u.z();
@@ -138,7 +152,9 @@ void AnalyticForce::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& a)
   }
 }
 
-void bakeField(const AnalyticField& field, const BakeSettings& s, const std::string& path) {
+namespace {
+
+openvdb::Vec3fGrid::Ptr bakeGrid(const AnalyticField& field, const BakeSettings& s, double time) {
   if (!(s.voxelSize > 0.0)) throw std::invalid_argument("bake: voxel size must be positive");
   if (s.gridName.empty()) throw std::invalid_argument("bake: the grid needs a name");
   const double h = s.voxelSize;
@@ -166,24 +182,49 @@ void bakeField(const AnalyticField& field, const BakeSettings& s, const std::str
             openvdb::Vec3d face = ijk.asVec3d();
             face[c] -= 0.5;
             const openvdb::Vec3d w = xform.indexToWorld(face);
-            value[c] = static_cast<float>(field.at(Eigen::Vector3d(w.x(), w.y(), w.z()))[c]);
+            value[c] = static_cast<float>(field.at(Eigen::Vector3d(w.x(), w.y(), w.z()), time)[c]);
           }
         } else {
           const openvdb::Vec3d w = xform.indexToWorld(ijk);
-          const Eigen::Vector3f u = field.at(Eigen::Vector3d(w.x(), w.y(), w.z())).cast<float>();
+          const Eigen::Vector3f u =
+              field.at(Eigen::Vector3d(w.x(), w.y(), w.z()), time).cast<float>();
           value = openvdb::Vec3f(u.x(), u.y(), u.z());
         }
         acc.setValueOn(ijk, value);
       }
     }
   }
+  return grid;
+}
+
+}  // namespace
+
+void bakeField(const AnalyticField& field, const BakeSettings& s, const std::string& path,
+               double time) {
+  const openvdb::Vec3fGrid::Ptr grid = bakeGrid(field, s, time);
+  // Written beside the target and renamed over it: a failed bake leaves no half-written file.
+  const std::string partial = path + ".partial";
   try {
-    openvdb::io::File file(path);
+    openvdb::io::File file(partial);
     file.write(openvdb::GridCPtrVec{grid});
     file.close();
+    std::filesystem::rename(partial, path);
   } catch (const std::exception& e) {
+    std::error_code ec;
+    std::filesystem::remove(partial, ec);
     throw std::runtime_error(path + ": cannot write grid '" + s.gridName + "': " + e.what());
   }
+}
+
+std::unique_ptr<VectorField> bakeVectorField(const AnalyticField& field, const BakeSettings& bake,
+                                             const VectorField::Settings& settings) {
+  VectorField::Grids grids;
+  const int last = settings.fps > 0.0 ? settings.lastFrame : settings.firstFrame;
+  for (int f = settings.firstFrame; f <= last; ++f) {
+    const double time = settings.fps > 0.0 ? (f - settings.firstFrame) / settings.fps : 0.0;
+    grids.grids.push_back(bakeGrid(field, bake, time));
+  }
+  return std::make_unique<VectorField>(settings, grids);
 }
 
 }  // namespace tickfx

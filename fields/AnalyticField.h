@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fields/ForceModule.h"
+#include "fields/VectorField.h"
 
 namespace tickfx {
 
@@ -32,11 +33,15 @@ class AnalyticField {
   /// Divergence-free noise: ψ_i(x) = Σ_k a_ik · sin(k_ik·x + φ_ik) over `octaves` terms per
   /// component, wave numbers of length `frequency` (rad/m), amplitudes scaled so that |u| is of
   /// the order of `amplitude`. Deterministic: the same seed gives the same field on every build.
+  /// With `evolution` ω > 0 (rad/s) the noise changes in time: each term's phase drifts at a
+  /// seeded rate in [−ω, ω], so the field at time t is still divergence-free and its pattern
+  /// renews over about 1/ω seconds.
   static AnalyticField curlNoise(std::uint64_t seed, double frequency, double amplitude,
-                                 int octaves = 4);
+                                 int octaves = 4, double evolution = 0.0);
 
-  /// The field at `x` (metres → the field's unit).
-  Eigen::Vector3d at(const Eigen::Vector3d& x) const;
+  /// The field at `x` (metres → the field's unit) and time `time` (seconds; only evolving curl
+  /// noise depends on it).
+  Eigen::Vector3d at(const Eigen::Vector3d& x, double time = 0.0) const;
 
   /// True for the affine family (uniform, vortex, shear).
   bool isAffine() const { return terms_.empty(); }
@@ -55,6 +60,7 @@ class AnalyticField {
     double a = 0.0;
     Eigen::Vector3d k = Eigen::Vector3d::Zero();
     double phase = 0.0;
+    double omega = 0.0;  // phase drift, rad/s
   };
   Eigen::Vector3d u0_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d m_ = Eigen::Matrix3d::Zero();
@@ -62,16 +68,21 @@ class AnalyticField {
   std::vector<Term> terms_;
 };
 
-/// A force module from an analytic field: a += scale·u(x) ("force") or a += k·(u(x) − v)
-/// ("drag"). u is evaluated in double and rounded to float once per particle.
+/// A force module from an analytic field: a += scale·u(x, t) ("force"), a += k·(u(x, t) − v)
+/// ("drag"), or v := scale·u(x, t) ("advect", see VectorField). u is evaluated in double and
+/// rounded to float once per particle.
 class AnalyticForce final : public ForceModule {
  public:
-  enum class Mode { Force, Drag };
+  enum class Mode { Force, Drag, Advect };
   AnalyticForce(AnalyticField field, Mode mode, float gain);
   std::string_view typeName() const override { return "analytic_field"; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
+  bool prescribesVelocity() const override { return mode_ == Mode::Advect; }
+  void accumulateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const override;
 
  private:
+  void add(const ForceInput& in, RowRange rows, Vec3Rows& out) const;
+
   AnalyticField field_;
   Mode mode_;
   float gain_;
@@ -91,10 +102,18 @@ struct BakeSettings {
   bool staggered = false;
 };
 
-/// Bakes `field` into an openvdb::Vec3fGrid (values rounded to float once) and writes it to
-/// `path` under `settings.gridName`, replacing the file. Throws std::invalid_argument for a
+/// Bakes `field` at time `time` into an openvdb::Vec3fGrid (values rounded to float once) and
+/// writes it to `path` under `settings.gridName`, replacing the file (written beside it and
+/// renamed, so a failure leaves no partial file). Throws std::invalid_argument for a
 /// non-positive voxel size, an empty box, or an empty grid name, and std::runtime_error (naming
 /// the file) when the file cannot be written.
-void bakeField(const AnalyticField& field, const BakeSettings& settings, const std::string& path);
+void bakeField(const AnalyticField& field, const BakeSettings& settings, const std::string& path,
+               double time = 0.0);
+
+/// Bakes `field` in memory and returns a VectorField sampling it with `settings` (file names
+/// are then only labels): one grid, or with settings.fps > 0 one grid a frame, frame f baked at
+/// (f − firstFrame)/fps seconds. The same bits as baking to files and loading them.
+std::unique_ptr<VectorField> bakeVectorField(const AnalyticField& field, const BakeSettings& bake,
+                                             const VectorField::Settings& settings);
 
 }  // namespace tickfx

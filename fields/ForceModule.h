@@ -104,8 +104,24 @@ class ForceModule {
   virtual void beginTick(const ParticlePool& /*pool*/, std::int64_t /*tick*/) {}
 
   /// Adds this module's acceleration at `in` to `acceleration`, whose element j is row
-  /// rows.begin + j.
+  /// rows.begin + j. Not called for a module that prescribes velocity.
   virtual void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const = 0;
+
+  /// True for an advection module: it sets the particles' velocity (v := u(x, t)) instead of
+  /// adding acceleration. The state then follows the first-order equation x' = u(x, t) (see
+  /// integrators/Advection.h); a ForceSet refuses to mix such modules with acceleration modules,
+  /// whose forces would be silently ignored.
+  virtual bool prescribesVelocity() const { return false; }
+
+  /// Advection modules: adds this module's velocity (m/s) at `in` to `velocity`, whose element j
+  /// is row rows.begin + j. Same threading rules as accumulate().
+  virtual void accumulateVelocity(const ForceInput& /*in*/, RowRange /*rows*/,
+                                  Vec3Rows& /*velocity*/) const {}
+
+  /// Called once per tick after the step, with the state at the end of the tick (`time` =
+  /// (tick + 1)/rate seconds): a module may flag particles dead here (a field's kill region).
+  /// The pool removes them before the next tick. Must give the same flags on any thread count.
+  virtual void endTick(ParticlePool& /*pool*/, std::int64_t /*tick*/, double /*time*/) {}
 };
 
 }  // namespace tickfx

@@ -1,10 +1,37 @@
 #include "fields/ForceSet.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace tickfx {
 
+namespace {
+
+// A pinned particle (infinite mass) does not move: no force accelerates it, gravity included, and
+// no flow carries it.
+void holdPinned(const ForceInput& in, RowRange rows, Vec3Rows& value) {
+  const auto pinned = in.pool.inverseMass().segment(rows.offset(), rows.count()) == 0.0f;
+  value.x = pinned.select(0.0f, value.x);
+  value.y = pinned.select(0.0f, value.y);
+  value.z = pinned.select(0.0f, value.z);
+}
+
+}  // namespace
+
 ForceModule& ForceSet::add(std::unique_ptr<ForceModule> module) {
+  for (const auto& m : modules_) {
+    if (m->prescribesVelocity() != module->prescribesVelocity()) {
+      const ForceModule& advect = m->prescribesVelocity() ? *m : *module;
+      const ForceModule& force = m->prescribesVelocity() ? *module : *m;
+      throw std::invalid_argument(
+          std::string(advect.typeName()) + " in advect mode sets the velocity, so the " +
+          std::string(force.typeName()) +
+          " force would be ignored: an advected effect cannot have acceleration forces (use "
+          "mode \"drag\" to pull particles toward the field instead)");
+    }
+  }
+  advects_ = module->prescribesVelocity();
   modules_.push_back(std::move(module));
   return *modules_.back();
 }
@@ -34,13 +61,19 @@ void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& accelerat
   acceleration.y.setConstant(uniform.y());
   acceleration.z.setConstant(uniform.z());
   for (; next < modules_.size(); ++next) modules_[next]->accumulate(in, rows, acceleration);
-  if (anyPinned_) {
-    // A pinned particle (infinite mass) does not move: no force accelerates it, gravity included.
-    const auto pinned = in.pool.inverseMass().segment(rows.offset(), rows.count()) == 0.0f;
-    acceleration.x = pinned.select(0.0f, acceleration.x);
-    acceleration.y = pinned.select(0.0f, acceleration.y);
-    acceleration.z = pinned.select(0.0f, acceleration.z);
-  }
+  if (anyPinned_) holdPinned(in, rows, acceleration);
+}
+
+void ForceSet::evaluateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const {
+  velocity.x.setZero();
+  velocity.y.setZero();
+  velocity.z.setZero();
+  for (const auto& m : modules_) m->accumulateVelocity(in, rows, velocity);
+  if (anyPinned_) holdPinned(in, rows, velocity);
+}
+
+void ForceSet::endTick(ParticlePool& pool, std::int64_t tick, double time) {
+  for (auto& m : modules_) m->endTick(pool, tick, time);
 }
 
 }  // namespace tickfx

@@ -15,7 +15,9 @@ class ForceSet {
   ForceSet(ForceSet&&) noexcept = default;
   ForceSet& operator=(ForceSet&&) noexcept = default;
 
-  /// Appends `module` (taking ownership); returns it for further configuration.
+  /// Appends `module` (taking ownership); returns it for further configuration. Throws
+  /// std::invalid_argument when the set would mix modules that prescribe velocity (advection)
+  /// with modules that add acceleration, naming both.
   ForceModule& add(std::unique_ptr<ForceModule> module);
 
   std::size_t size() const { return modules_.size(); }
@@ -33,9 +35,21 @@ class ForceSet {
   /// 0 + a_1 + a_2 + ... in module order, for every row; 0 for pinned particles.
   void evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const;
 
+  /// True when the modules prescribe velocity (advection): integrators then advance x' = u(x, t)
+  /// with evaluateVelocity() instead of asking for accelerations.
+  bool prescribesVelocity() const { return advects_; }
+
+  /// Writes the total prescribed velocity at `in` for rows `rows` into `velocity` (overwrites):
+  /// 0 + u_1 + u_2 + ... in module order; 0 for pinned particles.
+  void evaluateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const;
+
+  /// Once per tick after the step: the modules' endTick, in order (see ForceModule::endTick).
+  void endTick(ParticlePool& pool, std::int64_t tick, double time);
+
  private:
   std::vector<std::unique_ptr<ForceModule>> modules_;
   bool anyPinned_ = false;
+  bool advects_ = false;
 };
 
 }  // namespace tickfx

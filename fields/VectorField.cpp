@@ -1,8 +1,12 @@
 #include "fields/VectorField.h"
 
+#include "fields/VectorFieldGrids.h"
+#include "particles/ParallelFor.h"
+
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -153,6 +157,8 @@ struct VectorField::Impl {
   std::string valueType;
   bool staggered = false;
   int frames = 1;
+  double voxelSize = 0.0;
+  double maxMagnitude = 0.0;
 };
 
 namespace {
@@ -187,7 +193,7 @@ struct ImplT final : VectorField::Impl {
     Frame first{grids[f0]->getConstAccessor(), &grids[f0]->transform()};
     Frame second{grids[f1]->getConstAccessor(), &grids[f1]->transform()};
     const bool blend = f1 != f0 && w != 0.0f;
-    const bool zero = s.outside == VectorField::Outside::Zero;
+    const bool zero = s.outside != VectorField::Outside::Background;
     const float one = 1.0f - w;
     const ConstVec3Rows p = in.position.rows(rows);
     const ConstVec3Rows v = in.velocity.rows(rows);
@@ -211,7 +217,7 @@ struct ImplT final : VectorField::Impl {
         *single = u;
         return;
       }
-      if (s.mode == VectorField::Mode::Force) {
+      if (s.mode != VectorField::Mode::Drag) {  // Force adds acceleration, Advect velocity
         a->x[j] += s.scale * u.x();
         a->y[j] += s.scale * u.y();
         a->z[j] += s.scale * u.z();
@@ -276,37 +282,83 @@ std::unique_ptr<VectorField::Impl> load(const VectorField::Settings& s,
     impl->grids.push_back(grid);
   }
   impl->frames = static_cast<int>(raw.size());
+  const openvdb::Vec3d voxel = impl->grids.front()->voxelSize();
+  impl->voxelSize = std::min({voxel.x(), voxel.y(), voxel.z()});
+  for (const auto& grid : impl->grids) {
+    for (auto it = grid->cbeginValueOn(); it; ++it) {
+      impl->maxMagnitude = std::max(impl->maxMagnitude, static_cast<double>(it->length()));
+    }
+  }
   return impl;
 }
 
 }  // namespace
 
-VectorField::VectorField(const Settings& settings) : s_(settings) {
-  if (s_.fps > 0.0 && s_.lastFrame < s_.firstFrame) {
-    throw std::invalid_argument(s_.file + ": a field sequence needs lastFrame >= firstFrame");
-  }
-  const int last = s_.fps > 0.0 ? s_.lastFrame : s_.firstFrame;
-  std::vector<openvdb::GridBase::Ptr> raw;
-  for (int f = s_.firstFrame; f <= last; ++f) {
-    const std::string path = framePath(s_, f);
-    openvdb::GridBase::Ptr grid = readGrid(path, s_.grid);
+namespace {
+
+std::unique_ptr<const VectorField::Impl> makeImpl(const VectorField::Settings& s,
+                                                  std::vector<openvdb::GridBase::Ptr> raw) {
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const std::string path = framePath(s, s.firstFrame + static_cast<int>(i));
+    const auto& grid = raw[i];
+    if (!grid) throw std::runtime_error(where(path, s.grid) + ": no grid");
     if (!grid->isType<openvdb::Vec3fGrid>() && !grid->isType<openvdb::Vec3dGrid>()) {
-      throw std::runtime_error(where(path, s_.grid) + ": holds " + grid->valueType() + " values (" +
+      throw std::runtime_error(where(path, s.grid) + ": holds " + grid->valueType() + " values (" +
                                grid->type() + "); a vector field needs vec3s or vec3d");
     }
-    raw.push_back(grid);
   }
-  if (raw.front()->isType<openvdb::Vec3fGrid>()) {
-    impl_ = load<openvdb::Vec3fGrid>(s_, raw, "vec3s");
-  } else {
-    impl_ = load<openvdb::Vec3dGrid>(s_, raw, "vec3d");
+  if (raw.front()->isType<openvdb::Vec3fGrid>()) return load<openvdb::Vec3fGrid>(s, raw, "vec3s");
+  return load<openvdb::Vec3dGrid>(s, raw, "vec3d");
+}
+
+int frameSpan(const VectorField::Settings& s) {
+  if (s.fps > 0.0 && s.lastFrame < s.firstFrame) {
+    throw std::invalid_argument(s.file + ": a field sequence needs lastFrame >= firstFrame");
   }
+  return s.fps > 0.0 ? s.lastFrame - s.firstFrame + 1 : 1;
+}
+
+}  // namespace
+
+VectorField::VectorField(const Settings& settings) : s_(settings) {
+  const int frames = frameSpan(s_);
+  std::vector<openvdb::GridBase::Ptr> raw;
+  for (int f = s_.firstFrame; f < s_.firstFrame + frames; ++f) {
+    raw.push_back(readGrid(framePath(s_, f), s_.grid));
+  }
+  impl_ = makeImpl(s_, std::move(raw));
+}
+
+VectorField::VectorField(const Settings& settings, const Grids& grids) : s_(settings) {
+  const int frames = frameSpan(s_);
+  if (grids.grids.size() != static_cast<std::size_t>(frames)) {
+    throw std::invalid_argument(s_.file + ": " + std::to_string(grids.grids.size()) +
+                                " grids given for " + std::to_string(frames) + " frames");
+  }
+  impl_ = makeImpl(s_, grids.grids);
 }
 
 VectorField::~VectorField() = default;
 
 void VectorField::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
+  if (s_.mode == Mode::Advect) return;  // prescribes velocity: ForceSet never asks
   impl_->run(s_, in, rows, &acceleration, nullptr, nullptr);
+}
+
+void VectorField::accumulateVelocity(const ForceInput& in, RowRange rows,
+                                     Vec3Rows& velocity) const {
+  if (s_.mode != Mode::Advect) return;
+  impl_->run(s_, in, rows, &velocity, nullptr, nullptr);
+}
+
+void VectorField::endTick(ParticlePool& pool, std::int64_t tick, double time) {
+  if (s_.outside != Outside::Kill) return;
+  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), time,
+                      tick};
+  std::uint8_t* dead = pool.dead().data();
+  parallelForRows(pool.size(), [&](std::size_t b, std::size_t e) {
+    flagOutside(in, RowRange{b, e}, dead);
+  });
 }
 
 Eigen::Vector3f VectorField::sample(const Eigen::Vector3f& x, double t) const {
@@ -325,5 +377,7 @@ void VectorField::flagOutside(const ForceInput& in, RowRange rows, std::uint8_t*
 const std::string& VectorField::valueType() const { return impl_->valueType; }
 bool VectorField::staggered() const { return impl_->staggered; }
 int VectorField::frameCount() const { return impl_->frames; }
+double VectorField::voxelSize() const { return impl_->voxelSize; }
+double VectorField::maxMagnitude() const { return impl_->maxMagnitude; }
 
 }  // namespace tickfx

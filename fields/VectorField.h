@@ -17,16 +17,16 @@ namespace tickfx {
 /// a grid whose class is GRID_STAGGERED (MAC) is sampled with the staggered variants. Samples
 /// are computed in the grid's precision and rounded to float once.
 ///
-/// Modes: Force, a += scale·u(x); Drag, a += scale·(u(x) − v) (scale is the rate k, 1/s).
-/// "Advect" (v := u) is not a mode: an acceleration-based module cannot set a velocity, and
-/// the drag limit k = 1/dt only gives v = u for semi-implicit Euler. For a steady field the
-/// equivalent force is the material acceleration (u·∇)u with v(0) = u(x(0)) (see
-/// AnalyticField::materialAcceleration and bakeField); a true advect needs an integrator hook.
+/// Modes: Force, a += scale·u(x); Drag, a += scale·(u(x) − v) (scale is the rate k, 1/s: pulled
+/// toward the field velocity, like Houdini's advect-by-volumes "update velocity"); Advect,
+/// v := scale·u(x): the module prescribes velocity (prescribesVelocity()), the integrators then
+/// follow x' = u(x, t) with their advection schemes (integrators/Advection.h), and the effect
+/// can have no acceleration forces besides.
 ///
 /// Outside the active voxels (the voxel nearest to x is inactive): Background samples as
-/// OpenVDB does (the grid's background where nothing is stored); Zero adds nothing. Killing
-/// particles there needs a writable flag channel, which ForceInput (a const pool) does not
-/// give: flagOutside() computes the flags for a caller that owns the pool.
+/// OpenVDB does (the grid's background where nothing is stored); Zero adds nothing; Kill adds
+/// nothing during the step and, at the end of each tick (endTick), flags every particle whose new
+/// position is outside as dead, so the pool removes it before the next tick.
 ///
 /// Sequences: with `fps > 0`, `file` holds "{frame}", replaced by the frame number zero-padded
 /// to `framePadding` digits, for frames firstFrame..lastFrame (all loaded on construction).
@@ -38,15 +38,15 @@ namespace tickfx {
 /// value accessors per call; the grids are immutable after construction.
 class VectorField final : public ForceModule {
  public:
-  enum class Mode { Force, Drag };
+  enum class Mode { Force, Drag, Advect };
   enum class Interpolation { Linear, Quadratic };
-  enum class Outside { Background, Zero };
+  enum class Outside { Background, Zero, Kill };
 
   struct Settings {
     std::string file;
     std::string grid = "vel";
     Mode mode = Mode::Force;
-    float scale = 1.0f;  // Force: unit of the field → m/s²; Drag: k in 1/s
+    float scale = 1.0f;  // Force: unit of the field → m/s²; Drag: k in 1/s; Advect: unit → m/s
     Interpolation interpolation = Interpolation::Linear;
     Outside outside = Outside::Background;
     // Sequences (fps > 0 only).
@@ -56,13 +56,21 @@ class VectorField final : public ForceModule {
     int framePadding = 4;
   };
 
+  /// Loads the grid (or the frames of a sequence) from settings.file.
   explicit VectorField(const Settings& settings);
+  /// Grids already in memory (see VectorFieldGrids.h): one, or one a frame of a sequence
+  /// (settings.file is then only a name for messages). Checked as loaded grids are.
+  struct Grids;
+  VectorField(const Settings& settings, const Grids& grids);
   ~VectorField() override;
   VectorField(const VectorField&) = delete;
   VectorField& operator=(const VectorField&) = delete;
 
   std::string_view typeName() const override { return "vdb_field"; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
+  bool prescribesVelocity() const override { return s_.mode == Mode::Advect; }
+  void accumulateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const override;
+  void endTick(ParticlePool& pool, std::int64_t tick, double time) override;
 
   /// The field value (after the outside policy, before scale) at world position `x`, time `t`.
   Eigen::Vector3f sample(const Eigen::Vector3f& x, double t = 0.0) const;
@@ -74,6 +82,10 @@ class VectorField final : public ForceModule {
   const std::string& valueType() const;
   bool staggered() const;
   int frameCount() const;
+  /// The smallest edge of a voxel of the first frame, in metres.
+  double voxelSize() const;
+  /// The largest |u| over the active voxels of every frame (before scale), in the field's unit.
+  double maxMagnitude() const;
   const Settings& settings() const { return s_; }
 
   struct Impl;  // OpenVDB lives here (VectorField.cpp)

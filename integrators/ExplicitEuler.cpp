@@ -2,7 +2,7 @@
 
 namespace tickfx {
 
-void ExplicitEuler::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
   const float dt = time.dt();
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fields/ForceSet.h"
+#include "integrators/Advection.h"
 #include "particles/ParticlePool.h"
 
 namespace tickfx {
@@ -30,10 +31,16 @@ struct StepTime {
 /// started from in pool.previousPosition() (for interpolation). Rows from pool.firstUnstepped()
 /// on were spawned this tick: schemes with history start them on their own.
 ///
+/// When the forces prescribe velocity (advection, ForceSet::prescribesVelocity), step() runs the
+/// scheme's first-order counterpart instead (advectionScheme(); see integrators/Advection.h).
+///
 /// Implementations keep scratch columns between calls, so one instance serves one pool.
 class Integrator {
  public:
-  virtual ~Integrator() = default;
+  Integrator();
+  virtual ~Integrator();
+  Integrator(const Integrator&) = delete;
+  Integrator& operator=(const Integrator&) = delete;
   /// The name used in effect files ("semi_implicit_euler", ...).
   virtual std::string_view name() const = 0;
   /// Order of the global position error for smooth forces that depend on time only: 1, 2 or 4
@@ -41,7 +48,18 @@ class Integrator {
   virtual int order() const = 0;
   /// Force evaluations per tick (RK4: 4).
   virtual int evaluationsPerStep() const = 0;
-  virtual void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) = 0;
+  /// How this scheme advances x' = u(x, t) when the forces prescribe velocity.
+  virtual AdvectionScheme advectionScheme() const = 0;
+
+  /// Advances rows [0, pool.size()) by one tick: integrate(), or the advection scheme.
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time);
+
+ protected:
+  /// The scheme itself, under forces that add acceleration.
+  virtual void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) = 0;
+
+ private:
+  std::unique_ptr<Advection> advection_;  // made on the first advected step
 };
 
 /// The integrator called `name`; throws std::invalid_argument for an unknown name.

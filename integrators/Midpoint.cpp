@@ -2,7 +2,7 @@
 
 namespace tickfx {
 
-void Midpoint::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
   const float dt = time.dt();
   const float halfDt = 0.5f * dt;
   Vec3Column& p = pool.position();

@@ -16,7 +16,10 @@ class Midpoint final : public Integrator {
   std::string_view name() const override { return "midpoint"; }
   int order() const override { return 2; }
   int evaluationsPerStep() const override { return 2; }
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  AdvectionScheme advectionScheme() const override { return AdvectionScheme::Midpoint; }
+
+ protected:
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
   StageScratch scratch_{2};  // acceleration, midpoint velocity

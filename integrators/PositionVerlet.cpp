@@ -2,7 +2,7 @@
 
 namespace tickfx {
 
-void PositionVerlet::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
   const float dt = time.dt();
   const float dt2 = dt * dt;
   const float halfDt2 = 0.5f * dt2;

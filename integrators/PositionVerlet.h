@@ -20,7 +20,10 @@ class PositionVerlet final : public Integrator {
   std::string_view name() const override { return "position_verlet"; }
   int order() const override { return 2; }
   int evaluationsPerStep() const override { return 1; }
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  AdvectionScheme advectionScheme() const override { return AdvectionScheme::Euler; }
+
+ protected:
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
   StageScratch scratch_{2};  // acceleration, new position

@@ -8,7 +8,7 @@ enum Slot : int { kState = -1, K1 = 0, K2, K3, K4, P2, V2, P3, V3, P4, V4 };
 
 }  // namespace
 
-void RungeKutta4::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
   const float h = time.dt();
   const float halfH = 0.5f * h;
   const float sixthH = h / 6.0f;

@@ -13,7 +13,10 @@ class RungeKutta4 final : public Integrator {
   std::string_view name() const override { return "rk4"; }
   int order() const override { return 4; }
   int evaluationsPerStep() const override { return 4; }
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  AdvectionScheme advectionScheme() const override { return AdvectionScheme::RungeKutta4; }
+
+ protected:
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
   StageScratch scratch_{10};  // k1..k4, then the stage states p2 v2 p3 v3 p4 v4

@@ -2,7 +2,8 @@
 
 namespace tickfx {
 
-void SemiImplicitEuler::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces,
+                                  const StepTime& time) {
   const float dt = time.dt();
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();

@@ -13,7 +13,10 @@ class SemiImplicitEuler final : public Integrator {
   std::string_view name() const override { return "semi_implicit_euler"; }
   int order() const override { return 1; }
   int evaluationsPerStep() const override { return 1; }
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  AdvectionScheme advectionScheme() const override { return AdvectionScheme::Euler; }
+
+ protected:
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
   StageScratch scratch_{1};  // acceleration

@@ -2,7 +2,7 @@
 
 namespace tickfx {
 
-void VelocityVerlet::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
   const float dt = time.dt();
   const float halfDt = 0.5f * dt;
   const float halfDt2 = 0.5f * dt * dt;

@@ -15,7 +15,10 @@ class VelocityVerlet final : public Integrator {
   std::string_view name() const override { return "velocity_verlet"; }
   int order() const override { return 2; }
   int evaluationsPerStep() const override { return 1; }
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  AdvectionScheme advectionScheme() const override { return AdvectionScheme::Heun; }
+
+ protected:
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
   StageScratch scratch_{2};  // predicted velocity, new acceleration

@@ -99,8 +99,10 @@ void ParticleSystem::runTick() {
     if (p.tick == tick_) spawnStructure(p);
   }
   forces_.beginTick(pool_, tick_);
-  integrator_->step(pool_, forces_, StepTime{tick_, settings_.stepRateHz});
+  const StepTime time{tick_, settings_.stepRateHz};
+  integrator_->step(pool_, forces_, time);
   pool_.markAllStepped();
+  forces_.endTick(pool_, tick_, time.at(1.0));
   ++tick_;
   pool_.updateAges(tick_, settings_.stepRateHz);
   pool_.removeDead();
