@@ -28,9 +28,7 @@ std::string framePath(const VectorField::Settings& s, int frame) {
   std::string path = s.file;
   const std::string key = "{frame}";
   const std::size_t at = path.find(key);
-  if (at == std::string::npos) {
-    throw std::invalid_argument(s.file + ": a field sequence needs {frame} in the file name");
-  }
+  if (at == std::string::npos) return path + " (frame " + number + ")";  // grids made in memory
   path.replace(at, key.size(), number);
   return path;
 }
@@ -169,15 +167,32 @@ struct ImplT final : VectorField::Impl {
   using Accessor = typename GridT::ConstAccessor;
   std::vector<typename GridT::ConstPtr> grids;
 
-  // One frame: a grid's accessor (built per call) and its transform.
+  // One frame: a grid's accessor (built per call) and its transform. The maps baked and written
+  // by most tools (a uniform voxel size, with or without an offset) are final classes: calling
+  // them directly lets the compiler inline world → index, which a virtual call through the
+  // Transform would not. The arithmetic is the map's own, so the bits are the same.
   struct Frame {
+    Frame(const GridT& grid)
+        : acc(grid.getConstAccessor()),
+          xform(&grid.transform()),
+          scale(xform->template constMap<openvdb::math::UniformScaleMap>().get()),
+          scaleTranslate(
+              xform->template constMap<openvdb::math::UniformScaleTranslateMap>().get()) {}
     Accessor acc;
     const openvdb::math::Transform* xform;
+    const openvdb::math::UniformScaleMap* scale;
+    const openvdb::math::UniformScaleTranslateMap* scaleTranslate;
+
+    openvdb::Vec3d toIndex(const openvdb::Vec3d& world) const {
+      if (scale != nullptr) return scale->applyInverseMap(world);
+      if (scaleTranslate != nullptr) return scaleTranslate->applyInverseMap(world);
+      return xform->worldToIndex(world);
+    }
   };
 
   template <class Sampler>
   static Eigen::Vector3f at(Frame& f, const openvdb::Vec3d& world, bool zeroOutside) {
-    const openvdb::Vec3d index = f.xform->worldToIndex(world);
+    const openvdb::Vec3d index = f.toIndex(world);
     if (zeroOutside && !f.acc.isValueOn(openvdb::Coord::round(index))) {
       return Eigen::Vector3f::Zero();
     }
@@ -190,8 +205,8 @@ struct ImplT final : VectorField::Impl {
   void kernel(const VectorField::Settings& s, const ForceInput& in, RowRange rows, Vec3Rows* a,
               Eigen::Vector3f* single, std::uint8_t* dead, std::size_t f0, std::size_t f1,
               float w) const {
-    Frame first{grids[f0]->getConstAccessor(), &grids[f0]->transform()};
-    Frame second{grids[f1]->getConstAccessor(), &grids[f1]->transform()};
+    Frame first(*grids[f0]);
+    Frame second(*grids[f1]);
     const bool blend = f1 != f0 && w != 0.0f;
     const bool zero = s.outside != VectorField::Outside::Background;
     const float one = 1.0f - w;
@@ -201,7 +216,7 @@ struct ImplT final : VectorField::Impl {
       // float → double is exact; the sample is rounded to float once.
       const openvdb::Vec3d world(p.x[j], p.y[j], p.z[j]);
       if (dead != nullptr) {
-        const openvdb::Vec3d index = first.xform->worldToIndex(world);
+        const openvdb::Vec3d index = first.toIndex(world);
         if (!first.acc.isValueOn(openvdb::Coord::round(index))) {
           dead[rows.begin + static_cast<std::size_t>(j)] = 1;
         }
@@ -322,6 +337,9 @@ int frameSpan(const VectorField::Settings& s) {
 
 VectorField::VectorField(const Settings& settings) : s_(settings) {
   const int frames = frameSpan(s_);
+  if (s_.fps > 0.0 && s_.file.find("{frame}") == std::string::npos) {
+    throw std::invalid_argument(s_.file + ": a field sequence needs {frame} in the file name");
+  }
   std::vector<openvdb::GridBase::Ptr> raw;
   for (int f = s_.firstFrame; f < s_.firstFrame + frames; ++f) {
     raw.push_back(readGrid(framePath(s_, f), s_.grid));

@@ -28,8 +28,9 @@ struct SystemSettings {
 };
 
 /// The simulation. One tick does, in this order: emit the tick's particles, let the forces
-/// rebuild their tables, integrate every particle from t_k to t_{k+1}, recompute ages from the
-/// tick count and remove the dead. Nothing in a tick reads the frame time, so the state after
+/// rebuild their tables, integrate every particle from t_k to t_{k+1} (or advect it, when the
+/// forces prescribe velocity), let the forces flag particles dead at the new state (a field's
+/// kill region), recompute ages from the tick count and remove the dead. Nothing in a tick reads the frame time, so the state after
 /// tick k is the same for any sequence of frames that reaches it.
 ///
 /// Not thread-safe: one thread drives a system; the system uses its own TBB arena inside a tick.

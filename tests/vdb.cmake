@@ -4,3 +4,7 @@ if(TARGET tickfx_vdb)
   tickfx_add_test(test_vdb_field ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_field.cpp
     LIBS tickfx::vdb OpenVDB::openvdb)
 endif()
+if(TARGET tickfx_vdb)
+  tickfx_add_test(test_vdb_advect ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_advect.cpp
+    LIBS tickfx::vdb OpenVDB::openvdb)
+endif()
