@@ -164,7 +164,9 @@ namespace {
 template <class GridT>
 struct ImplT final : VectorField::Impl {
   using ValueT = typename GridT::ValueType;
-  using Accessor = typename GridT::ConstAccessor;
+  // Unregistered: the grids never change after loading, and registering an accessor with the tree
+  // locks a shared table at every construction (once per tile and pass).
+  using Accessor = typename GridT::ConstUnsafeAccessor;
   std::vector<typename GridT::ConstPtr> grids;
 
   // One frame: a grid's accessor (built per call) and its transform. The maps baked and written
@@ -173,7 +175,7 @@ struct ImplT final : VectorField::Impl {
   // Transform would not. The arithmetic is the map's own, so the bits are the same.
   struct Frame {
     Frame(const GridT& grid)
-        : acc(grid.getConstAccessor()),
+        : acc(grid.getConstUnsafeAccessor()),
           xform(&grid.transform()),
           scale(xform->template constMap<openvdb::math::UniformScaleMap>().get()),
           scaleTranslate(
