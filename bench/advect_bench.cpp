@@ -8,7 +8,10 @@
 //
 // The field: seeded curl noise (|u| ≈ 1 m/s, wave number 2 rad/m) baked at 5 cm into a float grid
 // over [−2, 2]³ m (81³ active voxels); the particles start on a Weyl sequence in [−1.5, 1.5]³
-// and stay inside over a batch. Step 1/24 s.
+// and stay inside over a batch. Step 1/24 s. Two layouts of the same points:
+//   scattered    in sequence order: consecutive particles are far apart, every sample a cache miss
+//   coherent     sorted by leaf node (8³ voxels) then voxel, as particles born together and
+//                moving together are: consecutive samples share leaves.
 //
 // Cases, each on its own copy of the points:
 //   tickfx       Integrator::step on a ParticlePool whose only module is a VectorField in advect
@@ -24,6 +27,7 @@
 #include <openvdb/tools/PointAdvect.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -32,6 +36,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <unistd.h>
@@ -141,7 +146,18 @@ int main(int argc, char** argv) {
     std::remove(path.c_str());
   }
   const auto grid = openvdb::gridPtrCast<openvdb::Vec3fGrid>(grids.grids.front());
-  const std::vector<openvdb::Vec3f> start = startingPoints(count);
+  const std::vector<openvdb::Vec3f> scattered = startingPoints(count);
+  std::vector<openvdb::Vec3f> coherentPoints = scattered;
+  {
+    const auto key = [&](const openvdb::Vec3f& p) {
+      const openvdb::Coord ijk = grid->transform().worldToIndexCellCentered(p);
+      const openvdb::Coord leaf = ijk >> 3;
+      return std::make_tuple(leaf.z(), leaf.y(), leaf.x(), ijk.z(), ijk.y(), ijk.x());
+    };
+    std::stable_sort(coherentPoints.begin(), coherentPoints.end(),
+                     [&](const auto& a, const auto& b) { return key(a) < key(b); });
+  }
+  const std::vector<openvdb::Vec3f>& coherent = coherentPoints;
   const float dt = tickfx::StepTime{0, kStepRateHz}.dt();
 
   std::printf(
@@ -164,45 +180,49 @@ int main(int argc, char** argv) {
   std::vector<std::unique_ptr<std::vector<openvdb::Vec3f>>> theirs;
   std::vector<std::unique_ptr<tbb::task_arena>> arenas;
   std::vector<AdvectCase> cases;
-  for (const int order : {1, 4}) {
-    for (const int threads : {1, 2}) {
-      arenas.push_back(std::make_unique<tbb::task_arena>(threads));
-      tbb::task_arena* arena = arenas.back().get();
-      auto o = std::make_unique<Ours>(
-          Ours{tickfx::ParticlePool(count), tickfx::ForceSet(),
-               tickfx::makeIntegrator(order == 1 ? "explicit_euler" : "rk4"), 0});
-      o->forces.add(std::make_unique<tickfx::VectorField>(settings, grids));
-      load(o->pool, start);
-      Ours* self = o.get();
-      ours.push_back(std::move(o));
-      cases.emplace_back(
-          "tickfx",
-          [=, &start](std::int64_t ticks) {
-            arena->execute([&] {
-              load(self->pool, start);
-              for (std::int64_t k = 0; k < ticks; ++k) {
-                self->integrator->step(self->pool, self->forces, {k, kStepRateHz});
-              }
-            });
-            bench::escape(self->pool.position().x.data());
-          },
-          order, threads, true);
-      theirs.push_back(std::make_unique<std::vector<openvdb::Vec3f>>(start));
-      std::vector<openvdb::Vec3f>* points = theirs.back().get();
-      cases.emplace_back(
-          "PointAdvect",
-          [=, &start, &grid](std::int64_t ticks) {
-            openvdb::tools::PointAdvect<openvdb::Vec3fGrid, std::vector<openvdb::Vec3f>, false>
-                advector(*grid);
-            advector.setIntegrationOrder(static_cast<unsigned>(order));
-            advector.setThreaded(true);
-            arena->execute([&] {
-              *points = start;
-              for (std::int64_t k = 0; k < ticks; ++k) advector.advect(*points, dt, 1);
-            });
-            bench::escape(points->data());
-          },
-          order, threads, false);
+  for (const std::vector<openvdb::Vec3f>* layout : {&scattered, &coherent}) {
+    const std::vector<openvdb::Vec3f>& start = *layout;
+    const char* layoutName = layout == &scattered ? "scattered" : "coherent";
+    for (const int order : {1, 4}) {
+      for (const int threads : {1, 2}) {
+        arenas.push_back(std::make_unique<tbb::task_arena>(threads));
+        tbb::task_arena* arena = arenas.back().get();
+        auto o = std::make_unique<Ours>(
+            Ours{tickfx::ParticlePool(count), tickfx::ForceSet(),
+                 tickfx::makeIntegrator(order == 1 ? "explicit_euler" : "rk4"), 0});
+        o->forces.add(std::make_unique<tickfx::VectorField>(settings, grids));
+        load(o->pool, start);
+        Ours* self = o.get();
+        ours.push_back(std::move(o));
+        cases.emplace_back(
+            std::string(layoutName) + " tickfx",
+            [=, &start](std::int64_t ticks) {
+              arena->execute([&] {
+                load(self->pool, start);
+                for (std::int64_t k = 0; k < ticks; ++k) {
+                  self->integrator->step(self->pool, self->forces, {k, kStepRateHz});
+                }
+              });
+              bench::escape(self->pool.position().x.data());
+            },
+            order, threads, true);
+        theirs.push_back(std::make_unique<std::vector<openvdb::Vec3f>>(start));
+        std::vector<openvdb::Vec3f>* points = theirs.back().get();
+        cases.emplace_back(
+            std::string(layoutName) + " PointAdvect",
+            [=, &start, &grid](std::int64_t ticks) {
+              openvdb::tools::PointAdvect<openvdb::Vec3fGrid, std::vector<openvdb::Vec3f>, false>
+                  advector(*grid);
+              advector.setIntegrationOrder(static_cast<unsigned>(order));
+              advector.setThreaded(true);
+              arena->execute([&] {
+                *points = start;
+                for (std::int64_t k = 0; k < ticks; ++k) advector.advect(*points, dt, 1);
+              });
+              bench::escape(points->data());
+            },
+            order, threads, false);
+      }
     }
   }
 
@@ -218,20 +238,20 @@ int main(int argc, char** argv) {
       differ += pool.position().x[e] != points[r].x() || pool.position().y[e] != points[r].y() ||
                 pool.position().z[e] != points[r].z();
     }
-    std::printf("order %d, %d thread(s): %zu of %zu positions differ after 3 steps\n",
-                cases[i].order, cases[i].threads, differ, count);
+    std::printf("%s, order %d, %d thread(s): %zu of %zu positions differ after 3 steps\n",
+                cases[i].name.c_str(), cases[i].order, cases[i].threads, differ, count);
   }
 
   bench::timeCases(cases, cl.timing);
 
-  std::printf("\n%-6s %-8s %-12s %16s %12s %8s\n", "order", "threads", "case", "particle-steps/s",
+  std::printf("\n%-6s %-8s %-22s %16s %12s %8s\n", "order", "threads", "case", "particle-steps/s",
               "ms/step", "ratio");
   for (std::size_t i = 0; i < cases.size(); i += 2) {
     const double oursT = bench::median(cases[i].secondsPerTick);
     const double theirsT = bench::median(cases[i + 1].secondsPerTick);
     for (const AdvectCase* c : {&cases[i], &cases[i + 1]}) {
       const double t = c->ours ? oursT : theirsT;
-      std::printf("%-6d %-8d %-12s %16.3e %12.3f %8.2f\n", c->order, c->threads, c->name.c_str(),
+      std::printf("%-6d %-8d %-22s %16.3e %12.3f %8.2f\n", c->order, c->threads, c->name.c_str(),
                   static_cast<double>(count) / t, 1e3 * t, theirsT / t);
     }
   }

@@ -145,6 +145,37 @@ Eigen::Vector3f toFloat(const openvdb::Vec3d& v) {
   return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
 }
 
+/// openvdb::tools::BoxSampler with the same result bit for bit, faster where it matters. BoxSampler
+/// reads the eight corners of the cell with eight accessor probes; when the cell lies inside one
+/// leaf node (7³ of its 8³ base corners: two cells in three for scattered points) this reads them
+/// from the leaf directly, then interpolates with BoxSampler's own function. Other cells, and
+/// cells where no leaf is allocated, go through BoxSampler itself.
+struct LeafBoxSampler {
+  template <class Accessor, class ValueT>
+  static void sample(Accessor& acc, const openvdb::Vec3R& index, ValueT& result) {
+    using Leaf = typename Accessor::TreeType::LeafNodeType;
+    const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(index);
+    const openvdb::Coord ijk(base);
+    constexpr openvdb::Int32 kLast = static_cast<openvdb::Int32>(Leaf::DIM) - 1;
+    const openvdb::Int32 i = ijk.x() & kLast, j = ijk.y() & kLast, k = ijk.z() & kLast;
+    const Leaf* leaf = i < kLast && j < kLast && k < kLast ? acc.probeConstLeaf(ijk) : nullptr;
+    if (leaf == nullptr) {
+      openvdb::tools::BoxSampler::sample(acc, index, result);
+      return;
+    }
+    constexpr openvdb::Index kDx = 1u << (2 * Leaf::LOG2DIM), kDy = 1u << Leaf::LOG2DIM;
+    const openvdb::Index o = Leaf::coordToOffset(ijk);
+    ValueT data[2][2][2];
+    for (openvdb::Index a = 0; a < 2; ++a) {
+      for (openvdb::Index b = 0; b < 2; ++b) {
+        for (openvdb::Index c = 0; c < 2; ++c)
+          data[a][b][c] = leaf->getValue(o + a * kDx + b * kDy + c);
+      }
+    }
+    result = openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
+  }
+};
+
 }  // namespace
 
 /// The grids, their precision hidden behind one virtual call per accumulate().
@@ -274,7 +305,7 @@ struct ImplT final : VectorField::Impl {
     } else if (quadratic) {
       kernel<vt::QuadraticSampler>(s, in, rows, a, single, dead, f0, f1, w);
     } else {
-      kernel<vt::BoxSampler>(s, in, rows, a, single, dead, f0, f1, w);
+      kernel<LeafBoxSampler>(s, in, rows, a, single, dead, f0, f1, w);
     }
   }
 };
