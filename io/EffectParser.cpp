@@ -37,7 +37,7 @@ constexpr std::int64_t kMaxFrameRatePart = 1'000'000;
 
 const std::vector<std::string> kShapes = {"point", "sphere", "box", "disc"};
 const std::vector<std::string> kOverrunPolicies = {"drop", "fall_behind"};
-const std::vector<std::string> kCacheFormats = {"csv", "ply"};
+const std::vector<std::string> kCacheFormats = {"csv", "ply", "vdb"};
 
 // Parameters of each shape and each force type, to tell "does not apply here" from "unknown".
 const std::map<std::string, std::vector<std::string>>& shapeKeys() {
@@ -951,7 +951,9 @@ void readOutput(Context& cx, const toml::table& table, OutputSettings& out) {
           ok = false;
           continue;
         }
-        const CacheFormat f = *name == "csv" ? CacheFormat::Csv : CacheFormat::Ply;
+        const CacheFormat f = *name == "csv"   ? CacheFormat::Csv
+                              : *name == "ply" ? CacheFormat::Ply
+                                               : CacheFormat::Vdb;
         if (std::find(formats.begin(), formats.end(), f) != formats.end()) {
           cx.error(cx.at(*array->get(i)), entryPath,
                    quote(*name) + " is listed twice (expected each format at most once)");

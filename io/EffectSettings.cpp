@@ -67,7 +67,15 @@ std::string structureKeyPath(const EffectSettings& effect, std::size_t index) {
 }
 
 std::string_view cacheFormatName(CacheFormat format) {
-  return format == CacheFormat::Csv ? "csv" : "ply";
+  switch (format) {
+    case CacheFormat::Csv:
+      return "csv";
+    case CacheFormat::Ply:
+      return "ply";
+    case CacheFormat::Vdb:
+      return "vdb";
+  }
+  return "csv";
 }
 
 std::int64_t OutputSettings::frameCount() const {

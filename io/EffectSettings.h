@@ -73,8 +73,8 @@ const std::vector<std::string>& clothPinsNames();
 /// count · clusterNeighbours / 2 springs.
 double clusterNeighbours(const ClusterShape& cluster);
 
-enum class CacheFormat { Csv, Ply };
-/// "csv" or "ply".
+enum class CacheFormat { Csv, Ply, Vdb };
+/// "csv", "ply" or "vdb".
 std::string_view cacheFormatName(CacheFormat format);
 
 /// The [output] table: what `tickfx run` writes.
