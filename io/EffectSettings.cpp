@@ -21,7 +21,7 @@ const std::vector<std::string>& forceTypeNames() {
 }
 
 const std::vector<std::string>& emitterTypeNames() {
-  static const std::vector<std::string> names = {"particles", "rope", "cloth", "cluster"};
+  static const std::vector<std::string> names = {"particles", "file", "rope", "cloth", "cluster"};
   return names;
 }
 

@@ -1,9 +1,12 @@
-# VDB point caches (io/VdbPointCache): the cache read back through OpenVDB itself, and `tickfx run
-# --format vdb` as a user runs it, checked with vdb_print when it is installed. The io/ suites are
-# named io* so that `ctest -R io` selects them. Every test writes into a temporary directory of
-# its own.
+# VDB point caches (io/VdbPointCache) and the file emitter ([[emitters]] type = "file"): the
+# cache read back through OpenVDB itself, the emitter fed from CSV and VDB files with its
+# effect-file messages, and `tickfx run --format vdb` as a user runs it, checked with vdb_print
+# when it is installed. The io/ suites are named io* so that `ctest -R io` selects them. Every
+# test writes into a temporary directory of its own.
 if(TARGET tickfx_io)
   tickfx_add_test(test_vdb_points ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_points.cpp
+    LIBS tickfx::io OpenVDB::openvdb)
+  tickfx_add_test(test_file_emitter ${CMAKE_CURRENT_SOURCE_DIR}/test_file_emitter.cpp
     LIBS tickfx::io OpenVDB::openvdb)
 endif()
 if(TARGET tickfx_cli)

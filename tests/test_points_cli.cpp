@@ -1,6 +1,6 @@
-// `tickfx run --format vdb` as a user runs it: the VDB caches hold what the CSV caches of the
-// same run hold, and vdb_print lists them with their point counts. Everything is written into the
-// test's own directory.
+// `tickfx run --format vdb` and the file emitter as a user runs them: the VDB caches hold what
+// the CSV caches of the same run hold, vdb_print lists them with their point counts, and an
+// effect can be seeded from a cache. Everything is written into the test's own directory.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -150,5 +150,32 @@ TEST_F(CliPoints, VdbPrintListsThePointsGridWithItsPointCount) {
   }
 }
 #endif
+
+TEST_F(CliPoints, AnEffectSeededFromACacheChecksAndRuns) {
+  ASSERT_EQ(tickfx("run samples/fountain.toml --frames 3 --format vdb,csv --out " + path("c")).exit,
+            0);
+  const auto rows = tickfx::io::readCsvCache(path("c/frame_0003.csv")).size();
+  for (const char* file : {"c/frame_0003.vdb", "c/frame_0003.csv"}) {
+    std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"
+                                      "[[emitters]]\ntype = \"file\"\nfile = \""
+                                   << file << "\"\n[[forces]]\ntype = \"gravity\"\n";
+    const Result check = tickfx("check " + path("fx.toml"));
+    EXPECT_EQ(check.exit, 0) << check.err;
+    const Result r = tickfx("run " + path("fx.toml") + " --frames 2 --format none");
+    ASSERT_EQ(r.exit, 0) << r.err;
+    EXPECT_NE(r.out.find("particles alive: " + std::to_string(rows) + " "), std::string::npos)
+        << r.out;
+  }
+  // A missing points file is an effect error: exit 2, nothing written.
+  std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"
+                                    "[[emitters]]\ntype = \"file\"\nfile = \"nope.vdb\"\n";
+  const Result r = tickfx("run " + path("fx.toml") + " --frames 2 --out " + path("o"));
+  EXPECT_EQ(r.exit, 2);
+  EXPECT_NE(r.err.find(path("fx.toml") + ":6:8: error: emitters.0.file: no such file \"" +
+                       path("nope.vdb") + "\""),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(path("o")));
+}
 
 }  // namespace
