@@ -662,8 +662,7 @@ bool readPointFile(Context& cx, const toml::node& node, const std::string& path,
 std::map<std::string, std::string> notForFileEmitter() {
   const std::vector<std::string>& own = fileEmitterKeys();
   const std::string message =
-      "does not apply to an emitter of type \"file\" (expected for a file "
-      "emitter: " +
+      "does not apply to an emitter of type \"file\" (expected for a file emitter: " +
       joinWords(own) + ")";
   std::map<std::string, std::string> out;
   const auto add = [&](const std::vector<std::string>& keys) {
@@ -693,11 +692,12 @@ void readFileEmitter(Context& cx, const toml::table& table, std::size_t index,
   if (named && readPointFile(cx, *table.get("file"), r.pathOf("file"), name, points)) {
     if (!points.velocities.empty()) {
       // The file says how each particle starts: the emitter's velocity keys would be ignored.
+      const std::string shown = "\"" + (cx.directory() / name).string() + "\"";
       for (const char* key : {"direction", "speed", "speed_jitter", "spread"}) {
         if (const toml::node* node = table.get(key)) {
           cx.error(cx.at(*node), r.pathOf(key),
-                   "does not apply: " + std::string("\"") + (cx.directory() / name).string() +
-                       "\" gives every point its velocity (expected direction, speed, "
+                   "does not apply: " + shown +
+                       " gives every point its velocity (expected direction, speed, "
                        "speed_jitter and spread only with a .vdb file without v)");
         }
       }

@@ -35,7 +35,8 @@ struct VdbCacheContents {
 
 /// Writes `frame` to `path` (atomically: into a temporary beside it, then renamed; an error
 /// leaves no file and an existing `path` untouched) as one OpenVDB PointDataGrid named "points",
-/// every value stored uncompressed so that it reads back bit for bit:
+/// every value stored whole (OpenVDB's null codec, no quantisation; the file itself is compressed
+/// losslessly) so that it reads back bit for bit:
 ///   P   vec3s, positions in metres, OpenVDB's way: the voxel's index plus P, times the voxel
 ///       size. The voxel size is 1 m (multiplying by 1 is exact: any other size would lose the
 ///       low bits of some positions), each point in the voxel nearest to it, so P is the offset
