@@ -22,6 +22,7 @@
 #include "io/FrameTimes.h"
 #include "io/PlyCache.h"
 #include "io/StateDump.h"
+#include "io/VdbPointCache.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {
@@ -40,7 +41,8 @@ constexpr const char* kHelp =
     "  --frame-times FILE    one frame duration in seconds a line\n"
     "Output:\n"
     "  --out DIR             cache directory (default: the effect's output.directory)\n"
-    "  --format LIST         comma-separated: csv, ply; 'none' writes no caches\n"
+    "  --format LIST         comma-separated: csv, ply, vdb (OpenVDB points); 'none' writes no\n"
+    "                        caches\n"
     "  --hash                print 'state-hash: <16 hex digits>' and 'ticks: N' of the last tick\n"
     "  --dump FILE           write the last tick's state as CSV: id,px,py,pz,vx,vy,vz,age\n"
     "  --trace FILE          write the state hash after every tick (tick,state_hash): diff two\n"
@@ -66,11 +68,15 @@ std::vector<io::CacheFormat> parseFormats(const std::string& text) {
       formats.push_back(io::CacheFormat::Csv);
     } else if (name == "ply") {
       formats.push_back(io::CacheFormat::Ply);
+    } else if (name == "vdb") {
+      formats.push_back(io::CacheFormat::Vdb);
     } else {
-      throw UsageError("run: --format: unknown format '" + name + "' (expected csv, ply or none)");
+      throw UsageError("run: --format: unknown format '" + name +
+                       "' (expected csv, ply, vdb or none)");
     }
   }
-  if (formats.empty()) throw UsageError("run: --format: empty list (expected csv, ply or none)");
+  if (formats.empty())
+    throw UsageError("run: --format: empty list (expected csv, ply, vdb or none)");
   return formats;
 }
 
@@ -209,6 +215,10 @@ int runCommand(Arguments& args) {
   const std::filesystem::path checkpoints =
       checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
   const std::uint64_t effectHash = effectFingerprint(effectPath, overrides);
+  // What a VDB cache records of the run, for the pipeline that reads it.
+  const io::VdbCacheMetadata vdbMeta{hashToHex(effectHash), effect.simulation.seed,
+                                     effect.simulation.stepRateHz, effect.simulation.integrator,
+                                     TICKFX_VERSION};
 
   const auto system = io::buildSystem(effect, threadOverride);
   std::int64_t firstFrame = 1;
@@ -262,6 +272,8 @@ int runCommand(Arguments& args) {
       for (io::CacheFormat fmt : formats) {
         if (fmt == io::CacheFormat::Csv) io::writeCsvCache(data, cachePath(outDir, f, "csv"));
         if (fmt == io::CacheFormat::Ply) io::writePlyCache(data, cachePath(outDir, f, "ply"));
+        if (fmt == io::CacheFormat::Vdb)
+          io::writeVdbPointCache(data, vdbMeta, cachePath(outDir, f, "vdb"));
       }
     }
     if (every > 0 && f % every == 0) {

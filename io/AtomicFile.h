@@ -13,4 +13,9 @@ namespace tickfx::io {
 void writeFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write);
 
+/// The same for writers that open files by name themselves (OpenVDB's io::File): `write` is
+/// given the temporary's path, beside `path`, and must leave the whole file there or throw.
+void writeFileAtomicallyByName(const std::filesystem::path& path,
+                               const std::function<void(const std::filesystem::path&)>& write);
+
 }  // namespace tickfx::io

@@ -1,9 +1,11 @@
 #include "io/EffectParser.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -14,8 +16,10 @@
 #include <toml++/toml.h>
 
 #include "integrators/Integrator.h"
+#include "io/CsvCache.h"
 #include "io/EditDistance.h"
 #include "io/SettingOverrides.h"
+#include "io/VdbPointCache.h"
 
 #if !TOML_EXCEPTIONS
 #error "tickfx_io reads parse errors from toml::parse_error: build toml++ with exceptions"
@@ -37,7 +41,16 @@ constexpr std::int64_t kMaxFrameRatePart = 1'000'000;
 
 const std::vector<std::string> kShapes = {"point", "sphere", "box", "disc"};
 const std::vector<std::string> kOverrunPolicies = {"drop", "fall_behind"};
-const std::vector<std::string> kCacheFormats = {"csv", "ply"};
+const std::vector<std::string> kCacheFormats = {"csv", "ply", "vdb"};
+
+// The keys of a file emitter (type "file"): a particle emitter's, with `file` for the shape.
+const std::vector<std::string>& fileEmitterKeys() {
+  static const std::vector<std::string> keys = {
+      "type",         "name",   "file",     "position",        "rate",
+      "start",        "stop",   "bursts",   "direction",       "speed",
+      "speed_jitter", "spread", "lifetime", "lifetime_jitter", "mass"};
+  return keys;
+}
 
 // Parameters of each shape and each force type, to tell "does not apply here" from "unknown".
 const std::map<std::string, std::vector<std::string>>& shapeKeys() {
@@ -181,6 +194,8 @@ class Context {
   }
 
   const OverrideOrigins& origins() const { return origins_; }
+  // The effect file's directory: files an effect names are relative to it.
+  std::filesystem::path directory() const { return std::filesystem::path(file_).parent_path(); }
   std::vector<Diagnostic>& diagnostics() { return diagnostics_; }
   SourceMap& sources() { return sources_; }
 
@@ -530,14 +545,9 @@ std::map<std::string, std::string> notForShape(const std::string& shape) {
 
 std::map<std::string, std::string> notForStructureKeys();
 
-void readEmitter(Context& cx, const toml::table& table, std::size_t index,
-                 std::int64_t maxParticles, EmitterSettings& e) {
-  TableReader r(cx, table, childPath("emitters", index));
-  r.take("type");  // "particles" or absent: judged by readEmitterEntry
-  e.name = "emitter_" + std::to_string(index);
-  r.string("name", e.name, "a name: a non-empty string, unique among the emitters");
-  r.vec3("position", e.position, kPositionText, Range{-kBig, kBig});
-  readShape(r, e);
+// The keys every particle emitter reads after its shape: when, how fast, how long, how heavy.
+void readEmission(Context& cx, const toml::table& table, TableReader& r, std::int64_t maxParticles,
+                  EmitterSettings& e) {
   r.number("rate", e.rate, "particles per second, a number from 0 to 1e9", Range{0.0, kBig});
   r.number("start", e.start, kSecondsText, Range{0.0, kBig});
   double stop = 0.0;
@@ -559,12 +569,154 @@ void readEmitter(Context& cx, const toml::table& table, std::size_t index,
   r.number("lifetime_jitter", e.lifetimeJitter, "a fraction >= 0 and < 1",
            Range{0.0, 1.0, false, true});
   r.number("mass", e.mass, "kilograms, a number > 0 and <= 1e9", Range{0.0, kBig, true});
+}
+
+void readEmitter(Context& cx, const toml::table& table, std::size_t index,
+                 std::int64_t maxParticles, EmitterSettings& e) {
+  TableReader r(cx, table, childPath("emitters", index));
+  r.take("type");  // "particles" or absent: judged by readEmitterEntry
+  e.name = "emitter_" + std::to_string(index);
+  r.string("name", e.name, "a name: a non-empty string, unique among the emitters");
+  r.vec3("position", e.position, kPositionText, Range{-kBig, kBig});
+  readShape(r, e);
+  readEmission(cx, table, r, maxParticles, e);
 
   std::string shape = "point";
   if (const toml::node* s = table.get("shape")) shape = s->value_or<std::string>("");
   std::map<std::string, std::string> notHere = notForStructureKeys();
   if (shapeKeys().count(shape) != 0) notHere.merge(notForShape(shape));
   r.finish(notHere);
+}
+
+// ---- file emitters: [[emitters]] of type "file" -------------------------------------------------
+
+const std::string kPointFileText =
+    "a points file relative to the effect file: .vdb (OpenVDB points, grid \"points\") or .csv "
+    "(a tickfx CSV cache)";
+
+// "[x, y, z]" with the shortest digits that read back to each float ("1e+30", not the double's
+// "1.0000000150474662e+30").
+std::string vectorText(const Eigen::Vector3f& v) {
+  std::string out = "[";
+  for (int c = 0; c < 3; ++c) {
+    char digits[32];
+    const auto end = std::to_chars(digits, digits + sizeof digits, v[c]).ptr;
+    out += std::string(digits, end) + (c < 2 ? ", " : "]");
+  }
+  return out;
+}
+
+// Reads the points of the file `name` (the value of `node`, at `path`) into `out`: positions
+// and, when the file has them, velocities. Reports what is wrong at the node.
+bool readPointFile(Context& cx, const toml::node& node, const std::string& path,
+                   const std::string& name, PointListShape& out) {
+  const std::filesystem::path file = cx.directory() / name;
+  const std::string shown = "\"" + file.string() + "\"";
+  const auto fail = [&](const std::string& what, const std::string& expected = kPointFileText) {
+    cx.error(cx.at(node), path, what + " (expected " + expected + ")");
+    return false;
+  };
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".vdb" && extension != ".csv") {
+    return fail(shown + " is neither a .vdb nor a .csv file");
+  }
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) return fail("no such file " + shown);
+  if (std::filesystem::is_directory(file, ec)) return fail(shown + " is a directory");
+  FrameData points;
+  bool hasVelocity = true;  // a CSV cache always has vx, vy, vz
+  try {
+    if (extension == ".vdb") {
+      VdbCacheContents contents;
+      points = readVdbPointCache(file, &contents);
+      hasVelocity = contents.hasVelocity;
+    } else {
+      points = readCsvCache(file);
+    }
+  } catch (const std::exception& e) {
+    return fail(shown + " cannot be read: " + e.what());
+  }
+  if (points.size() == 0) return fail(shown + " holds no points", kPointFileText + ", not empty");
+  out.positions.resize(points.size());
+  out.velocities.resize(hasVelocity ? points.size() : 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto row = static_cast<Eigen::Index>(i);
+    const Eigen::Vector3f x(points.position[0][row], points.position[1][row],
+                            points.position[2][row]);
+    const Eigen::Vector3f v(points.velocity[0][row], points.velocity[1][row],
+                            points.velocity[2][row]);
+    const std::string which = shown + ": the point of id " + std::to_string(points.id[i]);
+    const std::string expected = "points and velocities with every coordinate from -1e9 to 1e9";
+    if (!(x.array().abs() <= kBig).all()) return fail(which + " is at " + vectorText(x), expected);
+    if (hasVelocity && !(v.array().abs() <= kBig).all()) {
+      return fail(which + " has the velocity " + vectorText(v), expected);
+    }
+    out.positions[i] = x;
+    if (hasVelocity) out.velocities[i] = v;
+  }
+  return true;
+}
+
+// Keys of particle emitters (shapes) and of structures, on a file emitter.
+std::map<std::string, std::string> notForFileEmitter() {
+  const std::vector<std::string>& own = fileEmitterKeys();
+  const std::string message =
+      "does not apply to an emitter of type \"file\" (expected for a file emitter: " +
+      joinWords(own) + ")";
+  std::map<std::string, std::string> out;
+  const auto add = [&](const std::vector<std::string>& keys) {
+    for (const std::string& k : keys) {
+      if (std::find(own.begin(), own.end(), k) == own.end()) out[k] = message;
+    }
+  };
+  add(particleEmitterKeys());
+  add(structureCommonKeys());
+  for (const auto& [type, keys] : structureKeys()) add(keys);
+  return out;
+}
+
+// A particle emitter whose particles are born at the points of a file, in turn (PointListShape).
+void readFileEmitter(Context& cx, const toml::table& table, std::size_t index,
+                     std::int64_t maxParticles, EmitterSettings& e) {
+  TableReader r(cx, table, childPath("emitters", index));
+  r.take("type");
+  e.name = "file_" + std::to_string(index);
+  r.string("name", e.name, "a name: a non-empty string, unique among the emitters");
+  std::string name;
+  const bool named = r.string("file", name, kPointFileText);
+  if (table.get("file") == nullptr) r.missing("file", kPointFileText);
+  r.vec3("position", e.position, kPositionText, Range{-kBig, kBig});
+  readEmission(cx, table, r, maxParticles, e);
+  PointListShape points;
+  if (named && readPointFile(cx, *table.get("file"), r.pathOf("file"), name, points)) {
+    if (!points.velocities.empty()) {
+      // The file says how each particle starts: the emitter's velocity keys would be ignored.
+      const std::string shown = "\"" + (cx.directory() / name).string() + "\"";
+      for (const char* key : {"direction", "speed", "speed_jitter", "spread"}) {
+        if (const toml::node* node = table.get(key)) {
+          cx.error(cx.at(*node), r.pathOf(key),
+                   "does not apply: " + shown +
+                       " gives every point its velocity (expected direction, speed, "
+                       "speed_jitter and spread only with a .vdb file without v)");
+        }
+      }
+    }
+    const auto count = static_cast<std::int64_t>(points.positions.size());
+    if (table.get("rate") == nullptr && table.get("bursts") == nullptr) {
+      // Neither rate nor bursts: one burst of every point at `start`.
+      if (count > maxParticles) {
+        cx.error(cx.at(*table.get("file")), r.pathOf("file"),
+                 std::to_string(count) + " points are more than simulation.max_particles = " +
+                     std::to_string(maxParticles) +
+                     " (expected at most max_particles points for the burst of every point, or "
+                     "a rate or bursts)");
+      }
+      e.bursts = {Burst{e.start, static_cast<std::uint64_t>(count)}};
+    }
+    e.shape = std::move(points);
+  }
+  r.finish(notForFileEmitter());
 }
 
 // ---- structures: [[emitters]] of type "rope", "cloth" or "cluster" ----------------------------
@@ -580,9 +732,11 @@ std::map<std::string, std::string> notForStructureKeys() {
   std::map<std::string, std::vector<std::string>> owners;
   for (const std::string& type : emitterTypeNames()) {
     if (type == "particles") continue;
-    std::vector<std::string> keys = structureCommonKeys();
-    const std::vector<std::string>& extra = structureKeys().at(type);
-    keys.insert(keys.end(), extra.begin(), extra.end());
+    std::vector<std::string> keys = type == "file" ? fileEmitterKeys() : structureCommonKeys();
+    if (type != "file") {
+      const std::vector<std::string>& extra = structureKeys().at(type);
+      keys.insert(keys.end(), extra.begin(), extra.end());
+    }
     for (const std::string& k : keys) {
       if (std::find(own.begin(), own.end(), k) == own.end()) owners[k].push_back(type);
     }
@@ -620,6 +774,7 @@ std::map<std::string, std::string> notForStructure(const std::string& type) {
     }
   };
   add(particleEmitterKeys());
+  add(fileEmitterKeys());
   for (const auto& [other, keys] : structureKeys()) add(keys);
   return out;
 }
@@ -785,7 +940,8 @@ void readEmitterEntry(Context& cx, const toml::table& table, std::size_t index,
       TableReader r(cx, table, childPath("emitters", index));
       for (const std::string& k : particleEmitterKeys()) r.take(k);
       for (const std::string& t : emitterTypeNames()) {
-        if (t != "particles") r.allow(structureOwnKeys(t));
+        if (t == "file") r.allow(fileEmitterKeys());
+        if (t != "particles" && t != "file") r.allow(structureOwnKeys(t));
       }
       r.finish();
       return;
@@ -793,9 +949,13 @@ void readEmitterEntry(Context& cx, const toml::table& table, std::size_t index,
     type = *known;
   }
   std::string name;
-  if (type == "particles") {
+  if (type == "particles" || type == "file") {
     EmitterSettings e;
-    readEmitter(cx, table, index, maxParticles, e);
+    if (type == "file") {
+      readFileEmitter(cx, table, index, maxParticles, e);
+    } else {
+      readEmitter(cx, table, index, maxParticles, e);
+    }
     name = e.name;
     effect.emitters.push_back(std::move(e));
   } else {
@@ -951,7 +1111,9 @@ void readOutput(Context& cx, const toml::table& table, OutputSettings& out) {
           ok = false;
           continue;
         }
-        const CacheFormat f = *name == "csv" ? CacheFormat::Csv : CacheFormat::Ply;
+        const CacheFormat f = *name == "csv"   ? CacheFormat::Csv
+                              : *name == "ply" ? CacheFormat::Ply
+                                               : CacheFormat::Vdb;
         if (std::find(formats.begin(), formats.end(), f) != formats.end()) {
           cx.error(cx.at(*array->get(i)), entryPath,
                    quote(*name) + " is listed twice (expected each format at most once)");

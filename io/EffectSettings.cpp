@@ -21,7 +21,7 @@ const std::vector<std::string>& forceTypeNames() {
 }
 
 const std::vector<std::string>& emitterTypeNames() {
-  static const std::vector<std::string> names = {"particles", "rope", "cloth", "cluster"};
+  static const std::vector<std::string> names = {"particles", "file", "rope", "cloth", "cluster"};
   return names;
 }
 
@@ -67,7 +67,15 @@ std::string structureKeyPath(const EffectSettings& effect, std::size_t index) {
 }
 
 std::string_view cacheFormatName(CacheFormat format) {
-  return format == CacheFormat::Csv ? "csv" : "ply";
+  switch (format) {
+    case CacheFormat::Csv:
+      return "csv";
+    case CacheFormat::Ply:
+      return "ply";
+    case CacheFormat::Vdb:
+      return "vdb";
+  }
+  return "csv";
 }
 
 std::int64_t OutputSettings::frameCount() const {

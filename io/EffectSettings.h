@@ -58,7 +58,8 @@ std::string_view forceTypeName(const ForceSettings& force);
 const std::vector<std::string>& forceTypeNames();
 
 /// The `type` of an [[emitters]] entry: "particles" (an EmitterSettings, the default when `type`
-/// is absent), "rope", "cloth" or "cluster" (a StructureSettings).
+/// is absent), "file" (an EmitterSettings whose shape is the PointListShape of a points file),
+/// "rope", "cloth" or "cluster" (a StructureSettings).
 const std::vector<std::string>& emitterTypeNames();
 /// "rope", "cloth" or "cluster".
 std::string_view structureTypeName(const StructureShape& shape);
@@ -73,8 +74,8 @@ const std::vector<std::string>& clothPinsNames();
 /// count · clusterNeighbours / 2 springs.
 double clusterNeighbours(const ClusterShape& cluster);
 
-enum class CacheFormat { Csv, Ply };
-/// "csv" or "ply".
+enum class CacheFormat { Csv, Ply, Vdb };
+/// "csv", "ply" or "vdb".
 std::string_view cacheFormatName(CacheFormat format);
 
 /// The [output] table: what `tickfx run` writes.
@@ -96,8 +97,9 @@ struct OutputSettings {
 struct EffectSettings {
   std::int64_t formatVersion = kEffectFormatVersion;  // after migration: always the current one
   SystemSettings simulation;
-  /// The [[emitters]] entries of type "particles", in file order; an emitter's place here is its
-  /// index in the random keys (ParticleSystem numbers them so).
+  /// The [[emitters]] entries of type "particles" and "file", in file order; an emitter's place
+  /// here is its index in the random keys (ParticleSystem numbers them so). A file emitter's
+  /// points are read when the effect is loaded: its shape holds them, not the file's name.
   std::vector<EmitterSettings> emitters;
   /// The [[emitters]] entries of type "rope", "cloth" or "cluster", in file order; a structure's
   /// place here is its index among the structures (the core derives its random keys from it).

@@ -60,6 +60,15 @@ Emitter::Emitter(EmitterSettings settings, std::uint32_t index, std::int64_t ste
     require(disc->normal.allFinite() && disc->normal.norm() > 0.0, "disc normal must not be zero");
     disc->normal.normalize();
   }
+  if (const auto* list = std::get_if<PointListShape>(&s_.shape)) {
+    require(!list->positions.empty(), "a point list needs at least one point");
+    require(list->velocities.empty() || list->velocities.size() == list->positions.size(),
+            "a point list has one velocity per point or none");
+    for (const Eigen::Vector3f& p : list->positions)
+      require(p.allFinite(), "point list positions must be finite");
+    for (const Eigen::Vector3f& v : list->velocities)
+      require(v.allFinite(), "point list velocities must be finite");
+  }
   rateMicros_ = std::llround(s_.rate * static_cast<double>(kMicros));
   startTick_ = tickAtOrAfter(s_.start, stepRate_);
   stopTick_ = tickAtOrAfter(s_.stop, stepRate_);
@@ -142,6 +151,14 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
   ParticleInit init;
   init.position = (s_.position + offset).cast<float>();
   init.velocity = (speed * dir).cast<float>();
+  if (const auto* list = std::get_if<PointListShape>(&s_.shape)) {
+    const std::size_t point = serial % list->positions.size();
+    const Eigen::Vector3f& p = list->positions[point];
+    // Rounded to float once, as every shape; at the origin the point is kept as it is (adding
+    // +0.0 would turn a −0.0 coordinate into +0.0).
+    init.position = s_.position.isZero(0.0) ? p : (s_.position + p.cast<double>()).cast<float>();
+    if (!list->velocities.empty()) init.velocity = list->velocities[point];
+  }
   init.lifetime = static_cast<float>(life);
   init.mass = static_cast<float>(s_.mass);
   return init;

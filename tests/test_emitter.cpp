@@ -1,13 +1,16 @@
-// Emitters: shapes, directions, jitter, the purity of sample(), burst and rate timing.
+// Emitters: shapes, directions, jitter, the purity of sample(), burst and rate timing, point lists.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "CoreTestSupport.h"
@@ -325,6 +328,68 @@ TEST(EmitterSettingsCheck, RejectsSettingsOutOfRange) {
                })(),
                std::invalid_argument);
   EXPECT_NO_THROW(bad([](EmitterSettings&) {})());
+}
+
+// ---- point lists (PointListShape): particles born at given points ----------------------------
+
+std::uint32_t floatBits(float x) { return std::bit_cast<std::uint32_t>(x); }
+
+void expectSameBits(const Eigen::Vector3f& got, const Eigen::Vector3f& want,
+                    const std::string& what) {
+  for (int c = 0; c < 3; ++c)
+    EXPECT_EQ(floatBits(got[c]), floatBits(want[c])) << what << " component " << c;
+}
+
+constexpr float kDenormal = std::numeric_limits<float>::denorm_min();
+
+const std::vector<Eigen::Vector3f> kPoints = {
+    {0.0f, -0.0f, kDenormal}, {1.5f, -2.25f, 1e-30f}, {123.456f, 7.0f, -8.0f}};
+
+TEST(PointListEmitter, SerialSIsBornAtPointSModN) {
+  EmitterSettings s;
+  s.shape = PointListShape{kPoints, {}};
+  s.speed = 3.0;
+  s.spreadDegrees = 30.0;
+  s.lifetime = 2.0;
+  s.lifetimeJitter = 0.5;
+  // The same emitter at a point: speeds, directions and lifetimes are the same random numbers.
+  EmitterSettings point = s;
+  point.shape = PointShape{};
+  const Emitter list(s, 4, 60), reference(point, 4, 60);
+  for (std::uint64_t serial = 0; serial < 12; ++serial) {
+    const ParticleInit p = list.sample(9, serial), q = reference.sample(9, serial);
+    expectSameBits(p.position, kPoints[serial % 3], "serial " + std::to_string(serial));
+    expectSameBits(p.velocity, q.velocity, "velocity of serial " + std::to_string(serial));
+    EXPECT_EQ(floatBits(p.lifetime), floatBits(q.lifetime));
+    EXPECT_EQ(floatBits(p.mass), floatBits(q.mass));
+  }
+}
+
+TEST(PointListEmitter, VelocitiesOfTheListAndThePositionOffset) {
+  const std::vector<Eigen::Vector3f> velocities = {
+      {-0.0f, 1.0f, 2.0f}, {3.0f, kDenormal, -4.5f}, {1e20f, 0.0f, -1e-20f}};
+  EmitterSettings s;
+  s.shape = PointListShape{kPoints, velocities};
+  s.position = Eigen::Vector3d(1.0, -2.0, 0.1);
+  s.speed = 5.0;  // the list's velocities win
+  const Emitter e(s, 0, 60);
+  for (std::uint64_t serial = 0; serial < 6; ++serial) {
+    const ParticleInit p = e.sample(1, serial);
+    const std::size_t k = serial % 3;
+    // Offset by the emitter's position, in double, rounded to float once.
+    expectSameBits(p.position, (s.position + kPoints[k].cast<double>()).cast<float>(), "position");
+    expectSameBits(p.velocity, velocities[k], "velocity");
+  }
+}
+
+TEST(PointListEmitter, EmptyListsMismatchedVelocitiesAndNonFinitePointsAreRefused) {
+  EmitterSettings s;
+  s.shape = PointListShape{};
+  EXPECT_THROW(Emitter(s, 0, 60), std::invalid_argument);
+  s.shape = PointListShape{kPoints, {Eigen::Vector3f::Zero()}};
+  EXPECT_THROW(Emitter(s, 0, 60), std::invalid_argument);
+  s.shape = PointListShape{{Eigen::Vector3f(std::numeric_limits<float>::infinity(), 0, 0)}, {}};
+  EXPECT_THROW(Emitter(s, 0, 60), std::invalid_argument);
 }
 
 }  // namespace

@@ -294,15 +294,15 @@ type = 3
                    // Without a type only unknown keys can be told: count and rate are some
                    // type's keys.
                    "bad.toml:11:8: error: emitters.2.type: unknown emitter type \"jelly\" "
-                   "(expected one of: particles, rope, cloth, cluster)",
+                   "(expected one of: particles, file, rope, cloth, cluster)",
                    "bad.toml:13:1: error: emitters.2.colour: unknown key \"colour\" (expected one "
                    "of: type, name, position, shape, rate, start, stop, bursts, direction, speed, "
                    "speed_jitter, spread, lifetime, lifetime_jitter, mass, size, radius, normal, "
-                   "surface, time, stiffness, damping, break_ratio, velocity, end, count, "
+                   "surface, file, time, stiffness, damping, break_ratio, velocity, end, count, "
                    "pin_start, pin_end, origin, axis_u, axis_v, width, height, spacing, pins, "
                    "shear_scale, bend_scale, center, link_radius)",
                    "bad.toml:16:8: error: emitters.3.type: got the integer 3 (expected emitter "
-                   "type, one of: particles, rope, cloth, cluster)"}));
+                   "type, one of: particles, file, rope, cloth, cluster)"}));
 }
 
 TEST(ioStructures, MissingRequiredKeysPointAtTheirTable) {

@@ -1,0 +1,493 @@
+#include "io/VdbPointCache.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointDataGrid.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "io/AtomicFile.h"
+
+namespace tickfx::io {
+namespace {
+
+namespace vdbp = openvdb::points;
+
+const std::string kGridName = "points";
+// Points whose coordinates are within this bound sit in their nearest voxel; beyond it (or not
+// finite) in voxel 0 of that axis. Far inside the 32-bit voxel indices, with room for a tree's
+// nodes around them.
+constexpr double kLargestIndex = 1073741824.0;  // 2³⁰
+
+const char* const kMetaEffectHash = "tickfx_effect_hash";
+const char* const kMetaSeed = "tickfx_seed";
+const char* const kMetaStepRate = "tickfx_step_rate";
+const char* const kMetaIntegrator = "tickfx_integrator";
+const char* const kMetaFrame = "tickfx_frame";
+const char* const kMetaTime = "tickfx_time";
+const char* const kMetaVersion = "tickfx_version";
+const char* const kMetaPointCount = "tickfx_point_count";
+
+using PositionArray = vdbp::TypedAttributeArray<openvdb::Vec3f, vdbp::NullCodec>;
+using VectorArray = vdbp::TypedAttributeArray<openvdb::Vec3f, vdbp::NullCodec>;
+using IdArray = vdbp::TypedAttributeArray<std::int64_t, vdbp::NullCodec>;
+using FloatArray = vdbp::TypedAttributeArray<float, vdbp::NullCodec>;
+
+std::string where(const std::string& path) { return path + ": grid '" + kGridName + "'"; }
+
+// ---- writing ---------------------------------------------------------------------------------
+
+// One coordinate x as OpenVDB stores it: voxel index n and offset o with float(n + o) == x
+// bitwise (the voxel size is 1), |o| <= 0.5 in the voxel nearest to x. When that is not exact
+// (x beyond the bound, inf, nan; −0.0, whose sign no sum with n = 0 keeps) the coordinate goes
+// whole into voxel 0.
+std::pair<openvdb::Int32, float> place(float x) {
+  if (std::isfinite(x) && std::abs(x) < kLargestIndex) {
+    // Coord::round's rule (floor(x + 0.5)); x − n is exact in float for |x − n| <= 1.
+    const double n = std::floor(static_cast<double>(x) + 0.5);
+    const auto offset = static_cast<float>(static_cast<double>(x) - n);
+    const auto back = static_cast<float>(n + static_cast<double>(offset));
+    if (std::bit_cast<std::uint32_t>(back) == std::bit_cast<std::uint32_t>(x)) {
+      return {static_cast<openvdb::Int32>(n), offset};
+    }
+  }
+  return {0, x};
+}
+
+// The attributes every cache has, in the order they are written; custom ones follow.
+const std::vector<std::string>& standardAttributes() {
+  static const std::vector<std::string> names = {"P", "v", "id", "age", "life", "mass"};
+  return names;
+}
+
+bool isStandard(const std::string& name) {
+  const std::vector<std::string>& names = standardAttributes();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void checkAttributeName(const std::string& name) {
+  if (isStandard(name)) {
+    throw std::invalid_argument("custom attribute '" + name +
+                                "' has the name of a standard attribute of a VDB points cache");
+  }
+  if (!vdbp::AttributeSet::Descriptor::validName(name)) {
+    throw std::invalid_argument("custom attribute '" + name +
+                                "' is not a valid OpenVDB attribute name (letters, digits, '_', "
+                                "'|' and ':')");
+  }
+}
+
+openvdb::points::PointDataGrid::Ptr makeGrid(const FrameData& frame, const VdbCacheMetadata& meta) {
+  const std::size_t n = frame.size();
+  const auto rows = static_cast<Eigen::Index>(n);
+  auto sized = [&](const FloatColumn& c) { return c.size() == rows; };
+  bool ok = sized(frame.age) && sized(frame.life) && sized(frame.mass) &&
+            frame.attributes.size() == frame.attributeNames.size();
+  for (int c = 0; c < 3; ++c) ok = ok && sized(frame.position[c]) && sized(frame.velocity[c]);
+  for (const FloatColumn& a : frame.attributes) ok = ok && sized(a);
+  if (!ok) throw std::invalid_argument("frame columns of different lengths");
+  for (const std::string& name : frame.attributeNames) checkAttributeName(name);
+
+  // Each point's voxel and its offset there.
+  std::vector<openvdb::Coord> voxel(n);
+  std::vector<openvdb::Vec3f> offset(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const auto [index, o] = place(frame.position[c][static_cast<Eigen::Index>(i)]);
+      voxel[i][c] = index;
+      offset[i][c] = o;
+    }
+  }
+  using Leaf = vdbp::PointDataTree::LeafNodeType;
+  // Points leaf by leaf, voxel by voxel, and in row order within a voxel: the order of the
+  // leaves' attribute arrays.
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const auto leafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
+  auto origin = [&](std::size_t i) { return voxel[i] & leafMask; };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const openvdb::Coord oa = origin(a), ob = origin(b);
+    if (oa != ob) return oa < ob;
+    return Leaf::coordToOffset(voxel[a]) < Leaf::coordToOffset(voxel[b]);
+  });
+
+  auto descriptor = vdbp::AttributeSet::Descriptor::create(PositionArray::attributeType());
+  descriptor = descriptor->duplicateAppend("v", VectorArray::attributeType());
+  descriptor = descriptor->duplicateAppend("id", IdArray::attributeType());
+  for (const char* name : {"age", "life", "mass"})
+    descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
+  for (const std::string& name : frame.attributeNames)
+    descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
+  const std::size_t firstCustom = standardAttributes().size();
+
+  auto tree = std::make_shared<vdbp::PointDataTree>();
+  for (std::size_t begin = 0; begin < n;) {
+    const openvdb::Coord leafOrigin = origin(order[begin]);
+    std::size_t end = begin;
+    // Each voxel's value is the end of its points in the leaf's arrays.
+    std::vector<openvdb::Index32> counts(Leaf::SIZE, 0);
+    while (end < n && origin(order[end]) == leafOrigin) {
+      ++counts[Leaf::coordToOffset(voxel[order[end]])];
+      ++end;
+    }
+    std::vector<openvdb::PointDataIndex32> offsets(Leaf::SIZE);
+    openvdb::Index32 sum = 0;
+    for (std::size_t v = 0; v < counts.size(); ++v) offsets[v] = sum += counts[v];
+    Leaf* leaf = tree->touchLeaf(leafOrigin);
+    const auto count = static_cast<openvdb::Index>(end - begin);
+    // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
+    leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, count),
+                              /*allowMismatchingDescriptors=*/true);
+    leaf->setOffsets(offsets);
+
+    vdbp::AttributeWriteHandle<openvdb::Vec3f> p(leaf->attributeArray(0));
+    vdbp::AttributeWriteHandle<openvdb::Vec3f> v(leaf->attributeArray(1));
+    vdbp::AttributeWriteHandle<std::int64_t> id(leaf->attributeArray(2));
+    vdbp::AttributeWriteHandle<float> age(leaf->attributeArray(3));
+    vdbp::AttributeWriteHandle<float> life(leaf->attributeArray(4));
+    vdbp::AttributeWriteHandle<float> mass(leaf->attributeArray(5));
+    std::vector<vdbp::AttributeWriteHandle<float>> custom;
+    for (std::size_t a = 0; a < frame.attributes.size(); ++a)
+      custom.emplace_back(leaf->attributeArray(firstCustom + a));
+    for (openvdb::Index k = 0; k < count; ++k) {
+      const std::size_t i = order[begin + k];
+      const auto r = static_cast<Eigen::Index>(i);
+      p.set(k, offset[i]);
+      v.set(k, openvdb::Vec3f(frame.velocity[0][r], frame.velocity[1][r], frame.velocity[2][r]));
+      id.set(k, static_cast<std::int64_t>(frame.id[i]));
+      age.set(k, frame.age[r]);
+      life.set(k, frame.life[r]);
+      mass.set(k, frame.mass[r]);
+      for (std::size_t a = 0; a < custom.size(); ++a) custom[a].set(k, frame.attributes[a][r]);
+    }
+    begin = end;
+  }
+
+  auto grid = vdbp::PointDataGrid::create(tree);
+  grid->setName(kGridName);
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
+  grid->insertMeta(kMetaEffectHash, openvdb::StringMetadata(meta.effectHash));
+  grid->insertMeta(kMetaSeed, openvdb::Int64Metadata(static_cast<std::int64_t>(meta.seed)));
+  grid->insertMeta(kMetaStepRate, openvdb::Int64Metadata(meta.stepRateHz));
+  grid->insertMeta(kMetaIntegrator, openvdb::StringMetadata(meta.integrator));
+  grid->insertMeta(kMetaFrame, openvdb::Int64Metadata(frame.frame));
+  grid->insertMeta(kMetaTime, openvdb::DoubleMetadata(frame.timeSeconds));
+  grid->insertMeta(kMetaVersion, openvdb::StringMetadata(meta.tickfxVersion));
+  grid->insertMeta(kMetaPointCount, openvdb::Int64Metadata(static_cast<std::int64_t>(n)));
+  return grid;
+}
+
+// ---- reading ---------------------------------------------------------------------------------
+
+/// Checks, before OpenVDB reads any grid data, that every grid of the file ends within the file.
+/// OpenVDB 10 reads a file cut inside its grid data with garbage sizes (it may hang or fail at
+/// random), so the byte ranges in the grid descriptors are compared with the file size first.
+/// A copy of checkExtent in fields/VectorField.cpp (that library is kept apart from io/), with
+/// this file's messages. Layout (io::Archive::readHeader, MetaMap::readMeta,
+/// GridDescriptor::read): magic (8), format version (4), library major and minor (4 + 4),
+/// has-offsets flag (1), [compression flag (1) before format 222], UUID (36); file metadata:
+/// count (4), then per entry name and type strings and a byte-counted value; grid count (4); per
+/// grid: name, type, [instance parent from format 216] strings, then grid, block and end
+/// offsets (8 each), the next descriptor at the end offset. Strings are a 4-byte length and the
+/// bytes.
+void checkExtent(const std::string& path) {
+  std::ifstream is(path, std::ios::binary);
+  std::error_code ec;
+  const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path, ec));
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(where(path) + ": cannot read the grid (" + what + ")");
+  };
+  auto u32 = [&]() {
+    std::uint32_t v = 0;
+    if (!is.read(reinterpret_cast<char*>(&v), sizeof v)) fail("the file is truncated");
+    return v;
+  };
+  auto i64 = [&]() {
+    std::int64_t v = 0;
+    if (!is.read(reinterpret_cast<char*>(&v), sizeof v)) fail("the file is truncated");
+    return v;
+  };
+  auto skip = [&](std::int64_t bytes) {
+    if (bytes < 0 || static_cast<std::int64_t>(is.tellg()) + bytes > size) {
+      fail("the file is truncated");
+    }
+    is.seekg(bytes, std::ios::cur);
+  };
+  auto skipString = [&]() { skip(u32()); };
+  i64();  // magic (checked by OpenVDB already)
+  const std::uint32_t version = u32();
+  u32();
+  u32();
+  char hasOffsets = 0;
+  if (!is.read(&hasOffsets, 1)) fail("the file is truncated");
+  if (!hasOffsets) return;  // nothing to check against
+  if (version < 222) skip(1);
+  skip(36);
+  const std::uint32_t metadata = u32();
+  for (std::uint32_t i = 0; i < metadata; ++i) {
+    skipString();
+    skipString();
+    skip(u32());
+  }
+  const std::uint32_t grids = u32();
+  for (std::uint32_t i = 0; i < grids; ++i) {
+    skipString();
+    skipString();
+    if (version >= 216) skipString();
+    const std::int64_t gridPos = i64(), blockPos = i64(), endPos = i64();
+    if (!(0 < gridPos && gridPos <= blockPos && blockPos <= endPos) || endPos > size) {
+      fail("the file is truncated: a grid ends at byte " + std::to_string(endPos) + " of " +
+           std::to_string(size));
+    }
+    is.seekg(endPos);
+  }
+}
+
+// Reads the grid "points" of `path` completely (no delayed loading: the file may change later).
+openvdb::GridBase::Ptr readPointsGrid(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw std::runtime_error(where(path) + ": no such file");
+  }
+  openvdb::io::File file(path);
+  try {
+    file.open(/*delayLoad=*/false);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(where(path) + ": cannot open the file as OpenVDB (" + e.what() + ")");
+  }
+  openvdb::GridBase::Ptr grid;
+  try {
+    checkExtent(path);
+    if (!file.hasGrid(kGridName)) {
+      std::string names;
+      for (auto it = file.beginName(); it != file.endName(); ++it) {
+        names += (names.empty() ? "" : ", ") + it.gridName();
+      }
+      file.close();
+      throw std::runtime_error(where(path) + ": no such grid (" +
+                               (names.empty()
+                                    ? std::string("the file holds no grids: empty or truncated")
+                                    : "the file has: " + names) +
+                               ")");
+    }
+    grid = file.readGrid(kGridName);
+    file.close();
+  } catch (const std::runtime_error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(where(path) + ": cannot read the grid (" + e.what() + ")");
+  }
+  if (!grid) throw std::runtime_error(where(path) + ": cannot read the grid");
+  return grid;
+}
+
+template <typename T>
+std::optional<T> metaValue(const openvdb::GridBase& grid, const char* name) {
+  using Meta = openvdb::TypedMetadata<T>;
+  if (const auto m = grid.getMetadata<Meta>(name)) return m->value();
+  return std::nullopt;
+}
+
+// True when `transform` maps every index to the same world coordinates, exactly.
+bool isIdentity(const openvdb::math::Transform& transform) {
+  if (!transform.isLinear()) return false;
+  for (const openvdb::Vec3d& x :
+       {openvdb::Vec3d(0, 0, 0), openvdb::Vec3d(1, 0, 0), openvdb::Vec3d(0, 1, 0),
+        openvdb::Vec3d(0, 0, 1), openvdb::Vec3d(-3, 5, 7)}) {
+    if (transform.indexToWorld(x) != x) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
+                        const std::filesystem::path& path) {
+  openvdb::initialize();
+  const openvdb::GridCPtrVec grids{makeGrid(frame, meta)};
+  writeFileAtomicallyByName(path, [&](const std::filesystem::path& temp) {
+    try {
+      openvdb::io::File file(temp.string());
+      file.write(grids);
+      file.close();
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path.string() + ": cannot write the VDB points cache (" + e.what() +
+                               ")");
+    }
+  });
+}
+
+FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents* contents) {
+  const std::string file = path.string();
+  openvdb::initialize();
+  const openvdb::GridBase::Ptr base = readPointsGrid(file);
+  const auto grid = openvdb::gridPtrCast<vdbp::PointDataGrid>(base);
+  if (!grid) {
+    throw std::runtime_error(where(file) + ": is a grid of type " + base->type() +
+                             " (expected a PointDataGrid)");
+  }
+  const vdbp::PointDataTree& tree = grid->constTree();
+  const openvdb::math::Transform& transform = grid->constTransform();
+  const bool identity = isIdentity(transform);
+
+  VdbCacheContents found;
+  std::vector<openvdb::Vec3f> position, velocity;
+  std::vector<std::int64_t> id;
+  std::vector<float> age, life, mass;
+  std::vector<std::string> customNames;
+  std::vector<std::vector<float>> custom;
+  bool first = true;
+  for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+    const vdbp::AttributeSet::Descriptor& d = leaf->attributeSet().descriptor();
+    // Every leaf of a PointDataGrid shares one descriptor: positions and names are the first
+    // leaf's.
+    const std::size_t pPos = d.find("P");
+    if (pPos == vdbp::AttributeSet::INVALID_POS) {
+      throw std::runtime_error(where(file) + ": the points have no attribute P");
+    }
+    if (!leaf->constAttributeArray(pPos).hasValueType<openvdb::Vec3f>()) {
+      throw std::runtime_error(where(file) + ": P is of type " + d.valueType(pPos) +
+                               " (expected vec3s)");
+    }
+    auto find = [&](const char* name, auto typed) {
+      const std::size_t pos = d.find(name);
+      using T = decltype(typed);
+      if (pos == vdbp::AttributeSet::INVALID_POS) return pos;
+      return leaf->constAttributeArray(pos).template hasValueType<T>()
+                 ? pos
+                 : vdbp::AttributeSet::INVALID_POS;
+    };
+    const std::size_t vPos = find("v", openvdb::Vec3f());
+    const std::size_t idPos = find("id", std::int64_t());
+    const std::size_t id32Pos = find("id", std::int32_t());
+    const std::size_t agePos = find("age", float()), lifePos = find("life", float()),
+                      massPos = find("mass", float());
+    std::vector<std::size_t> customPos;
+    std::vector<std::string> names(d.size());
+    for (const auto& [name, pos] : d.map()) names[pos] = name;
+    for (std::size_t pos = 0; pos < d.size(); ++pos) {
+      if (!isStandard(names[pos]) && leaf->constAttributeArray(pos).hasValueType<float>())
+        customPos.push_back(pos);
+    }
+    if (first) {
+      found.hasVelocity = vPos != vdbp::AttributeSet::INVALID_POS;
+      found.hasId =
+          idPos != vdbp::AttributeSet::INVALID_POS || id32Pos != vdbp::AttributeSet::INVALID_POS;
+      found.hasAge = agePos != vdbp::AttributeSet::INVALID_POS;
+      found.hasLife = lifePos != vdbp::AttributeSet::INVALID_POS;
+      found.hasMass = massPos != vdbp::AttributeSet::INVALID_POS;
+      for (std::size_t pos : customPos) customNames.push_back(names[pos]);
+      custom.resize(customPos.size());
+      first = false;
+    }
+
+    vdbp::AttributeHandle<openvdb::Vec3f> p(leaf->constAttributeArray(pPos));
+    for (auto index = leaf->beginIndexAll(); index; ++index) {
+      const openvdb::Coord ijk = index.getCoord();
+      const openvdb::Vec3f o = p.get(*index);
+      openvdb::Vec3f x;
+      if (identity) {
+        // (ijk + P) · 1 as OpenVDB computes it, but a coordinate of voxel 0 is P as stored, so
+        // that −0.0 stays −0.0.
+        for (int c = 0; c < 3; ++c) {
+          x[c] = ijk[c] == 0
+                     ? o[c]
+                     : static_cast<float>(static_cast<double>(ijk[c]) + static_cast<double>(o[c]));
+        }
+      } else {
+        const openvdb::Vec3d w = transform.indexToWorld(ijk.asVec3d() + openvdb::Vec3d(o));
+        x = openvdb::Vec3f(static_cast<float>(w[0]), static_cast<float>(w[1]),
+                           static_cast<float>(w[2]));
+      }
+      position.push_back(x);
+    }
+    const openvdb::Index count = leaf->pointCount();
+    auto readAll = [&](std::size_t pos, auto& out, auto fallback) {
+      using T = std::decay_t<decltype(fallback)>;
+      if (pos == vdbp::AttributeSet::INVALID_POS) {
+        out.insert(out.end(), count, fallback);
+        return;
+      }
+      vdbp::AttributeHandle<T> h(leaf->constAttributeArray(pos));
+      for (openvdb::Index k = 0; k < count; ++k) out.push_back(h.get(k));
+    };
+    readAll(vPos, velocity, openvdb::Vec3f(0.0f));
+    if (idPos != vdbp::AttributeSet::INVALID_POS) {
+      readAll(idPos, id, std::int64_t{0});
+    } else if (id32Pos != vdbp::AttributeSet::INVALID_POS) {
+      std::vector<std::int32_t> narrow;
+      readAll(id32Pos, narrow, std::int32_t{0});
+      id.insert(id.end(), narrow.begin(), narrow.end());
+    } else {
+      // Without an id the rows are numbered in file order.
+      for (openvdb::Index k = 0; k < count; ++k) id.push_back(static_cast<std::int64_t>(id.size()));
+    }
+    readAll(agePos, age, 0.0f);
+    readAll(lifePos, life, std::numeric_limits<float>::infinity());
+    readAll(massPos, mass, 1.0f);
+    if (customPos.size() != custom.size()) {
+      throw std::runtime_error(where(file) + ": leaves with different attributes");
+    }
+    for (std::size_t a = 0; a < customPos.size(); ++a) readAll(customPos[a], custom[a], 0.0f);
+    if (position.size() != id.size()) {
+      throw std::runtime_error(where(file) + ": a leaf's offsets do not match its attributes");
+    }
+  }
+
+  // Rows in id order (ids are unique in a tickfx cache; equal ids keep the file's order).
+  const std::size_t n = position.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  if (found.hasId) {
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return static_cast<std::uint64_t>(id[a]) < static_cast<std::uint64_t>(id[b]);
+    });
+  }
+  FrameData frame;
+  const auto rows = static_cast<Eigen::Index>(n);
+  frame.position.resize(rows);
+  frame.velocity.resize(rows);
+  frame.age.resize(rows);
+  frame.life.resize(rows);
+  frame.mass.resize(rows);
+  frame.id.resize(n);
+  frame.attributeNames = customNames;
+  frame.attributes.assign(custom.size(), FloatColumn(rows));
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = order[r];
+    const auto row = static_cast<Eigen::Index>(r);
+    for (int c = 0; c < 3; ++c) {
+      frame.position[c][row] = position[i][c];
+      frame.velocity[c][row] = velocity[i][c];
+    }
+    frame.id[r] = static_cast<std::uint64_t>(id[i]);
+    frame.age[row] = age[i];
+    frame.life[row] = life[i];
+    frame.mass[row] = mass[i];
+    for (std::size_t a = 0; a < custom.size(); ++a) frame.attributes[a][row] = custom[a][i];
+  }
+
+  VdbCacheMetadata& meta = found.metadata;
+  meta.effectHash = metaValue<std::string>(*grid, kMetaEffectHash).value_or("");
+  meta.seed = static_cast<std::uint64_t>(metaValue<std::int64_t>(*grid, kMetaSeed).value_or(0));
+  meta.stepRateHz = metaValue<std::int64_t>(*grid, kMetaStepRate).value_or(0);
+  meta.integrator = metaValue<std::string>(*grid, kMetaIntegrator).value_or("");
+  meta.tickfxVersion = metaValue<std::string>(*grid, kMetaVersion).value_or("");
+  frame.frame = metaValue<std::int64_t>(*grid, kMetaFrame).value_or(0);
+  frame.timeSeconds = metaValue<double>(*grid, kMetaTime).value_or(0.0);
+  if (contents != nullptr) *contents = found;
+  return frame;
+}
+
+}  // namespace tickfx::io

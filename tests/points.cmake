@@ -1,0 +1,25 @@
+# VDB point caches (io/VdbPointCache) and the file emitter ([[emitters]] type = "file"): the
+# cache read back through OpenVDB itself, the emitter fed from CSV and VDB files with its
+# effect-file messages, and `tickfx run --format vdb` as a user runs it, checked with vdb_print
+# when it is installed. The io/ suites are named io* so that `ctest -R io` selects them. Every
+# test writes into a temporary directory of its own.
+if(TARGET tickfx_io)
+  tickfx_add_test(test_vdb_points ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_points.cpp
+    LIBS tickfx::io OpenVDB::openvdb)
+  tickfx_add_test(test_file_emitter ${CMAKE_CURRENT_SOURCE_DIR}/test_file_emitter.cpp
+    LIBS tickfx::io OpenVDB::openvdb)
+endif()
+if(TARGET tickfx_cli)
+  tickfx_add_test(test_points_cli ${CMAKE_CURRENT_SOURCE_DIR}/test_points_cli.cpp
+    LIBS tickfx::io)
+  target_compile_definitions(test_points_cli PRIVATE
+    TICKFX_CLI="$<TARGET_FILE:tickfx_cli>" TICKFX_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    TICKFX_VERSION="${PROJECT_VERSION}")
+  add_dependencies(test_points_cli tickfx_cli)
+  # vdb_print (Debian package libopenvdb-tools) lists the caches; its test is only built when it
+  # is installed.
+  find_program(VDB_PRINT vdb_print)
+  if(VDB_PRINT)
+    target_compile_definitions(test_points_cli PRIVATE TICKFX_VDB_PRINT="${VDB_PRINT}")
+  endif()
+endif()

@@ -1,0 +1,181 @@
+// `tickfx run --format vdb` and the file emitter as a user runs them: the VDB caches hold what
+// the CSV caches of the same run hold, vdb_print lists them with their point counts, and an
+// effect can be seeded from a cache. Everything is written into the test's own directory.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "io/CsvCache.h"
+#include "io/VdbPointCache.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class CliPoints : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("tickfx_cli_points_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `PROGRAM ARGS` from the source tree (so samples/... resolve), stdin closed.
+  Result run(const std::string& program, const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command = "cd '" TICKFX_SOURCE_DIR "' && '" + program + "' " + args +
+                                " </dev/null >'" + out.string() + "' 2>'" + err.string() + "'";
+    const int status = std::system(command.c_str());
+    Result r;
+    r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = readAll(out);
+    r.err = readAll(err);
+    return r;
+  }
+  Result tickfx(const std::string& args) const { return run(TICKFX_CLI, args); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  fs::path dir_;
+};
+
+TEST_F(CliPoints, RunWritesVdbCachesHoldingTheCsvCachesBits) {
+  const Result r =
+      tickfx("run samples/fountain.toml --frames 3 --format vdb,csv --out " + path("c"));
+  ASSERT_EQ(r.exit, 0) << r.err;
+  for (int f = 1; f <= 3; ++f) {
+    const std::string name = path("c/frame_000" + std::to_string(f));
+    const tickfx::io::FrameData csv = tickfx::io::readCsvCache(name + ".csv");
+    tickfx::io::VdbCacheContents contents;
+    const tickfx::io::FrameData vdb = tickfx::io::readVdbPointCache(name + ".vdb", &contents);
+    ASSERT_GT(csv.size(), 0u);
+    ASSERT_EQ(vdb.size(), csv.size());
+    EXPECT_EQ(vdb.id, csv.id);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(0, std::memcmp(vdb.position[c].data(), csv.position[c].data(), csv.size() * 4));
+      EXPECT_EQ(0, std::memcmp(vdb.velocity[c].data(), csv.velocity[c].data(), csv.size() * 4));
+    }
+    EXPECT_EQ(0, std::memcmp(vdb.age.data(), csv.age.data(), csv.size() * 4));
+    EXPECT_EQ(0, std::memcmp(vdb.life.data(), csv.life.data(), csv.size() * 4));
+    EXPECT_EQ(0, std::memcmp(vdb.mass.data(), csv.mass.data(), csv.size() * 4));
+    EXPECT_EQ(vdb.frame, f);
+    EXPECT_EQ(vdb.timeSeconds, f / 24.0);
+    // samples/fountain.toml: seed 7, 120 Hz, the default integrator.
+    EXPECT_TRUE(std::regex_match(contents.metadata.effectHash, std::regex("[0-9a-f]{16}")))
+        << contents.metadata.effectHash;
+    EXPECT_EQ(contents.metadata.seed, 7u);
+    EXPECT_EQ(contents.metadata.stepRateHz, 120);
+    EXPECT_EQ(contents.metadata.integrator, "semi_implicit_euler");
+    EXPECT_EQ(contents.metadata.tickfxVersion, TICKFX_VERSION);
+  }
+  // The same effect, overridden, is another effect: another hash in the caches.
+  ASSERT_EQ(tickfx("run samples/fountain.toml --frames 1 --format vdb --set simulation.seed=7 "
+                   "--out " +
+                   path("d"))
+                .exit,
+            0);
+  tickfx::io::VdbCacheContents a, b;
+  tickfx::io::readVdbPointCache(path("c/frame_0001.vdb"), &a);
+  tickfx::io::readVdbPointCache(path("d/frame_0001.vdb"), &b);
+  EXPECT_NE(a.metadata.effectHash, b.metadata.effectHash);
+}
+
+TEST_F(CliPoints, UnknownFormatsNameVdb) {
+  const Result r = tickfx("run samples/fountain.toml --frames 1 --format vdbs --out " + path("c"));
+  EXPECT_EQ(r.exit, 2);
+  EXPECT_NE(r.err.find("unknown format 'vdbs' (expected csv, ply, vdb or none)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(path("c")));
+  // In the effect file too.
+  std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"
+                                    "[[emitters]]\nrate = 10\n[output]\nformats = [\"vdb\"]\n";
+  EXPECT_EQ(tickfx("check " + path("fx.toml")).exit, 0);
+  ASSERT_EQ(tickfx("run " + path("fx.toml") + " --frames 2 --out " + path("e")).exit, 0);
+  EXPECT_TRUE(fs::exists(path("e/frame_0002.vdb")));
+  EXPECT_FALSE(fs::exists(path("e/frame_0002.csv")));
+}
+
+#ifdef TICKFX_VDB_PRINT
+// vdb_print (OpenVDB's own tool) lists the grid "points" of each cache, and the point count
+// from its metadata, which is the number of rows of the CSV cache of the same frame and the
+// run's final particle count.
+TEST_F(CliPoints, VdbPrintListsThePointsGridWithItsPointCount) {
+  const Result r =
+      tickfx("run samples/fountain.toml --frames 3 --format vdb,csv --out " + path("c"));
+  ASSERT_EQ(r.exit, 0) << r.err;
+  std::smatch alive;
+  ASSERT_TRUE(std::regex_search(r.out, alive, std::regex("particles alive: ([0-9]+)"))) << r.out;
+  for (int f = 1; f <= 3; ++f) {
+    const std::string vdb = path("c/frame_000" + std::to_string(f) + ".vdb");
+    const Result listing = run(TICKFX_VDB_PRINT, "-m '" + vdb + "'");
+    ASSERT_EQ(listing.exit, 0) << listing.err;
+    // "points      ptdataidx32 (0,0,0)->(0,1,0) ..." then the grid's metadata.
+    EXPECT_TRUE(std::regex_search(listing.out, std::regex("(^|\n)points +ptdataidx32 ")))
+        << listing.out;
+    std::smatch count;
+    ASSERT_TRUE(std::regex_search(listing.out, count, std::regex("tickfx_point_count: ([0-9]+)")))
+        << listing.out;
+    const auto rows = tickfx::io::readCsvCache(path("c/frame_000" + std::to_string(f) + ".csv"));
+    EXPECT_EQ(std::stoul(count[1].str()), rows.size()) << "frame " << f;
+    if (f == 3) {
+      EXPECT_EQ(count[1].str(), alive[1].str());
+    }
+    EXPECT_NE(listing.out.find("tickfx_frame: " + std::to_string(f)), std::string::npos);
+    EXPECT_NE(listing.out.find("tickfx_integrator: semi_implicit_euler"), std::string::npos);
+    EXPECT_NE(listing.out.find("tickfx_step_rate: 120"), std::string::npos);
+    EXPECT_NE(listing.out.find("tickfx_seed: 7"), std::string::npos);
+  }
+}
+#endif
+
+TEST_F(CliPoints, AnEffectSeededFromACacheChecksAndRuns) {
+  ASSERT_EQ(tickfx("run samples/fountain.toml --frames 3 --format vdb,csv --out " + path("c")).exit,
+            0);
+  const auto rows = tickfx::io::readCsvCache(path("c/frame_0003.csv")).size();
+  for (const char* file : {"c/frame_0003.vdb", "c/frame_0003.csv"}) {
+    std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"
+                                      "[[emitters]]\ntype = \"file\"\nfile = \""
+                                   << file << "\"\n[[forces]]\ntype = \"gravity\"\n";
+    const Result check = tickfx("check " + path("fx.toml"));
+    EXPECT_EQ(check.exit, 0) << check.err;
+    const Result r = tickfx("run " + path("fx.toml") + " --frames 2 --format none");
+    ASSERT_EQ(r.exit, 0) << r.err;
+    EXPECT_NE(r.out.find("particles alive: " + std::to_string(rows) + " "), std::string::npos)
+        << r.out;
+  }
+  // A missing points file is an effect error: exit 2, nothing written.
+  std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"
+                                    "[[emitters]]\ntype = \"file\"\nfile = \"nope.vdb\"\n";
+  const Result r = tickfx("run " + path("fx.toml") + " --frames 2 --out " + path("o"));
+  EXPECT_EQ(r.exit, 2);
+  EXPECT_NE(r.err.find(path("fx.toml") + ":6:8: error: emitters.0.file: no such file \"" +
+                       path("nope.vdb") + "\""),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(path("o")));
+}
+
+}  // namespace

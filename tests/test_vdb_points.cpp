@@ -1,0 +1,389 @@
+// VDB point caches (io/VdbPointCache): a frame read back through OpenVDB itself has every
+// attribute's bits and the run's metadata; broken files fail with the file and grid named.
+// Every file is written into a temporary directory of the test and removed afterwards.
+#include <gtest/gtest.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointAttribute.h>
+#include <openvdb/points/PointConversion.h>
+#include <openvdb/points/PointCount.h>
+#include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tools/PointIndexGrid.h>
+#include <unistd.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "io/FrameData.h"
+#include "io/VdbPointCache.h"
+
+namespace tickfx::io {
+namespace {
+
+namespace fs = std::filesystem;
+namespace vdbp = openvdb::points;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kDenormal = std::numeric_limits<float>::denorm_min();
+
+std::uint32_t bits(float x) { return std::bit_cast<std::uint32_t>(x); }
+
+class ioVdbPoints : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("tickfx_vdb_points_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path path(const std::string& name) const { return dir_ / name; }
+
+  fs::path dir_;
+};
+
+VdbCacheMetadata sampleMetadata() {
+  return VdbCacheMetadata{"0123456789abcdef", 9223372036854775807ull, 240, "velocity_verlet",
+                          "0.1.0"};
+}
+
+// Particles at odd places with odd values: zero and −0.0, denormals, halves (on voxel faces),
+// coordinates past the 2³⁰ bound and up to 1e30 and inf, ids past 2⁵³ and past 2⁶³, and two
+// custom attributes. Rows in id order, as FrameData promises.
+FrameData oddFrame() {
+  const std::vector<std::array<float, 3>> positions = {
+      {0.0f, -0.0f, kDenormal},
+      {-kDenormal, 0.5f, -0.5f},
+      {1.5f, -2.5f, 3.25f},
+      {0.49999997f, -0.49999997f, 7.999999f},
+      {123456.79f, -98765.43f, 16777217.0f},
+      {1e30f, -1e30f, 3e9f},
+      {1073741824.0f, -1073741824.0f, 1073741760.0f},
+      {kInf, -kInf, 1e-30f},
+      {std::numeric_limits<float>::min(), -std::numeric_limits<float>::max(), 0.1f},
+      {-7.75f, 8.125f, -1e-7f},
+  };
+  const std::vector<std::uint64_t> ids = {
+      0,    1, 2, 17, 4096, (1ull << 53) + 1, (1ull << 60) + 3, (1ull << 62) + 7, (1ull << 63) + 5,
+      ~0ull};
+  FrameData f;
+  f.frame = 42;
+  f.timeSeconds = 1.75;
+  const auto n = static_cast<Eigen::Index>(positions.size());
+  f.id = ids;
+  f.position.resize(n);
+  f.velocity.resize(n);
+  f.age.resize(n);
+  f.life.resize(n);
+  f.mass.resize(n);
+  f.attributeNames = {"heat", "Cd_r"};
+  f.attributes.assign(2, FloatColumn::Zero(n));
+  const float odd[] = {0.0f,    -0.0f, kDenormal, -kDenormal, 1e30f,
+                       -1e-30f, kInf,  0.1f,      3.0f,       2e-45f};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    for (int c = 0; c < 3; ++c) {
+      f.position[c][i] = positions[k][static_cast<std::size_t>(c)];
+      f.velocity[c][i] = odd[(k + static_cast<std::size_t>(c)) % 10];
+    }
+    f.age[i] = odd[(k + 3) % 10];
+    f.life[i] = i % 2 == 0 ? kInf : odd[(k + 4) % 10];
+    f.mass[i] = odd[(k + 5) % 10];
+    f.attributes[0][i] = odd[(k + 6) % 10];
+    f.attributes[1][i] = -odd[(k + 7) % 10];
+  }
+  return f;
+}
+
+// Bitwise equality of every column; `signOfZero` false lets a −0.0 position read as +0.0.
+void expectSameBits(const FrameData& got, const FrameData& want, bool signOfZero = true) {
+  ASSERT_EQ(got.size(), want.size());
+  EXPECT_EQ(got.id, want.id);
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(want.size()); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const float p = want.position[c][i];
+      const float expected = !signOfZero && p == 0.0f ? 0.0f : p;
+      EXPECT_EQ(bits(got.position[c][i]), bits(expected)) << "row " << i << " P" << c << " " << p;
+      EXPECT_EQ(bits(got.velocity[c][i]), bits(want.velocity[c][i])) << "row " << i;
+    }
+    EXPECT_EQ(bits(got.age[i]), bits(want.age[i])) << "row " << i;
+    EXPECT_EQ(bits(got.life[i]), bits(want.life[i])) << "row " << i;
+    EXPECT_EQ(bits(got.mass[i]), bits(want.mass[i])) << "row " << i;
+  }
+  ASSERT_EQ(got.attributeNames, want.attributeNames);
+  for (std::size_t a = 0; a < want.attributes.size(); ++a) {
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(want.size()); ++i)
+      EXPECT_EQ(bits(got.attributes[a][i]), bits(want.attributes[a][i])) << want.attributeNames[a];
+  }
+}
+
+openvdb::GridBase::Ptr readWithOpenVdb(const fs::path& file, const std::string& grid) {
+  openvdb::initialize();
+  openvdb::io::File in(file.string());
+  in.open(false);
+  openvdb::GridBase::Ptr g = in.readGrid(grid);
+  in.close();
+  return g;
+}
+
+// ---- the cache read back through OpenVDB ------------------------------------------------------
+
+TEST_F(ioVdbPoints, OpenVdbReadsEveryAttributeBitwiseAndTheMetadata) {
+  const FrameData frame = oddFrame();
+  writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
+
+  const auto grid =
+      openvdb::gridPtrCast<vdbp::PointDataGrid>(readWithOpenVdb(path("f.vdb"), "points"));
+  ASSERT_TRUE(grid);
+  // The metadata a pipeline reads.
+  EXPECT_EQ(grid->metaValue<std::string>("tickfx_effect_hash"), "0123456789abcdef");
+  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_seed"), 9223372036854775807);
+  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_step_rate"), 240);
+  EXPECT_EQ(grid->metaValue<std::string>("tickfx_integrator"), "velocity_verlet");
+  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_frame"), 42);
+  EXPECT_EQ(grid->metaValue<double>("tickfx_time"), 1.75);
+  EXPECT_EQ(grid->metaValue<std::string>("tickfx_version"), "0.1.0");
+  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_point_count"), 10);
+  EXPECT_EQ(grid->voxelSize(), openvdb::Vec3d(1.0));
+  EXPECT_EQ(vdbp::pointCount(grid->tree()), 10u);
+
+  // Each point as OpenVDB gives it: world position (voxel + P) · transform, and the attributes,
+  // by id.
+  std::map<std::uint64_t, std::vector<std::uint32_t>> seen;
+  std::vector<std::string> names;
+  for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+    const vdbp::AttributeSet::Descriptor& d = leaf->attributeSet().descriptor();
+    names.assign(d.size(), "");
+    for (const auto& [name, pos] : d.map()) names[pos] = name;
+    EXPECT_EQ(leaf->constAttributeArray("P").codecType(), "null");
+    EXPECT_EQ(d.valueType(d.find("P")), "vec3s");
+    EXPECT_EQ(d.valueType(d.find("v")), "vec3s");
+    EXPECT_EQ(d.valueType(d.find("id")), "int64");
+    for (const char* name : {"age", "life", "mass", "heat", "Cd_r"})
+      EXPECT_EQ(d.valueType(d.find(name)), "float") << name;
+    vdbp::AttributeHandle<openvdb::Vec3f> p(leaf->constAttributeArray("P"));
+    vdbp::AttributeHandle<openvdb::Vec3f> v(leaf->constAttributeArray("v"));
+    vdbp::AttributeHandle<std::int64_t> id(leaf->constAttributeArray("id"));
+    std::vector<vdbp::AttributeHandle<float>> scalars;
+    for (const char* name : {"age", "life", "mass", "heat", "Cd_r"})
+      scalars.emplace_back(leaf->constAttributeArray(name));
+    for (auto index = leaf->beginIndexOn(); index; ++index) {
+      const openvdb::Vec3f offset = p.get(*index);
+      const openvdb::Vec3d world =
+          grid->transform().indexToWorld(index.getCoord().asVec3d() + openvdb::Vec3d(offset));
+      std::vector<std::uint32_t> values;
+      for (int c = 0; c < 3; ++c) values.push_back(bits(static_cast<float>(world[c])));
+      for (int c = 0; c < 3; ++c) values.push_back(bits(v.get(*index)[c]));
+      for (const auto& s : scalars) values.push_back(bits(s.get(*index)));
+      const auto key = static_cast<std::uint64_t>(id.get(*index));
+      EXPECT_EQ(seen.count(key), 0u);
+      seen[key] = values;
+      // Points within the bound sit in their nearest voxel, as OpenVDB's convention has it.
+      for (int c = 0; c < 3; ++c) {
+        if (index.getCoord()[c] != 0) {
+          EXPECT_LE(std::abs(offset[c]), 0.5f);
+        }
+      }
+    }
+  }
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"P", "v", "id", "age", "life", "mass", "heat", "Cd_r"}));
+  ASSERT_EQ(seen.size(), frame.size());
+  for (std::size_t k = 0; k < frame.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    ASSERT_EQ(seen.count(frame.id[k]), 1u) << frame.id[k];
+    const std::vector<std::uint32_t>& got = seen[frame.id[k]];
+    std::vector<std::uint32_t> want;
+    // (voxel + P) · 1 is exact, but a sum cannot give −0.0: OpenVDB's reading shows it as +0.0.
+    for (int c = 0; c < 3; ++c) want.push_back(bits(frame.position[c][i] + 0.0f));
+    for (int c = 0; c < 3; ++c) want.push_back(bits(frame.velocity[c][i]));
+    for (const FloatColumn* col :
+         {&frame.age, &frame.life, &frame.mass, &frame.attributes[0], &frame.attributes[1]})
+      want.push_back(bits((*col)[i]));
+    EXPECT_EQ(got, want) << "id " << frame.id[k];
+  }
+  // Points are spread over voxels (not all kept in one).
+  EXPECT_GT(grid->tree().activeVoxelCount(), 5u);
+}
+
+TEST_F(ioVdbPoints, ReadBackGivesTheFrameInIdOrderWithItsBitsAndMetadata) {
+  const FrameData frame = oddFrame();
+  writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
+  VdbCacheContents contents;
+  const FrameData back = readVdbPointCache(path("f.vdb"), &contents);
+  expectSameBits(back, frame);  // −0.0 included
+  EXPECT_EQ(back.frame, 42);
+  EXPECT_EQ(back.timeSeconds, 1.75);
+  EXPECT_EQ(contents.metadata.effectHash, "0123456789abcdef");
+  EXPECT_EQ(contents.metadata.seed, 9223372036854775807ull);
+  EXPECT_EQ(contents.metadata.stepRateHz, 240);
+  EXPECT_EQ(contents.metadata.integrator, "velocity_verlet");
+  EXPECT_EQ(contents.metadata.tickfxVersion, "0.1.0");
+  EXPECT_TRUE(contents.hasVelocity && contents.hasId && contents.hasAge && contents.hasLife &&
+              contents.hasMass);
+}
+
+TEST_F(ioVdbPoints, ManyPointsOverManyLeavesComeBackInIdOrder) {
+  // 5000 points scattered over ±200 m (hundreds of leaves), ids increasing with gaps.
+  FrameData frame;
+  const Eigen::Index n = 5000;
+  frame.position.resize(n);
+  frame.velocity.resize(n);
+  frame.age = FloatColumn::Zero(n);
+  frame.life = FloatColumn::Constant(n, kInf);
+  frame.mass = FloatColumn::Ones(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    frame.id.push_back(static_cast<std::uint64_t>(3 * i + 1));
+    for (int c = 0; c < 3; ++c) {
+      const double t =
+          std::fmod(0.5 + (0.7548776662466927 + 0.21 * c) * static_cast<double>(i + 1), 1.0);
+      frame.position[c][i] = static_cast<float>(400.0 * t - 200.0);
+      frame.velocity[c][i] = static_cast<float>(t);
+    }
+  }
+  writeVdbPointCache(frame, sampleMetadata(), path("many.vdb"));
+  const FrameData back = readVdbPointCache(path("many.vdb"));
+  expectSameBits(back, frame);
+  const auto grid =
+      openvdb::gridPtrCast<vdbp::PointDataGrid>(readWithOpenVdb(path("many.vdb"), "points"));
+  EXPECT_GT(grid->tree().leafCount(), 100u);
+}
+
+TEST_F(ioVdbPoints, AnEmptyFrameIsAnEmptyGrid) {
+  FrameData empty;
+  empty.frame = 1;
+  writeVdbPointCache(empty, sampleMetadata(), path("empty.vdb"));
+  const FrameData back = readVdbPointCache(path("empty.vdb"));
+  EXPECT_EQ(back.size(), 0u);
+  EXPECT_EQ(back.frame, 1);
+}
+
+TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
+  // Points as another tool writes them: OpenVDB's own conversion, a 0.25 m voxel, P in a 16-bit
+  // fixed-point codec, no v, id or age; one extra float attribute and an int one.
+  openvdb::initialize();
+  const std::vector<openvdb::Vec3R> positions = {
+      {0.1, 0.2, 0.3}, {-1.0, 2.0, 0.5}, {3.0, -3.0, 1.0}};
+  const vdbp::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
+  const auto transform = openvdb::math::Transform::createLinearTransform(0.25);
+  const auto index =
+      openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
+  auto grid = vdbp::createPointDataGrid<vdbp::FixedPointCodec<false>, vdbp::PointDataGrid>(
+      *index, wrapper, *transform);
+  vdbp::appendAttribute<float>(grid->tree(), "density", 2.5f);
+  vdbp::appendAttribute<std::int32_t>(grid->tree(), "flags", 7);
+  grid->setName("points");
+  openvdb::io::File(path("foreign.vdb").string()).write(openvdb::GridCPtrVec{grid});
+
+  VdbCacheContents contents;
+  const FrameData back = readVdbPointCache(path("foreign.vdb"), &contents);
+  ASSERT_EQ(back.size(), 3u);
+  EXPECT_FALSE(contents.hasVelocity || contents.hasId || contents.hasAge || contents.hasLife ||
+               contents.hasMass);
+  EXPECT_EQ(back.attributeNames, std::vector<std::string>{"density"});
+  // Rows in file order, numbered from 0; positions within the codec's resolution.
+  EXPECT_EQ(back.id, (std::vector<std::uint64_t>{0, 1, 2}));
+  std::vector<bool> matched(3, false);
+  for (Eigen::Index r = 0; r < 3; ++r) {
+    EXPECT_EQ(back.velocity.x[r], 0.0f);
+    EXPECT_EQ(back.age[r], 0.0f);
+    EXPECT_EQ(back.life[r], kInf);
+    EXPECT_EQ(back.mass[r], 1.0f);
+    EXPECT_EQ(back.attributes[0][r], 2.5f);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p(back.position.x[r], back.position.y[r], back.position.z[r]);
+      if ((p - Eigen::Vector3d(positions[k].x(), positions[k].y(), positions[k].z())).norm() < 1e-5)
+        matched[k] = true;
+    }
+  }
+  EXPECT_EQ(matched, std::vector<bool>(3, true));
+}
+
+// ---- errors ------------------------------------------------------------------------------------
+
+std::string errorOf(const fs::path& file) {
+  try {
+    readVdbPointCache(file);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST_F(ioVdbPoints, MissingTruncatedAndForeignFilesNameTheFileAndGrid) {
+  const std::string missing = path("missing.vdb").string();
+  EXPECT_EQ(errorOf(missing), missing + ": grid 'points': no such file");
+
+  const FrameData frame = oddFrame();
+  writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
+  std::ifstream in(path("f.vdb"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 400u);
+  // Cut inside the grid data (caught before OpenVDB reads it: OpenVDB 10 may hang there), and
+  // inside the header.
+  for (const std::size_t size : {bytes.size() - 1, bytes.size() / 2, std::size_t{300}}) {
+    const std::string cut = path("cut" + std::to_string(size) + ".vdb").string();
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, size);
+    EXPECT_EQ(errorOf(cut), cut +
+                                ": grid 'points': cannot read the grid (the file is truncated: a "
+                                "grid ends at byte " +
+                                std::to_string(bytes.size()) + " of " + std::to_string(size) + ")");
+  }
+  const std::string empty = path("empty.vdb").string();
+  std::ofstream(empty, std::ios::binary).flush();
+  EXPECT_EQ(errorOf(empty).rfind(empty + ": grid 'points': cannot open the file as OpenVDB (", 0),
+            0u)
+      << errorOf(empty);
+  const std::string head = path("head.vdb").string();
+  std::ofstream(head, std::ios::binary) << bytes.substr(0, 20);
+  EXPECT_EQ(errorOf(head), head + ": grid 'points': cannot read the grid (the file is truncated)");
+
+  // A file without the grid, and a "points" grid of another type.
+  auto density = openvdb::FloatGrid::create(1.0f);
+  density->setName("density");
+  openvdb::io::File(path("density.vdb").string()).write(openvdb::GridCPtrVec{density});
+  EXPECT_EQ(errorOf(path("density.vdb")),
+            path("density.vdb").string() + ": grid 'points': no such grid (the file has: density)");
+  density->setName("points");
+  openvdb::io::File(path("float.vdb").string()).write(openvdb::GridCPtrVec{density});
+  EXPECT_EQ(errorOf(path("float.vdb")), path("float.vdb").string() +
+                                            ": grid 'points': is a grid of type Tree_float_5_4_3 "
+                                            "(expected a PointDataGrid)");
+}
+
+TEST_F(ioVdbPoints, AFailedWriteLeavesNoFile) {
+  FrameData frame = oddFrame();
+  // Into a directory that does not exist: the error names the file, nothing is left behind.
+  const fs::path nowhere = path("no/such/dir/f.vdb");
+  try {
+    writeVdbPointCache(frame, sampleMetadata(), nowhere);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(
+        std::string(e.what()).rfind(nowhere.string() + ": cannot write the VDB points cache (", 0),
+        0u)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(path("no")));
+  // A custom attribute named like a standard one, or not a name OpenVDB takes: refused before
+  // anything is written; an existing file is left as it was.
+  writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
+  const auto size = fs::file_size(path("f.vdb"));
+  frame.attributeNames[0] = "mass";
+  EXPECT_THROW(writeVdbPointCache(frame, sampleMetadata(), path("f.vdb")), std::invalid_argument);
+  frame.attributeNames[0] = "hot spot";
+  EXPECT_THROW(writeVdbPointCache(frame, sampleMetadata(), path("f.vdb")), std::invalid_argument);
+  EXPECT_EQ(fs::file_size(path("f.vdb")), size);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+}  // namespace
+}  // namespace tickfx::io
