@@ -1,7 +1,7 @@
 // [[forces]] of type "vector_field": reading every key and its errors, the advection rules,
-// overrides, and the builder (files loaded relative to the effect, bakes in memory with the bits
-// of baked files, load errors located at the force's key). Every .vdb file is written into a
-// temporary directory of the test.
+// overrides, the lint's warnings (a file that does not load, the CFL condition), and the builder
+// (files loaded relative to the effect, bakes in memory with the bits of baked files, load errors
+// located at the force's key). Every .vdb file is written into a temporary directory of the test.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -15,6 +15,7 @@
 
 #include "fields/AnalyticField.h"
 #include "io/EffectBuilder.h"
+#include "io/EffectLint.h"
 #include "io/EffectParser.h"
 #include "io/VectorFieldSource.h"
 #include "particles/StateHash.h"
@@ -70,6 +71,15 @@ const VectorFieldSettings& fieldOf(const EffectSettings& effect, std::size_t i =
     return none;
   }
   return *field;
+}
+
+Lines lint(const EffectSettings& effect) {
+  Lines out;
+  for (const Diagnostic& d : lintEffect(effect)) {
+    EXPECT_EQ(d.severity, Severity::Warning);
+    out.push_back(d.format());
+  }
+  return out;
 }
 
 class ioVectorField : public ::testing::Test {
@@ -468,6 +478,79 @@ TEST(ioVectorFieldParse, OverridesReachEveryKeyOfAField) {
   EXPECT_EQ(messages(text, {"forces.0.bake.kind=uniform"}),
             (Lines{"--set forces.0.bake.kind: error: forces.0.bake: given together with file "
                    "(expected either file or bake)"}));
+}
+
+// ---- lint -------------------------------------------------------------------------------------
+
+TEST_F(ioVectorField, LintWarnsAboutAFileThatDoesNotLoad) {
+  const EffectSettings effect = loadFile(fieldEffect("file = \"fields/none.vdb\"\n"));
+  EXPECT_EQ(lint(effect),
+            (Lines{path("fx.toml") + ":8:8: warning: forces.0.file: " + path("fields/none.vdb") +
+                   ": grid 'vel': no such file (tickfx run stops at this: write the file first, "
+                   "e.g. with tickfx bake-field, or correct file and grid)"}));
+  // A grid the file does not have.
+  bakeField(AnalyticField::uniform({1.0, 0.0, 0.0}), BakeSettings{}, path("fields/u.vdb"));
+  EXPECT_EQ(lint(loadFile(fieldEffect("file = \"fields/u.vdb\"\ngrid = \"velocity\"\n"))),
+            (Lines{path("fx.toml") + ":8:8: warning: forces.0.file: " + path("fields/u.vdb") +
+                   ": grid 'velocity': no such grid (the file has: vel) (tickfx run stops at "
+                   "this: write the file first, e.g. with tickfx bake-field, or correct file and "
+                   "grid)"}));
+  // A sequence names the first frame that is missing.
+  bakeField(AnalyticField::uniform({1.0, 0.0, 0.0}), BakeSettings{}, path("fields/s.0001.vdb"));
+  EXPECT_EQ(
+      lint(loadFile(fieldEffect("file = \"fields/s.{frame}.vdb\"\nfps = 24\nlast_frame = 2\n"))),
+      (Lines{path("fx.toml") + ":8:8: warning: forces.0.file: " + path("fields/s.0002.vdb") +
+             ": grid 'vel': no such file (tickfx run stops at this: write the file first, "
+             "e.g. with tickfx bake-field, or correct file and grid)"}));
+  EXPECT_TRUE(lint(loadFile(fieldEffect("file = \"fields/u.vdb\"\n"))).empty());
+}
+
+// A uniform field of `speed` m/s baked at voxel size `h` in mode `mode` at `rate` Hz.
+std::string cflEffect(const std::string& mode, double speed, double h, int rate,
+                      double scale = 1.0) {
+  return "format_version = 1\n[simulation]\nstep_rate = " + std::to_string(rate) +
+         "\n[[emitters]]\nbursts = [{ time = 0.0, count = 1 }]\n[[forces]]\ntype = "
+         "\"vector_field\"\nmode = \"" +
+         mode + "\"\nscale = " + std::to_string(scale) +
+         "\nbake = { kind = \"uniform\", velocity = [0, " + std::to_string(speed) +
+         ", 0], voxel_size = " + std::to_string(h) + " }\n";
+}
+
+TEST(ioVectorFieldLint, CflNamesTheStepRateThatKeepsAStepWithinAVoxel) {
+  // Advection: 12 m/s at 60 Hz is 0.2 m a step through voxels of 0.1 m: 120 Hz is the fix.
+  EXPECT_EQ(lint(load(cflEffect("advect", 12.0, 0.1, 60))),
+            (Lines{"fx.toml:6:1: warning: forces.0: the field carries particles up to 12 m/s, "
+                   "12·dt = 0.2 m a step, more than a voxel (0.1 m) (use a step_rate of at least "
+                   "120 Hz)"}));
+  EXPECT_TRUE(lint(load(cflEffect("advect", 12.0, 0.1, 120))).empty());  // exactly a voxel
+  // Advection's speed is scaled, whatever the scale's sign.
+  EXPECT_EQ(lint(load(cflEffect("advect", 3.0, 0.125, 24, -2.0))),
+            (Lines{"fx.toml:6:1: warning: forces.0: the field carries particles up to 6 m/s, "
+                   "6·dt = 0.25 m a step, more than a voxel (0.125 m) (use a step_rate of at least "
+                   "48 Hz)"}));
+  // Drag pulls toward the field's own velocity: its scale is a rate, not a speed.
+  EXPECT_EQ(lint(load(cflEffect("drag", 7.0, 0.1, 60, 5.0))),
+            (Lines{"fx.toml:6:1: warning: forces.0: the field carries particles up to 7 m/s, "
+                   "7·dt = 0.1167 m a step, more than a voxel (0.1 m) (use a step_rate of at least "
+                   "70 Hz)"}));
+  EXPECT_TRUE(lint(load(cflEffect("drag", 7.0, 0.1, 70, 5.0))).empty());
+  // A force field is an acceleration: no CFL condition.
+  EXPECT_TRUE(lint(load(cflEffect("force", 700.0, 0.1, 60))).empty());
+}
+
+TEST(ioVectorFieldLint, TheNamedStepRateIsTheSmallestThatHolds) {
+  for (const double speed : {0.7, 3.3, 9.99, 12.01, 47.3}) {
+    for (const double h : {0.05, 0.1, 0.3}) {
+      const Lines w = lint(load(cflEffect("advect", speed, h, 1)));
+      ASSERT_EQ(w.size(), 1u) << speed << " " << h;
+      const std::size_t at = w[0].find("at least ");
+      const int needed = std::stoi(w[0].substr(at + 9));
+      EXPECT_TRUE(lint(load(cflEffect("advect", speed, h, needed))).empty()) << w[0];
+      if (needed > 1) {
+        EXPECT_EQ(lint(load(cflEffect("advect", speed, h, needed - 1))).size(), 1u) << w[0];
+      }
+    }
+  }
 }
 
 // ---- building ---------------------------------------------------------------------------------
