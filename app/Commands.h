@@ -14,5 +14,6 @@ int runCommand(Arguments& args);
 int checkCommand(Arguments& args);
 int studyCommand(Arguments& args);
 int determinismCommand(Arguments& args);
+int bakeFieldCommand(Arguments& args);
 
 }  // namespace tickfx::app

@@ -6,6 +6,7 @@
 
 #include "app/Commands.h"
 #include "app/DeterminismCheck.h"
+#include "io/EffectBuilder.h"
 #include "io/EffectParser.h"
 #include "io/FrameTimes.h"
 #include "particles/StateHash.h"
@@ -83,7 +84,12 @@ int determinismCommand(Arguments& args) {
 
   std::vector<DriveTrace> traces;
   for (const DriveCase& drive : standardDriveCases(total, threads, recorded)) {
-    traces.push_back(traceDrive(effect, drive));
+    try {
+      traces.push_back(traceDrive(effect, drive));
+    } catch (const io::BuildError& e) {  // a vector field's file that does not load: bad input
+      std::fprintf(stderr, "%s\n", e.what());
+      return kExitUsage;
+    }
     const DriveTrace& t = traces.back();
     std::printf("%-18s %7d %7zu  %-16s  %-16s  %-16s %8.3f%s\n", t.label.c_str(), t.threads,
                 t.ticks.size(), hashAt(t, rate).c_str(), hashAt(t, 2 * rate).c_str(),

@@ -190,8 +190,6 @@ int runCommand(Arguments& args) {
   for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
   if (!load.ok()) return kExitUsage;
   const io::EffectSettings& effect = *load.effect;
-  for (const io::Diagnostic& d : io::lintEffect(effect))
-    std::fprintf(stderr, "%s\n", d.format().c_str());
 
   const std::vector<io::CacheFormat> formats =
       format ? parseFormats(*format) : effect.output.formats;
@@ -220,7 +218,18 @@ int runCommand(Arguments& args) {
                                      effect.simulation.stepRateHz, effect.simulation.integrator,
                                      TICKFX_VERSION};
 
-  const auto system = io::buildSystem(effect, threadOverride);
+  // Building loads the effect's vector fields: a file that does not load is bad input, reported
+  // like an effect error, before anything is written. The lint comes after, so that such a file
+  // is reported once, as the error.
+  std::unique_ptr<ParticleSystem> system;
+  try {
+    system = io::buildSystem(effect, threadOverride);
+  } catch (const io::BuildError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitUsage;
+  }
+  for (const io::Diagnostic& d : io::lintEffect(effect))
+    std::fprintf(stderr, "%s\n", d.format().c_str());
   std::int64_t firstFrame = 1;
   Flicks resumedAt = 0;
   if (resume) {

@@ -18,6 +18,8 @@ constexpr const char* kUsage =
     "  study              the integrator study: three experiments against exact solutions\n"
     "  determinism EFFECT.toml  run an effect under many frame rates and thread counts and\n"
     "                     compare the state after every tick\n"
+    "  bake-field KIND --out FILE.vdb  bake an analytic vector field (uniform, vortex, shear,\n"
+    "                     curl-noise) into an OpenVDB file, or a sequence of them\n"
     "\n"
     "`tickfx COMMAND --help` describes a command. Exit codes: 0 ok, 2 usage or effect errors,\n"
     "1 failure at run time.\n";
@@ -42,6 +44,7 @@ int main(int argc, char** argv) {
     if (command == "check") return checkCommand(args);
     if (command == "study") return studyCommand(args);
     if (command == "determinism") return determinismCommand(args);
+    if (command == "bake-field") return bakeFieldCommand(args);
     std::fprintf(stderr, "tickfx: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return kExitUsage;
   } catch (const UsageError& e) {

@@ -6,6 +6,7 @@
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
+#include "io/VectorFieldSource.h"
 
 namespace tickfx::io {
 namespace {
@@ -30,13 +31,32 @@ struct MakeModule {
     return std::make_unique<AnchorSpring>(a.rest.cast<float>(), static_cast<float>(a.stiffness),
                                           static_cast<float>(a.damping));
   }
+  std::unique_ptr<ForceModule> operator()(const VectorFieldSettings& v) const {
+    return loadVectorField(v);
+  }
 };
 
 }  // namespace
 
+BuildError::BuildError(Diagnostic diagnostic)
+    : std::runtime_error(diagnostic.format()), diagnostic_(std::move(diagnostic)) {}
+
 ForceSet buildForces(const std::vector<ForceSettings>& forces) {
   ForceSet set;
-  for (const ForceSettings& f : forces) set.add(std::visit(MakeModule{}, f));
+  for (std::size_t i = 0; i < forces.size(); ++i) {
+    std::unique_ptr<ForceModule> module;
+    try {
+      module = std::visit(MakeModule{}, forces[i]);
+    } catch (const std::runtime_error& e) {
+      // Only loading a field reads anything outside the settings: VectorField's message names
+      // the file and the grid.
+      const auto* field = std::get_if<VectorFieldSettings>(&forces[i]);
+      if (field == nullptr) throw;
+      const std::string key = "forces." + std::to_string(i) + (field->bake ? ".bake" : ".file");
+      throw BuildError(Diagnostic{Severity::Error, "", 0, 0, key, e.what()});
+    }
+    set.add(std::move(module));
+  }
   return set;
 }
 
@@ -47,7 +67,18 @@ std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
     if (*threadsOverride < 0) throw std::invalid_argument("threads must be >= 0");
     settings.threads = *threadsOverride;
   }
-  return std::make_unique<ParticleSystem>(settings, effect.emitters, buildForces(effect.forces),
+  ForceSet forces;
+  try {
+    forces = buildForces(effect.forces);
+  } catch (const BuildError& e) {
+    Diagnostic d = e.diagnostic();
+    const SourceLocation at = effect.sources.find(d.keyPath);
+    d.file = at.file.empty() ? "<effect>" : at.file;  // "<effect>": settings built in code
+    d.line = at.line;
+    d.column = at.column;
+    throw BuildError(std::move(d));
+  }
+  return std::make_unique<ParticleSystem>(settings, effect.emitters, std::move(forces),
                                           effect.structures);
 }
 

@@ -3,23 +3,41 @@
 
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "fields/ForceSet.h"
+#include "io/Diagnostics.h"
 #include "io/EffectSettings.h"
 #include "particles/ParticleSystem.h"
 
 namespace tickfx::io {
 
+/// A valid effect that cannot be built because of something outside the file: a vector field's
+/// .vdb file missing or unreadable (loading happens here, not in the parser). Holds one error
+/// at the force's key, e.g. `fx.toml:9:8: error: forces.1.file: fields/wind.vdb: grid 'vel': no
+/// such file`; what() is its format(). Bad input like an effect error: `tickfx run` exits 2.
+class BuildError : public std::runtime_error {
+ public:
+  explicit BuildError(Diagnostic diagnostic);
+  const Diagnostic& diagnostic() const { return diagnostic_; }
+
+ private:
+  Diagnostic diagnostic_;
+};
+
 /// The force modules of `forces`, in order. Values are rounded from double to float once, here
-/// (the modules work in float). Throws std::invalid_argument for settings the modules refuse (a
-/// zero wind direction): settings from parseEffect() never are.
+/// (the modules work in float). Vector fields are loaded from their files (or baked) now. Throws
+/// BuildError (without a position: key path "forces.<i>.file" or ".bake") when a field cannot be
+/// loaded, and std::invalid_argument for settings the modules refuse (a zero wind direction):
+/// settings from parseEffect() never are.
 ForceSet buildForces(const std::vector<ForceSettings>& forces);
 
 /// A new system for `effect`: its [simulation] settings (with `threadsOverride`, when given, in
 /// place of simulation.threads), its emitters, its structures and its forces. The caller owns the
-/// system; the effect is not referenced after the call. Throws std::invalid_argument as
-/// ParticleSystem does for settings out of range: settings from parseEffect() never are.
+/// system; the effect is not referenced after the call. Throws BuildError, located through
+/// effect.sources, when a vector field cannot be loaded; std::invalid_argument as ParticleSystem
+/// does for settings out of range: settings from parseEffect() never are.
 std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
                                             std::optional<int> threadsOverride = std::nullopt);
 

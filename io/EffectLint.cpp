@@ -5,6 +5,10 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "io/VectorFieldSource.h"
 
 namespace tickfx::io {
 namespace {
@@ -66,6 +70,39 @@ void lintWind(const EffectSettings& effect, const WindSettings& wind, const std:
                   " Hz (half of step_rate = " + std::to_string(effect.simulation.stepRateHz) +
                   " Hz) and is sampled as a " + rounded(alias, 4) +
                   " Hz wind (use a step_rate of at least " + std::to_string(needed) + " Hz)"));
+}
+
+// A vector field, loaded (or baked) as the builder will: a file that will not load, and a field
+// that carries particles across more than a voxel a step (drag and advect modes: the particles
+// follow the field's velocity, so a step longer than a voxel skips its structure, the CFL
+// condition of advection).
+void lintVectorField(const EffectSettings& effect, const VectorFieldSettings& field,
+                     const std::string& path, std::vector<Diagnostic>& out) {
+  std::unique_ptr<VectorField> loaded;
+  try {
+    loaded = loadVectorField(field);
+  } catch (const std::runtime_error& e) {
+    out.push_back(warning(effect, path + (field.bake ? ".bake" : ".file"),
+                          std::string(e.what()) +
+                              " (tickfx run stops at this: write the file first, e.g. with "
+                              "tickfx bake-field, or correct file and grid)"));
+    return;
+  }
+  if (field.mode == VectorField::Mode::Force) return;
+  // Drag pulls particles toward the field's velocity itself (scale is a rate there); advection
+  // moves them at scale times it.
+  const double speed = loaded->maxMagnitude() *
+                       (field.mode == VectorField::Mode::Advect ? std::abs(field.scale) : 1.0);
+  const double voxel = loaded->voxelSize();
+  const double rate = static_cast<double>(effect.simulation.stepRateHz);
+  if (!(speed / rate > voxel)) return;
+  auto needed = static_cast<std::int64_t>(std::ceil(speed / voxel));
+  while (speed / static_cast<double>(needed) > voxel) ++needed;  // ceil's rounding, at most once
+  out.push_back(warning(effect, path,
+                        "the field carries particles up to " + rounded(speed, 4) + " m/s, " +
+                            rounded(speed, 4) + "·dt = " + rounded(speed / rate, 4) +
+                            " m a step, more than a voxel (" + rounded(voxel, 4) +
+                            " m) (use a step_rate of at least " + std::to_string(needed) + " Hz)"));
 }
 
 // The lightest particle mass of the effect (emitters' and structures'), or nothing.
@@ -294,6 +331,9 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect) {
       lintWind(effect, *wind, path, out);
     if (const auto* spring = std::get_if<AnchorSpringSettings>(&effect.forces[i])) {
       lintSpring(effect, *spring, path, out);
+    }
+    if (const auto* field = std::get_if<VectorFieldSettings>(&effect.forces[i])) {
+      lintVectorField(effect, *field, path, out);
     }
   }
   lintStructures(effect, out);

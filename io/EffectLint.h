@@ -66,6 +66,12 @@ StructureStiffness structureStiffness(const StructureSettings& structure);
 ///     c_eff < k_eff·dt (×(1 + (k_eff·dt − c_eff)·dt/m) a step): the damping per spring that
 ///     stops the gain and the step_rate that keeps it under 1 % over the output. (Midpoint's
 ///     loss in a structure's fastest vibration is not warned about: it only damps the jitter.)
+///   - a vector field whose file or grid cannot be loaded (the message VectorField gives,
+///     naming file and grid; `tickfx run` stops at it), and, in modes drag and advect, a field
+///     that carries particles more than a voxel a step: speed·dt > h, with speed the field's
+///     largest |u| over all frames (times |scale| for advect) and h its voxel size, the CFL
+///     condition of advection: a step_rate of at least ⌈speed / h⌉ Hz. Fields are loaded (or
+///     baked) to know this, as the builder will load them.
 /// An anchor spring's mass m is the lightest of the emitters' and the structures'.
 /// Positions come from effect.sources (the value's line, else its table's header).
 std::vector<Diagnostic> lintEffect(const EffectSettings& effect);

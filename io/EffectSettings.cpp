@@ -11,13 +11,24 @@ std::string_view forceTypeName(const ForceSettings& force) {
     std::string_view operator()(const DragSettings&) const { return "drag"; }
     std::string_view operator()(const WindSettings&) const { return "wind"; }
     std::string_view operator()(const AnchorSpringSettings&) const { return "anchor_spring"; }
+    std::string_view operator()(const VectorFieldSettings&) const { return "vector_field"; }
   };
   return std::visit(Name{}, force);
 }
 
 const std::vector<std::string>& forceTypeNames() {
-  static const std::vector<std::string> names = {"gravity", "drag", "wind", "anchor_spring"};
+  static const std::vector<std::string> names = {"gravity", "drag", "wind", "anchor_spring",
+                                                 "vector_field"};
   return names;
+}
+
+const std::vector<std::string>& fieldKindNames() {
+  static const std::vector<std::string> names = {"uniform", "vortex", "shear", "curl-noise"};
+  return names;
+}
+
+std::string_view fieldKindName(FieldBakeSettings::Kind kind) {
+  return fieldKindNames()[static_cast<std::size_t>(kind)];
 }
 
 const std::vector<std::string>& emitterTypeNames() {

@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "fields/VectorField.h"
 #include "io/SourceMap.h"
 #include "particles/Clock.h"
 #include "particles/Emitter.h"
@@ -48,11 +49,67 @@ struct AnchorSpringSettings {
   double damping = 0.0;                            // N·s/m
 };
 
-/// One entry of [[forces]], in file order (the order the forces are summed in).
-using ForceSettings =
-    std::variant<GravitySettings, DragSettings, WindSettings, AnchorSpringSettings>;
+/// The `bake` table of a vector field: an analytic field (fields/AnalyticField.h) baked into
+/// grids in memory when the effect is built, so that an effect needs no .vdb file. Only the
+/// parameters of `kind` are used; the others keep their defaults.
+struct FieldBakeSettings {
+  enum class Kind { Uniform, Vortex, Shear, CurlNoise };
+  Kind kind = Kind::Uniform;
+  double voxelSize = 0.1;                                 // metres
+  Eigen::Vector3d min = Eigen::Vector3d::Constant(-1.0);  // metres: every voxel whose centre
+  Eigen::Vector3d max = Eigen::Vector3d::Constant(1.0);   // i·voxelSize is in [min, max] is baked
+  bool staggered = false;                                 // a MAC grid (face-centred components)
+  Eigen::Vector3d background = Eigen::Vector3d::Zero();   // field units, outside the baked box
+  // uniform: u = velocity
+  Eigen::Vector3d velocity = Eigen::Vector3d::UnitX();  // field units (m/s)
+  // vortex: u = omega · axis × (x − centre)
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // metres
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitY();   // any length but zero
+  double omega = 1.0;                                // rad/s
+  // shear: u = rate · (gradient·(x − origin)) · direction (both normalised)
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();      // metres
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // any length but zero
+  Eigen::Vector3d gradient = Eigen::Vector3d::UnitY();   // any length but zero
+  double rate = 1.0;                                     // 1/s
+  // curl-noise (AnalyticField::curlNoise)
+  std::uint64_t seed = 0;
+  double frequency = 3.0;  // rad/m
+  double amplitude = 1.0;  // field units (m/s), the order of |u|
+  int octaves = 4;
+  double evolution = 0.0;  // rad/s: how fast the noise changes in time
+};
 
-/// The `type` of a force as written in effect files ("gravity", "drag", "wind", "anchor_spring").
+/// The `kind` of a bake as written: "uniform", "vortex", "shear" or "curl-noise".
+std::string_view fieldKindName(FieldBakeSettings::Kind kind);
+/// Every bake kind, in the order of FieldBakeSettings::Kind.
+const std::vector<std::string>& fieldKindNames();
+
+/// `type = "vector_field"`: a Vec3 grid sampled in world space (fields/VectorField.h), from a
+/// .vdb file (or a {frame} sequence of them) or baked in memory from `bake`. Exactly one of
+/// `file` and `bake` is set.
+struct VectorFieldSettings {
+  std::string file;  // as written; may hold {frame}. Empty when baked
+  std::string path;  // `file` resolved against the effect file's directory: what is loaded
+  std::optional<FieldBakeSettings> bake;
+  std::string grid = "vel";
+  VectorField::Mode mode = VectorField::Mode::Force;
+  /// Force: m/s² per field unit; Drag: the rate k in 1/s; Advect: m/s per field unit.
+  double scale = 1.0;
+  VectorField::Interpolation interpolation = VectorField::Interpolation::Linear;
+  VectorField::Outside outside = VectorField::Outside::Background;
+  // A sequence when fps > 0: frames firstFrame..lastFrame, frame f at (f − firstFrame)/fps s.
+  double fps = 0.0;
+  int firstFrame = 1;
+  int lastFrame = 1;
+  int framePadding = 4;  // digits {frame} is zero-padded to (files only)
+};
+
+/// One entry of [[forces]], in file order (the order the forces are summed in).
+using ForceSettings = std::variant<GravitySettings, DragSettings, WindSettings,
+                                   AnchorSpringSettings, VectorFieldSettings>;
+
+/// The `type` of a force as written in effect files ("gravity", "drag", "wind", "anchor_spring",
+/// "vector_field").
 std::string_view forceTypeName(const ForceSettings& force);
 /// Every force type, in the order above.
 const std::vector<std::string>& forceTypeNames();

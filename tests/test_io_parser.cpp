@@ -121,7 +121,7 @@ type = "drag"
              "bad.toml:6:11: error: emitters.0.bursts.0.count: missing (expected particles, an "
              "integer from 1 to simulation.max_particles = 1000000)",
              "bad.toml:8:1: error: forces.0.type: missing (expected force type, one of: "
-             "gravity, drag, wind, anchor_spring)",
+             "gravity, drag, wind, anchor_spring, vector_field)",
              "bad.toml:11:1: error: forces.1.k: missing (expected a rate in 1/s, a number from "
              "0 to 1e9)"}));
 }
@@ -184,7 +184,7 @@ type = "magnet"
              "bad.toml:9:8: error: forces.0.type: unknown force type \"gravty\" (did you mean "
              "\"gravity\"?)",
              "bad.toml:11:8: error: forces.1.type: unknown force type \"magnet\" (expected one "
-             "of: gravity, drag, wind, anchor_spring)"}));
+             "of: gravity, drag, wind, anchor_spring, vector_field)"}));
   // Case is not a spelling: "RK4" is one edit-free step from "rk4" but still wrong.
   EXPECT_EQ(
       messages("format_version = 1\n[simulation]\nstep_rate = 60\nintegrator = \"RK4\"\n"

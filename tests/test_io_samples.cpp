@@ -17,7 +17,7 @@ namespace {
 
 const std::vector<std::string> kSamples = {
     "fountain",   "oscillator", "wind_aliasing", "wind_aliasing_fixed", "smoke_drift", "burst",
-    "rope_swing", "flag",       "jelly"};
+    "rope_swing", "flag",       "jelly",         "vortex_smoke",        "leaves"};
 
 std::filesystem::path samplePath(const std::string& name) {
   return std::filesystem::path(TICKFX_SOURCE_DIR) / "samples" / (name + ".toml");

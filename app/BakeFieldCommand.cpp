@@ -1,0 +1,317 @@
+// tickfx bake-field: an analytic vector field (uniform, vortex, shear, curl noise) baked into a
+// .vdb file, or a sequence of them, so that samples and tests make their fields instead of
+// shipping binaries.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "app/Commands.h"
+#include "io/EditDistance.h"
+#include "io/VectorFieldSource.h"
+
+namespace tickfx::app {
+namespace {
+
+constexpr const char* kHelp =
+    "usage: tickfx bake-field KIND --out FILE.vdb [--voxel-size V] [--bounds x0,y0,z0,x1,y1,z1]\n"
+    "                         [--grid NAME] [KIND's options] [--frames A..B --fps F]\n"
+    "\n"
+    "Bakes an analytic vector field into an OpenVDB file: one vec3s grid whose voxels with "
+    "centres\n"
+    "i*V inside the bounds are active and hold the field there, rounded to float once. The same\n"
+    "fields as the `bake` table of a vector_field force (docs/effects.md). Units: metres, m/s.\n"
+    "\n"
+    "KIND and its options (defaults in brackets):\n"
+    "  uniform      u = velocity\n"
+    "                 --velocity X,Y,Z   m/s [1,0,0]\n"
+    "  vortex       u = omega * axis x (x - centre), a rigid rotation\n"
+    "                 --centre X,Y,Z     m [0,0,0]\n"
+    "                 --axis X,Y,Z       direction, not all zero [0,1,0]\n"
+    "                 --omega W          rad/s [1]\n"
+    "  shear        u = rate * (gradient . (x - origin)) * direction\n"
+    "                 --origin X,Y,Z     m [0,0,0]\n"
+    "                 --direction X,Y,Z  the flow, not all zero [1,0,0]\n"
+    "                 --gradient X,Y,Z   the way the speed grows, not all zero [0,1,0]\n"
+    "                 --rate R           1/s [1]\n"
+    "  curl-noise   divergence-free noise, a pure function of the seed\n"
+    "                 --seed N           0 to 9223372036854775807 [0]\n"
+    "                 --frequency F      rad/m, > 0 [3]\n"
+    "                 --amplitude A      m/s, the order of |u| [1]\n"
+    "                 --octaves N        1 to 16 [4]\n"
+    "                 --evolution W      rad/s: how fast the noise changes in time [0]\n"
+    "Grid:\n"
+    "  --out FILE.vdb       the file written (required); replaced whole, never left half-written\n"
+    "  --voxel-size V       metres [0.1]\n"
+    "  --bounds x0,y0,z0,x1,y1,z1  the baked box in metres [-1,-1,-1,1,1,1]\n"
+    "  --grid NAME          the grid's name [vel]\n"
+    "  --staggered          a staggered (MAC) grid: component c at the centre of the voxel's\n"
+    "                       face on the -c side\n"
+    "  --background X,Y,Z   the value outside the baked voxels [0,0,0]\n"
+    "Sequences (curl noise with --evolution changes in time):\n"
+    "  --frames A..B        bake frames A to B, frame f at time (f - A)/F s, each into --out with\n"
+    "                       {frame} replaced by f zero-padded to --frame-padding digits [4]\n"
+    "  --fps F              the sequence's frames per second (required with --frames)\n"
+    "At most 100000000 voxels over all frames. Exit codes: 0 ok, 2 usage errors (nothing is\n"
+    "written), 1 failure at run time.\n";
+
+constexpr double kBig = 1e9;
+constexpr long long kMaxFrame = 1'000'000;
+constexpr long long kMaxFrames = 10'000;
+
+const std::vector<std::pair<std::string, std::vector<std::string>>>& kindOptions() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> options = {
+      {"uniform", {"--velocity"}},
+      {"vortex", {"--centre", "--axis", "--omega"}},
+      {"shear", {"--origin", "--direction", "--gradient", "--rate"}},
+      {"curl-noise", {"--seed", "--frequency", "--amplitude", "--octaves", "--evolution"}}};
+  return options;
+}
+
+std::string join(const std::vector<std::string>& words, const std::string& last) {
+  std::string out;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    out += (i == 0 ? "" : (i + 1 == words.size() ? last : ", ")) + words[i];
+  }
+  return out;
+}
+
+// "x,y,z" (or `count` numbers), each a number in [-1e9, 1e9].
+std::vector<double> parseList(const std::string& text, const std::string& option, std::size_t count,
+                              const std::string& shape) {
+  std::vector<std::string> parts;
+  std::stringstream list(text);
+  std::string part;
+  while (std::getline(list, part, ',')) parts.push_back(part);
+  if (!text.empty() && text.back() == ',') parts.push_back("");
+  if (parts.size() != count) {
+    throw UsageError(option + ": '" + text + "' is not " + std::to_string(count) + " numbers " +
+                     shape);
+  }
+  std::vector<double> values;
+  for (const std::string& p : parts) values.push_back(parseNumber(p, option, -kBig, kBig));
+  return values;
+}
+
+Eigen::Vector3d parseVector(const std::string& text, const std::string& option,
+                            bool nonZero = false) {
+  const std::vector<double> v = parseList(text, option, 3, "x,y,z");
+  const Eigen::Vector3d out(v[0], v[1], v[2]);
+  if (nonZero && out.isZero(0.0)) {
+    throw UsageError(option + ": '" + text + "' is not a direction (expected x,y,z not all zero)");
+  }
+  return out;
+}
+
+// A number in (0, max]: a size or a rate.
+double parsePositive(const std::string& text, const std::string& option, double max) {
+  char range[64];
+  std::snprintf(range, sizeof range, "(0, %g]", max);
+  const UsageError refused(option + ": '" + text + "' is not a number in " + range);
+  double v = 0.0;
+  try {
+    v = parseNumber(text, option, 0.0, max);
+  } catch (const UsageError&) {
+    throw refused;
+  }
+  if (!(v > 0.0)) throw refused;
+  return v;
+}
+
+// "A..B" with whole numbers A <= B.
+std::pair<int, int> parseFrames(const std::string& text) {
+  const std::string expected = "bake-field: --frames: '" + text +
+                               "' is not a frame range A..B (whole numbers from -1000000 to "
+                               "1000000, A <= B)";
+  const std::size_t dots = text.find("..");
+  if (dots == std::string::npos) throw UsageError(expected);
+  long long a = 0, b = 0;
+  try {
+    a = parseInteger(text.substr(0, dots), "--frames", -kMaxFrame, kMaxFrame);
+    b = parseInteger(text.substr(dots + 2), "--frames", -kMaxFrame, kMaxFrame);
+  } catch (const UsageError&) {
+    throw UsageError(expected);
+  }
+  if (b < a) throw UsageError(expected);
+  if (b - a + 1 > kMaxFrames) {
+    throw UsageError("bake-field: --frames: " + std::to_string(b - a + 1) +
+                     " frames are too many (expected at most 10000)");
+  }
+  return {static_cast<int>(a), static_cast<int>(b)};
+}
+
+std::string numberText(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+}  // namespace
+
+int bakeFieldCommand(Arguments& args) {
+  if (args.flag("--help")) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  const auto out = args.value("--out");
+  const auto voxelSize = args.value("--voxel-size");
+  const auto bounds = args.value("--bounds");
+  const auto grid = args.value("--grid");
+  const bool staggered = args.flag("--staggered");
+  const auto background = args.value("--background");
+  const auto frames = args.value("--frames");
+  const auto fps = args.value("--fps");
+  const auto padding = args.value("--frame-padding");
+  std::map<std::string, std::string> given;  // the kinds' options, by name
+  for (const auto& [kind, options] : kindOptions()) {
+    for (const std::string& option : options) {
+      if (const auto v = args.value(option)) given[option] = *v;
+    }
+  }
+  const std::string kind =
+      args.positionals(1,
+                       "a field kind: tickfx bake-field KIND --out FILE.vdb (KIND: uniform, "
+                       "vortex, shear or curl-noise)")[0];
+
+  // Everything is checked before anything is written.
+  std::vector<std::string> kinds;
+  const std::vector<std::string>* own = nullptr;
+  for (const auto& [name, options] : kindOptions()) {
+    kinds.push_back(name);
+    if (name == kind) own = &options;
+  }
+  if (own == nullptr) {
+    const std::optional<std::string> guess = io::closestMatch(kind, kinds);
+    throw UsageError(
+        "bake-field: unknown kind '" + kind + "' " +
+        (guess ? "(did you mean '" + *guess + "'?)" : "(expected " + join(kinds, " or ") + ")"));
+  }
+  for (const auto& [option, value] : given) {
+    if (std::find(own->begin(), own->end(), option) == own->end()) {
+      throw UsageError("bake-field: " + option + " does not apply to kind '" + kind +
+                       "' (its options: " + join(*own, " and ") + ")");
+    }
+  }
+  if (!out || out->empty()) throw UsageError("bake-field: --out FILE.vdb is required");
+
+  io::FieldBakeSettings bake;
+  for (std::size_t k = 0; k < kinds.size(); ++k) {
+    if (kinds[k] == kind) bake.kind = static_cast<io::FieldBakeSettings::Kind>(k);
+  }
+  const auto option = [&](const char* name) -> std::optional<std::string> {
+    const auto it = given.find(name);
+    if (it == given.end()) return std::nullopt;
+    return it->second;
+  };
+  const std::string p = "bake-field: ";
+  if (const auto v = option("--velocity")) bake.velocity = parseVector(*v, p + "--velocity");
+  if (const auto v = option("--centre")) bake.centre = parseVector(*v, p + "--centre");
+  if (const auto v = option("--axis")) bake.axis = parseVector(*v, p + "--axis", true);
+  if (const auto v = option("--omega")) bake.omega = parseNumber(*v, p + "--omega", -kBig, kBig);
+  if (const auto v = option("--origin")) bake.origin = parseVector(*v, p + "--origin");
+  if (const auto v = option("--direction")) {
+    bake.direction = parseVector(*v, p + "--direction", true);
+  }
+  if (const auto v = option("--gradient")) bake.gradient = parseVector(*v, p + "--gradient", true);
+  if (const auto v = option("--rate")) bake.rate = parseNumber(*v, p + "--rate", -kBig, kBig);
+  if (const auto v = option("--seed")) {
+    bake.seed = static_cast<std::uint64_t>(parseInteger(*v, p + "--seed", 0, INT64_MAX));
+  }
+  if (const auto v = option("--frequency")) {
+    bake.frequency = parsePositive(*v, p + "--frequency", kBig);
+  }
+  if (const auto v = option("--amplitude")) {
+    bake.amplitude = parseNumber(*v, p + "--amplitude", 0.0, kBig);
+  }
+  if (const auto v = option("--octaves")) {
+    bake.octaves = static_cast<int>(parseInteger(*v, p + "--octaves", 1, 16));
+  }
+  if (const auto v = option("--evolution")) {
+    bake.evolution = parseNumber(*v, p + "--evolution", 0.0, kBig);
+  }
+
+  if (voxelSize) bake.voxelSize = parsePositive(*voxelSize, p + "--voxel-size", kBig);
+  if (bounds) {
+    const std::vector<double> b = parseList(*bounds, p + "--bounds", 6, "x0,y0,z0,x1,y1,z1");
+    for (int c = 0; c < 3; ++c) {
+      if (b[c + 3] < b[c]) {
+        const std::string axis(1, "xyz"[c]);
+        throw UsageError(p + "--bounds: " + axis + "1 = " + numberText(b[c + 3]) + " is below " +
+                         axis + "0 = " + numberText(b[c]) +
+                         " (expected x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1 and z0 <= z1)");
+      }
+    }
+    bake.min = Eigen::Vector3d(b[0], b[1], b[2]);
+    bake.max = Eigen::Vector3d(b[3], b[4], b[5]);
+  }
+  bake.staggered = staggered;
+  if (background) bake.background = parseVector(*background, p + "--background");
+  const std::string gridName = grid.value_or("vel");
+  if (gridName.empty()) throw UsageError(p + "--grid: the grid needs a name");
+
+  // The sequence: frame numbers, times and files.
+  if (frames && !fps)
+    throw UsageError(p + "--frames needs --fps (the sequence's frames per second)");
+  if (fps && !frames) throw UsageError(p + "--fps needs --frames A..B");
+  if (padding && !frames) throw UsageError(p + "--frame-padding needs --frames A..B");
+  int first = 0, last = 0, digits = 4;
+  double rate = 0.0;
+  if (frames) {
+    std::tie(first, last) = parseFrames(*frames);
+    rate = parsePositive(*fps, p + "--fps", 1e6);
+    if (padding) digits = static_cast<int>(parseInteger(*padding, p + "--frame-padding", 1, 10));
+  }
+  const bool pattern = out->find("{frame}") != std::string::npos;
+  if (frames && !pattern) {
+    throw UsageError(p + "--out: '" + *out +
+                     "' has no {frame} (expected a pattern such as vel.{frame}.vdb with --frames)");
+  }
+  if (!frames && pattern) {
+    throw UsageError(p + "--out: '" + *out + "' has {frame} but no --frames A..B is given");
+  }
+
+  // The grid's size, as an effect's bake table is judged.
+  const double h = bake.voxelSize;
+  const double reach = std::max(bake.min.cwiseAbs().maxCoeff(), bake.max.cwiseAbs().maxCoeff());
+  if (reach / h > io::kMaxBakedIndex) {
+    throw UsageError(p + "--voxel-size: " + numberText(h) + " m puts the bounds " +
+                     numberText(std::ceil(reach / h)) +
+                     " voxels from the origin (expected at least " +
+                     numberText(reach / io::kMaxBakedIndex) + " m for these bounds)");
+  }
+  const double perFrame = io::bakedVoxelCount(h, bake.min, bake.max);
+  if (perFrame < 1.0) {
+    throw UsageError(p + "--bounds: the box holds no voxel centre at --voxel-size " +
+                     numberText(h) + " (expected at least one point i*V on each axis)");
+  }
+  const int count = last - first + 1;
+  if (perFrame * count > io::kMaxBakedVoxels) {
+    throw UsageError(p + "--voxel-size " + numberText(h) + " and --bounds make " +
+                     numberText(perFrame) + " voxels a frame, " + numberText(perFrame * count) +
+                     " over " + std::to_string(count) + (count == 1 ? " frame" : " frames") +
+                     " (expected at most 100000000)");
+  }
+
+  const AnalyticField field = io::analyticField(bake);
+  const BakeSettings settings = io::bakeSettings(bake, gridName);
+  const std::filesystem::path parent = std::filesystem::path(*out).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  for (int f = first; f <= last; ++f) {
+    const std::string path = frames ? io::sequenceFramePath(*out, f, digits) : *out;
+    const double time = frames ? (f - first) / rate : 0.0;
+    bakeField(field, settings, path, time);
+    std::printf("%s: %s field, grid '%s', %.0f voxels of %s m%s\n", path.c_str(), kind.c_str(),
+                gridName.c_str(), perFrame, numberText(h).c_str(),
+                frames ? (", t = " + numberText(time) + " s").c_str() : "");
+  }
+  return kExitOk;
+}
+
+}  // namespace tickfx::app

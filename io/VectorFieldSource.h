@@ -1,0 +1,48 @@
+// Where the grids of a `vector_field` force come from: its .vdb file (or {frame} sequence), or
+// its `bake` table baked in memory. The builder (run) and the lint (check) load fields through
+// here; `tickfx bake-field` makes its analytic fields with the same functions.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "fields/AnalyticField.h"
+#include "fields/VectorField.h"
+#include "io/EffectSettings.h"
+
+namespace tickfx::io {
+
+/// The most voxels a bake may hold over all its frames: 10⁸ vec3s voxels are about 1.2 GB of
+/// values, and baking them takes minutes. Effect files and `tickfx bake-field` refuse more.
+inline constexpr double kMaxBakedVoxels = 1e8;
+/// The largest |bound| / voxel_size a bake accepts: voxel indices must fit OpenVDB's 32-bit
+/// coordinates (2³¹ ≈ 2.1e9) with room to spare.
+inline constexpr double kMaxBakedIndex = 1e9;
+
+/// The voxels of one baked frame of the box [min, max] (metres) at `voxelSize` (metres): per
+/// axis, the voxel centres i·voxelSize inside the box, as fields/AnalyticField's bakeField counts
+/// them. A double, since bad input can make it astronomically large; 0 when the box holds no
+/// centre on some axis.
+double bakedVoxelCount(double voxelSize, const Eigen::Vector3d& min, const Eigen::Vector3d& max);
+
+/// The file of frame `frame` of the sequence `pattern`: its first "{frame}" replaced by the frame
+/// number zero-padded to `padding` digits (a minus sign before the digits of a negative frame),
+/// the names VectorField loads a sequence from. `pattern` unchanged when it has no "{frame}".
+std::string sequenceFramePath(const std::string& pattern, int frame, int padding);
+
+/// The analytic field `bake` describes (its kind's parameters). Throws std::invalid_argument as
+/// AnalyticField does (a zero axis or direction): settings from parseEffect() never are.
+AnalyticField analyticField(const FieldBakeSettings& bake);
+
+/// Where and how `bake` is baked, under grid name `gridName` (values rounded to float once).
+BakeSettings bakeSettings(const FieldBakeSettings& bake, const std::string& gridName = "vel");
+
+/// The VectorField of one vector_field force: every frame of `field.path` loaded now (the caller
+/// owns the result), or `field.bake` baked in memory (one grid, or one a frame of a sequence, frame
+/// f at (f − firstFrame)/fps s), with the same bits a baked file would give. Throws
+/// std::runtime_error naming the file and the grid when a file cannot be read ("PATH: grid 'vel':
+/// no such file", see VectorField).
+std::unique_ptr<VectorField> loadVectorField(const VectorFieldSettings& field);
+
+}  // namespace tickfx::io
