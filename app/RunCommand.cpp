@@ -228,7 +228,7 @@ int runCommand(Arguments& args) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitUsage;
   }
-  for (const io::Diagnostic& d : io::lintEffect(effect))
+  for (const io::Diagnostic& d : io::lintEffect(effect, &system->forces()))
     std::fprintf(stderr, "%s\n", d.format().c_str());
   std::int64_t firstFrame = 1;
   Flicks resumedAt = 0;

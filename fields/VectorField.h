@@ -66,7 +66,7 @@ class VectorField final : public ForceModule {
   VectorField(const VectorField&) = delete;
   VectorField& operator=(const VectorField&) = delete;
 
-  std::string_view typeName() const override { return "vdb_field"; }
+  std::string_view typeName() const override { return "vector_field"; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   bool prescribesVelocity() const override { return s_.mode == Mode::Advect; }
   void accumulateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const override;

@@ -77,10 +77,15 @@ void lintWind(const EffectSettings& effect, const WindSettings& wind, const std:
 // follow the field's velocity, so a step longer than a voxel skips its structure, the CFL
 // condition of advection).
 void lintVectorField(const EffectSettings& effect, const VectorFieldSettings& field,
-                     const std::string& path, std::vector<Diagnostic>& out) {
-  std::unique_ptr<VectorField> loaded;
+                     const std::string& path, const VectorField* built,
+                     std::vector<Diagnostic>& out) {
+  std::unique_ptr<VectorField> owned;
+  const VectorField* loaded = built;
   try {
-    loaded = loadVectorField(field);
+    if (loaded == nullptr) {
+      owned = loadVectorField(field);
+      loaded = owned.get();
+    }
   } catch (const std::runtime_error& e) {
     out.push_back(warning(effect, path + (field.bake ? ".bake" : ".file"),
                           std::string(e.what()) +
@@ -323,7 +328,7 @@ std::optional<double> springStabilityLimit(std::string_view integrator) {
   return std::nullopt;
 }
 
-std::vector<Diagnostic> lintEffect(const EffectSettings& effect) {
+std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built) {
   std::vector<Diagnostic> out;
   for (std::size_t i = 0; i < effect.forces.size(); ++i) {
     const std::string path = "forces." + std::to_string(i);
@@ -333,7 +338,11 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect) {
       lintSpring(effect, *spring, path, out);
     }
     if (const auto* field = std::get_if<VectorFieldSettings>(&effect.forces[i])) {
-      lintVectorField(effect, *field, path, out);
+      // The builder's module when there is one: a field sequence is not loaded twice.
+      const VectorField* module = built != nullptr && i < built->size()
+                                      ? dynamic_cast<const VectorField*>(&built->module(i))
+                                      : nullptr;
+      lintVectorField(effect, *field, path, module, out);
     }
   }
   lintStructures(effect, out);

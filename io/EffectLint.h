@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fields/ForceSet.h"
 #include "io/Diagnostics.h"
 #include "io/EffectSettings.h"
 
@@ -74,6 +75,10 @@ StructureStiffness structureStiffness(const StructureSettings& structure);
 ///     baked) to know this, as the builder will load them.
 /// An anchor spring's mass m is the lightest of the emitters' and the structures'.
 /// Positions come from effect.sources (the value's line, else its table's header).
-std::vector<Diagnostic> lintEffect(const EffectSettings& effect);
+///
+/// `built`: the forces buildForces() (or a ParticleSystem built from `effect`) made, in effect
+/// order; their vector fields are then inspected instead of loaded again. Without it, fields are
+/// loaded (or baked) here.
+std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built = nullptr);
 
 }  // namespace tickfx::io

@@ -539,6 +539,23 @@ TEST(ioVectorFieldLint, CflNamesTheStepRateThatKeepsAStepWithinAVoxel) {
   EXPECT_TRUE(lint(load(cflEffect("force", 700.0, 0.1, 60))).empty());
 }
 
+TEST(ioVectorFieldLint, TheBuiltFieldsGiveTheSameWarningsWithoutLoadingAgain) {
+  // `tickfx run` lints with the forces it built, so that a field is loaded once.
+  const EffectSettings effect = load(cflEffect("advect", 12.0, 0.1, 60));
+  const ForceSet built = buildForces(effect.forces);
+  Lines withBuilt;
+  for (const Diagnostic& d : lintEffect(effect, &built)) withBuilt.push_back(d.format());
+  EXPECT_EQ(withBuilt, lint(effect));
+  ASSERT_EQ(withBuilt.size(), 1u);
+  // What the lint read is the built module: a different one shows.
+  const EffectSettings slower = load(cflEffect("advect", 24.0, 0.1, 60));
+  const ForceSet faster = buildForces(slower.forces);
+  Lines fromFaster;
+  for (const Diagnostic& d : lintEffect(effect, &faster)) fromFaster.push_back(d.format());
+  ASSERT_EQ(fromFaster.size(), 1u);
+  EXPECT_NE(fromFaster[0].find("up to 24 m/s"), std::string::npos) << fromFaster[0];
+}
+
 TEST(ioVectorFieldLint, TheNamedStepRateIsTheSmallestThatHolds) {
   for (const double speed : {0.7, 3.3, 9.99, 12.01, 47.3}) {
     for (const double h : {0.05, 0.1, 0.3}) {

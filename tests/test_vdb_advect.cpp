@@ -244,7 +244,7 @@ TEST(VdbAdvect, KillAddsNothingOutsideDuringTheStep) {
 TEST(VdbAdvect, CannotBeMixedWithAccelerationForces) {
   const auto bake = box(0.5, Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1));
   const std::string message =
-      "vdb_field in advect mode sets the velocity, so the gravity force would be ignored: an "
+      "vector_field in advect mode sets the velocity, so the gravity force would be ignored: an "
       "advected effect cannot have acceleration forces (use mode \"drag\" to pull particles "
       "toward the field instead)";
   {
