@@ -59,11 +59,12 @@ struct LeafBoxSampler {
     }
     constexpr openvdb::Index kDx = 1u << (2 * Leaf::LOG2DIM), kDy = 1u << Leaf::LOG2DIM;
     const openvdb::Index o = Leaf::coordToOffset(ijk);
+    // The buffer once (LeafBuffer::data() checks for out-of-core data on every call).
+    const auto* values = leaf->buffer().data();
     ValueT data[2][2][2];
     for (openvdb::Index a = 0; a < 2; ++a) {
       for (openvdb::Index b = 0; b < 2; ++b) {
-        for (openvdb::Index c = 0; c < 2; ++c)
-          data[a][b][c] = leaf->getValue(o + a * kDx + b * kDy + c);
+        for (openvdb::Index c = 0; c < 2; ++c) data[a][b][c] = values[o + a * kDx + b * kDy + c];
       }
     }
     result = openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
