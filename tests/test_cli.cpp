@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "CliTestSupport.h"
 #include "io/CsvCache.h"
 #include "io/PlyCache.h"
 
@@ -16,43 +17,15 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exit = -1;
-  std::string out;
-  std::string err;
-};
+using tickfx::cli_test::readAll;
+using tickfx::cli_test::Result;
 
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class Cli : public ::testing::Test {
+class Cli : public tickfx::cli_test::CliFixture {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("tickfx_cli_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Cli() : CliFixture("tickfx_cli") {}
 
-  // Runs `tickfx ARGS` from the source tree (so samples/... resolve), stdin closed.
-  Result run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = "cd '" TICKFX_SOURCE_DIR "' && '" TICKFX_CLI "' " + args +
-                                " </dev/null >'" + out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(command.c_str());
-    Result r;
-    r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = readAll(out);
-    r.err = readAll(err);
-    return r;
-  }
+  // `tickfx ARGS` from the source tree, stdin closed.
+  Result run(const std::string& args) const { return runProgram(TICKFX_CLI, args); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::string writeFile(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / name) << text;
@@ -67,8 +40,6 @@ class Cli : public ::testing::Test {
     if (hash.find_first_not_of("0123456789abcdef") != std::string::npos) return "bad hash: " + hash;
     return hash + "@" + r.out.substr(ticks + 8, r.out.find('\n', ticks + 1) - ticks - 8);
   }
-
-  fs::path dir_;
 };
 
 TEST_F(Cli, HelpOnEveryCommandExitsZero) {

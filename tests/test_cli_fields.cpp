@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "CliTestSupport.h"
 #include "fields/AnalyticField.h"
 #include "fields/VectorField.h"
 
@@ -21,45 +22,22 @@ namespace fs = std::filesystem;
 namespace tickfx {
 namespace {
 
-struct Result {
-  int exit = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using cli_test::readAll;
 
 std::string firstLine(const std::string& text) { return text.substr(0, text.find('\n')); }
+using cli_test::Result;
 
-class CliFields : public ::testing::Test {
+class CliFields : public cli_test::CliFixture {
  protected:
+  CliFields() : CliFixture("tickfx_cli_fields") {}
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("tickfx_cli_fields_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_ / "work");
+    CliFixture::SetUp();
+    std::filesystem::create_directories(dir_ / "work");
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
-  // Runs `tickfx ARGS` from the source tree (so samples/... resolve), stdin closed; its output
-  // goes beside dir_/work, which tests keep for the files the command writes.
-  Result run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = "cd '" TICKFX_SOURCE_DIR "' && '" TICKFX_CLI "' " + args +
-                                " </dev/null >'" + out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(command.c_str());
-    Result r;
-    r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = readAll(out);
-    r.err = readAll(err);
-    return r;
-  }
+  // `tickfx ARGS` from the source tree, stdin closed; its output goes beside dir_/work, which
+  // tests keep for the files the command writes.
+  Result run(const std::string& args) const { return runProgram(TICKFX_CLI, args); }
   std::string path(const std::string& name) const { return (dir_ / "work" / name).string(); }
   std::string writeFile(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / "work" / name) << text;
@@ -72,8 +50,6 @@ class CliFields : public ::testing::Test {
     if (at == std::string::npos) return "no hash in: " + r.out + r.err;
     return r.out.substr(at + 12, 16);
   }
-
-  fs::path dir_;
 };
 
 // Every voxel centre of the default box (±1 m) at 0.125 m, exact in float, holds the field there

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "CliTestSupport.h"
 #include "io/CsvCache.h"
 #include "io/VdbPointCache.h"
 
@@ -19,47 +20,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exit = -1;
-  std::string out;
-  std::string err;
-};
+using tickfx::cli_test::readAll;
+using tickfx::cli_test::Result;
 
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class CliPoints : public ::testing::Test {
+class CliPoints : public tickfx::cli_test::CliFixture {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("tickfx_cli_points_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  CliPoints() : CliFixture("tickfx_cli_points") {}
 
-  // Runs `PROGRAM ARGS` from the source tree (so samples/... resolve), stdin closed.
   Result run(const std::string& program, const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = "cd '" TICKFX_SOURCE_DIR "' && '" + program + "' " + args +
-                                " </dev/null >'" + out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(command.c_str());
-    Result r;
-    r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = readAll(out);
-    r.err = readAll(err);
-    return r;
+    return runProgram(program, args);
   }
   Result tickfx(const std::string& args) const { return run(TICKFX_CLI, args); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
 };
 
 TEST_F(CliPoints, RunWritesVdbCachesHoldingTheCsvCachesBits) {
