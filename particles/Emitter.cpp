@@ -154,9 +154,11 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
   if (const auto* list = std::get_if<PointListShape>(&s_.shape)) {
     const std::size_t point = serial % list->positions.size();
     const Eigen::Vector3f& p = list->positions[point];
-    // Rounded to float once, as every shape; at the origin the point is kept as it is (adding
-    // +0.0 would turn a −0.0 coordinate into +0.0).
-    init.position = s_.position.isZero(0.0) ? p : (s_.position + p.cast<double>()).cast<float>();
+    // In float: the point is float already, and widening it to double to add the offset would be
+    // the float → double → float round trip that g++ 12's vectoriser may fold away in some lanes.
+    // The offset is rounded to float once. At the origin the point is kept as it is (adding +0.0
+    // would turn a −0.0 coordinate into +0.0).
+    init.position = s_.position.isZero(0.0) ? p : Eigen::Vector3f(s_.position.cast<float>() + p);
     if (!list->velocities.empty()) init.velocity = list->velocities[point];
   }
   init.lifetime = static_cast<float>(life);

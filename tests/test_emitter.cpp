@@ -376,8 +376,8 @@ TEST(PointListEmitter, VelocitiesOfTheListAndThePositionOffset) {
   for (std::uint64_t serial = 0; serial < 6; ++serial) {
     const ParticleInit p = e.sample(1, serial);
     const std::size_t k = serial % 3;
-    // Offset by the emitter's position, in double, rounded to float once.
-    expectSameBits(p.position, (s.position + kPoints[k].cast<double>()).cast<float>(), "position");
+    // Offset by the emitter's position rounded to float, added in float (one precision).
+    expectSameBits(p.position, Eigen::Vector3f(s.position.cast<float>() + kPoints[k]), "position");
     expectSameBits(p.velocity, velocities[k], "velocity");
   }
 }

@@ -197,7 +197,7 @@ speed = 4.0
   for (std::size_t s = 0; s < 5; ++s) {
     const auto k = static_cast<Eigen::Index>(s % 2);
     const Eigen::Vector3f want =
-        (Eigen::Vector3d(10.0, 0.0, 0.0) + row(read.position, k).cast<double>()).cast<float>();
+        Eigen::Vector3f(Eigen::Vector3f(10.0f, 0.0f, 0.0f) + row(read.position, k));
     expectSameBits(b.particles[s].position, want, "serial " + std::to_string(s));
     EXPECT_EQ(b.particles[s].velocity, Eigen::Vector3f(0.0f, 0.0f, 4.0f));
   }
