@@ -33,7 +33,7 @@ int advectionOrder(AdvectionScheme scheme) {
 
 namespace {
 
-enum Slot : int { kState = -1, K1 = 0, K2, K3, K4, X2, X3, X4 };
+enum Slot : int { kState = kPoolColumn, K1 = 0, K2, K3, K4, X2, X3, X4 };
 
 }  // namespace
 
@@ -49,11 +49,7 @@ void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime&
 
   // k_out = u(X_in, t)
   auto sample = [&](int xIn, double t, int out) {
-    return [&, xIn, t, out](const Tile& tile) {
-      Vec3Rows k = tile.stage(out);
-      const Vec3View x = xIn == kState ? Vec3View::of(p) : tile.view(xIn);
-      forces.evaluateVelocity({pool, x, Vec3View::of(v), t, time.tick}, tile.rows(), k);
-    };
+    return flowPass(pool, forces, xIn, t, time.tick, out);
   };
   // X_out = x + step·K_in
   auto predict = [&](int kIn, float step, int out) {

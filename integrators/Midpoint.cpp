@@ -9,31 +9,24 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const double t0 = time.at(0.0), tHalf = time.at(0.5);
-  runPasses(
-      pool.size(), forces.isLocal(), scratch_,
-      {[&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0);
-         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, tile.rows(), a);
-       },
-       [&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0), vMid = tile.stage(1), pr = rowsOf(p, tile.rows()),
-                  vr = rowsOf(v, tile.rows()), old = rowsOf(prev, tile.rows());
-         for (int c = 0; c < 3; ++c) {
-           old[c] = pr[c];
-           vMid[c] = vr[c] + a[c] * halfDt;
-           pr[c] += vMid[c] * dt;
-         }
-       },
-       [&](const Tile& tile) {
-         // The second evaluation sees the new position (where a field would be sampled)
-         // with the midpoint velocity, at t + dt/2.
-         Vec3Rows a = tile.stage(0);
-         forces.evaluate({pool, Vec3View::of(p), tile.view(1), tHalf, time.tick}, tile.rows(), a);
-       },
-       [&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0), vr = rowsOf(v, tile.rows());
-         for (int c = 0; c < 3; ++c) vr[c] += a[c] * dt;
-       }});
+  runPasses(pool.size(), forces.isLocal(), scratch_,
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, time.tick, 0),
+             [&](const Tile& tile) {
+               Vec3Rows a = tile.stage(0), vMid = tile.stage(1), pr = rowsOf(p, tile.rows()),
+                        vr = rowsOf(v, tile.rows()), old = rowsOf(prev, tile.rows());
+               for (int c = 0; c < 3; ++c) {
+                 old[c] = pr[c];
+                 vMid[c] = vr[c] + a[c] * halfDt;
+                 pr[c] += vMid[c] * dt;
+               }
+             },
+             // The second evaluation sees the new position (where a field would be sampled) with
+             // the midpoint velocity, at t + dt/2.
+             forcePass(pool, forces, kPoolColumn, 1, tHalf, time.tick, 0),
+             [&](const Tile& tile) {
+               Vec3Rows a = tile.stage(0), vr = rowsOf(v, tile.rows());
+               for (int c = 0; c < 3; ++c) vr[c] += a[c] * dt;
+             }});
 }
 
 }  // namespace tickfx

@@ -15,11 +15,7 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   const double t0 = time.at(0.0);
   runPasses(
       n, forces.isLocal(), scratch_,
-      {[&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0);
-         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, tile.rows(), a);
-       },
-       [&](const Tile& tile) {
+      {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, time.tick, 0), [&](const Tile& tile) {
          const RowRange r = tile.rows();
          // A new particle has no history: give it the position it would have had a step ago.
          const RowRange started = intersect(r, fresh, n);

@@ -4,7 +4,7 @@ namespace tickfx {
 namespace {
 
 // Slots of the stage scratch; kState stands for the pool's own columns (the state at t).
-enum Slot : int { kState = -1, K1 = 0, K2, K3, K4, P2, V2, P3, V3, P4, V4 };
+enum Slot : int { kState = kPoolColumn, K1 = 0, K2, K3, K4, P2, V2, P3, V3, P4, V4 };
 
 }  // namespace
 
@@ -22,12 +22,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   };
   // k_out = a(P_in, V_in, t)
   auto evaluate = [&](int pIn, int vIn, double t, int out) {
-    return [&, pIn, vIn, t, out](const Tile& tile) {
-      Vec3Rows k = tile.stage(out);
-      const Vec3View pos = pIn == kState ? Vec3View::of(p) : tile.view(pIn);
-      const Vec3View vel = vIn == kState ? Vec3View::of(v) : tile.view(vIn);
-      forces.evaluate({pool, pos, vel, t, time.tick}, tile.rows(), k);
-    };
+    return forcePass(pool, forces, pIn, vIn, t, time.tick, out);
   };
   // (P_out, V_out) = (p + V_in · step, v + K_in · step)
   auto advance = [&](int vIn, int kIn, int pOut, int vOut, float step) {

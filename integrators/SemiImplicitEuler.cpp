@@ -11,11 +11,7 @@ void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces,
   const double t0 = time.at(0.0);
   runPasses(
       pool.size(), forces.isLocal(), scratch_,
-      {[&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0);
-         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, tile.rows(), a);
-       },
-       [&](const Tile& tile) {
+      {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, time.tick, 0), [&](const Tile& tile) {
          Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                   old = rowsOf(prev, tile.rows());
          for (int c = 0; c < 3; ++c) {

@@ -47,6 +47,34 @@ void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
   }
 }
 
+namespace {
+
+Vec3View viewOf(const Tile& tile, const Vec3Column& column, int slot) {
+  return slot == kPoolColumn ? Vec3View::of(column) : tile.view(slot);
+}
+
+}  // namespace
+
+RowPass forcePass(const ParticlePool& pool, const ForceSet& forces, int position, int velocity,
+                  double t, std::int64_t tick, int out) {
+  return [&pool, &forces, position, velocity, t, tick, out](const Tile& tile) {
+    Vec3Rows a = tile.stage(out);
+    const ForceInput in{pool, viewOf(tile, pool.position(), position),
+                        viewOf(tile, pool.velocity(), velocity), t, tick};
+    forces.evaluate(in, tile.rows(), a);
+  };
+}
+
+RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position, double t,
+                 std::int64_t tick, int out) {
+  return [&pool, &forces, position, t, tick, out](const Tile& tile) {
+    Vec3Rows u = tile.stage(out);
+    const ForceInput in{pool, viewOf(tile, pool.position(), position),
+                        Vec3View::of(pool.velocity()), t, tick};
+    forces.evaluateVelocity(in, tile.rows(), u);
+  };
+}
+
 RowRange intersect(RowRange r, std::size_t begin, std::size_t end) {
   const std::size_t b = std::max(r.begin, begin);
   const std::size_t e = std::min(r.end, end);

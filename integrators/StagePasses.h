@@ -5,7 +5,7 @@
 #include <initializer_list>
 #include <vector>
 
-#include "fields/ForceModule.h"
+#include "fields/ForceSet.h"
 
 namespace tickfx {
 
@@ -63,6 +63,19 @@ using RowPass = std::function<void(const Tile&)>;
 /// bits do not depend on the mode, the tile size or the thread count.
 void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
                std::initializer_list<RowPass> passes);
+
+/// In forcePass() and flowPass(): the pool's own column instead of a stage value.
+inline constexpr int kPoolColumn = -1;
+
+/// The pass that writes the forces' total acceleration (ForceSet::evaluate) at the positions
+/// `position` and velocities `velocity` (stage slots, or kPoolColumn) and time `t` into stage
+/// value `out`.
+RowPass forcePass(const ParticlePool& pool, const ForceSet& forces, int position, int velocity,
+                  double t, std::int64_t tick, int out);
+
+/// The same for the velocity that advection modules prescribe (ForceSet::evaluateVelocity).
+RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position, double t,
+                 std::int64_t tick, int out);
 
 /// Rows of `r` that are also in [begin, end).
 RowRange intersect(RowRange r, std::size_t begin, std::size_t end);

@@ -31,10 +31,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            vPred[c] = vr[c] + ar[c] * dt;
          }
        },
-       [&](const Tile& tile) {
-         Vec3Rows aNew = tile.stage(1);
-         forces.evaluate({pool, Vec3View::of(p), tile.view(0), t1, time.tick}, tile.rows(), aNew);
-       },
+       forcePass(pool, forces, kPoolColumn, 0, t1, time.tick, 1),
        [&](const Tile& tile) {
          Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
          for (int c = 0; c < 3; ++c) {
