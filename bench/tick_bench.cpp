@@ -42,6 +42,7 @@
 #include "fields/PeriodicWind.h"
 #include "integrators/SemiImplicitEuler.h"
 #include "particles/ParticleSystem.h"
+#include "particles/Random.h"
 
 namespace {
 
@@ -77,16 +78,9 @@ tickfx::ForceSet makeForces() {
   return forces;
 }
 
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
 // Uniform in [-1, 1), from the top 24 bits so that every value is an exact float.
 float symmetricUnit(std::uint64_t key) {
-  return static_cast<float>(splitmix64(key) >> 40) * 0x1p-23f - 1.0f;
+  return static_cast<float>(tickfx::splitmix64(key) >> 40) * 0x1p-23f - 1.0f;
 }
 
 struct Particle {

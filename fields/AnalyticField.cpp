@@ -10,6 +10,7 @@
 
 #include "fields/VectorFieldGrids.h"
 #include "particles/DetMath.h"
+#include "particles/Random.h"
 
 namespace tickfx {
 
@@ -28,17 +29,10 @@ Eigen::Matrix3d cross(const Eigen::Vector3d& a) {  // [a]×, so that [a]×·x = 
   return m;
 }
 
-/// splitmix64: the noise parameters are a pure function of (seed, counter).
-std::uint64_t mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
 /// A double in [0, 1) from 53 bits.
 double uniform01(std::uint64_t seed, std::uint64_t counter) {
-  return static_cast<double>(mix(seed ^ mix(counter)) >> 11) * 0x1p-53;
+  // The noise parameters are a pure function of (seed, counter).
+  return static_cast<double>(splitmix64(seed ^ splitmix64(counter)) >> 11) * 0x1p-53;
 }
 
 }  // namespace

@@ -28,6 +28,17 @@ struct RandomKey {
   std::uint32_t purpose = 0;  // a RandomPurpose
 };
 
+/// SplitMix64's finaliser (Stafford's variant 13): a bijection of 64 bits in which every input bit
+/// flips about half the output bits. The building block of every hash-like draw in tickfx.
+constexpr std::uint64_t mix64(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+/// One SplitMix64 output for state `x`: mix64(x + the golden-ratio increment).
+constexpr std::uint64_t splitmix64(std::uint64_t x) { return mix64(x + 0x9e3779b97f4a7c15ULL); }
+
 /// 64 well-mixed bits for `key` (a keyed SplitMix64-style finaliser over the four coordinates).
 std::uint64_t randomBits(const RandomKey& key);
 
