@@ -286,7 +286,7 @@ int bakeFieldCommand(Arguments& args) {
                      " voxels from the origin (expected at least " +
                      numberText(reach / io::kMaxBakedIndex) + " m for these bounds)");
   }
-  const double perFrame = io::bakedVoxelCount(h, bake.min, bake.max);
+  const double perFrame = bakedVoxelCount(h, bake.min, bake.max);
   if (perFrame < 1.0) {
     throw UsageError(p + "--bounds: the box holds no voxel centre at --voxel-size " +
                      numberText(h) + " (expected at least one point i*V on each axis)");
@@ -304,7 +304,7 @@ int bakeFieldCommand(Arguments& args) {
   const std::filesystem::path parent = std::filesystem::path(*out).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   for (int f = first; f <= last; ++f) {
-    const std::string path = frames ? io::sequenceFramePath(*out, f, digits) : *out;
+    const std::string path = frames ? sequenceFramePath(*out, f, digits) : *out;
     const double time = frames ? (f - first) / rate : 0.0;
     bakeField(field, settings, path, time);
     std::printf("%s: %s field, grid '%s', %.0f voxels of %s m%s\n", path.c_str(), kind.c_str(),

@@ -39,8 +39,6 @@
 #include <tuple>
 #include <vector>
 
-#include <unistd.h>
-
 #include "BenchHarness.h"
 #include "fields/AnalyticField.h"
 #include "fields/ForceSet.h"
@@ -134,18 +132,9 @@ int main(int argc, char** argv) {
   tickfx::VectorField::Settings settings;
   settings.file = "curl-noise (baked)";
   settings.mode = tickfx::VectorField::Mode::Advect;
-  // PointAdvect samples a grid it is given; bake one and hand the same grid to both.
-  tickfx::VectorField::Grids grids;
-  {
-    const std::string path = "/tmp/tickfx_advect_bench_" + std::to_string(::getpid()) + ".vdb";
-    tickfx::bakeField(noise, bake, path);
-    openvdb::io::File file(path);
-    file.open(false);
-    grids.grids.push_back(file.readGrid(bake.gridName));
-    file.close();
-    std::remove(path.c_str());
-  }
-  const auto grid = openvdb::gridPtrCast<openvdb::Vec3fGrid>(grids.grids.front());
+  // One grid, handed to both.
+  const openvdb::Vec3fGrid::Ptr grid = tickfx::bakeGrid(noise, bake);
+  const tickfx::VectorField::Grids grids{{grid}};
   const std::vector<openvdb::Vec3f> scattered = startingPoints(count);
   std::vector<openvdb::Vec3f> coherentPoints = scattered;
   {

@@ -148,14 +148,32 @@ void AnalyticForce::add(const ForceInput& in, RowRange rows, Vec3Rows& a) const 
 
 namespace {
 
+// The indices of the voxel centres i·h in [lo, hi] along one axis: first to last, none when
+// first > last.
+std::pair<double, double> centreIndices(double h, double lo, double hi) {
+  return {std::ceil(lo / h), std::floor(hi / h)};
+}
+
+}  // namespace
+
+double bakedVoxelCount(double voxelSize, const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
+  double count = 1.0;
+  for (int c = 0; c < 3; ++c) {
+    const auto [first, last] = centreIndices(voxelSize, min[c], max[c]);
+    count *= std::max(0.0, last - first + 1.0);
+  }
+  return count;
+}
+
 openvdb::Vec3fGrid::Ptr bakeGrid(const AnalyticField& field, const BakeSettings& s, double time) {
   if (!(s.voxelSize > 0.0)) throw std::invalid_argument("bake: voxel size must be positive");
   if (s.gridName.empty()) throw std::invalid_argument("bake: the grid needs a name");
   const double h = s.voxelSize;
   openvdb::Coord lo, hi;
   for (int c = 0; c < 3; ++c) {
-    lo[c] = static_cast<openvdb::Int32>(std::ceil(s.min[c] / h));
-    hi[c] = static_cast<openvdb::Int32>(std::floor(s.max[c] / h));
+    const auto [first, last] = centreIndices(h, s.min[c], s.max[c]);
+    lo[c] = static_cast<openvdb::Int32>(first);
+    hi[c] = static_cast<openvdb::Int32>(last);
     if (lo[c] > hi[c]) throw std::invalid_argument("bake: the box holds no voxel centre");
   }
   openvdb::initialize();
@@ -190,8 +208,6 @@ openvdb::Vec3fGrid::Ptr bakeGrid(const AnalyticField& field, const BakeSettings&
   }
   return grid;
 }
-
-}  // namespace
 
 void bakeField(const AnalyticField& field, const BakeSettings& s, const std::string& path,
                double time) {

@@ -102,6 +102,11 @@ struct BakeSettings {
   bool staggered = false;
 };
 
+/// The voxels bakeField() writes for the box [min, max] (metres) at `voxelSize` (metres): per
+/// axis, the voxel centres i·voxelSize inside the box. A double, since bad input can make it
+/// astronomically large; 0 when the box holds no centre on some axis.
+double bakedVoxelCount(double voxelSize, const Eigen::Vector3d& min, const Eigen::Vector3d& max);
+
 /// Bakes `field` at time `time` into an openvdb::Vec3fGrid (values rounded to float once) and
 /// writes it to `path` under `settings.gridName`, replacing the file (written beside it and
 /// renamed, so a failure leaves no partial file). Throws std::invalid_argument for a

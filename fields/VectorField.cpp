@@ -17,21 +17,29 @@
 
 namespace tickfx {
 
-namespace {
-
-std::string framePath(const VectorField::Settings& s, int frame) {
-  if (!(s.fps > 0.0)) return s.file;
-  std::string number = std::to_string(frame < 0 ? -frame : frame);
-  if (number.size() < static_cast<std::size_t>(s.framePadding)) {
-    number.insert(0, static_cast<std::size_t>(s.framePadding) - number.size(), '0');
+std::string sequenceFramePath(const std::string& pattern, int frame, int padding) {
+  const std::string key = "{frame}";
+  const std::size_t at = pattern.find(key);
+  if (at == std::string::npos) return pattern;
+  std::string number = std::to_string(frame < 0 ? -static_cast<long long>(frame) : frame);
+  if (number.size() < static_cast<std::size_t>(padding)) {
+    number.insert(0, static_cast<std::size_t>(padding) - number.size(), '0');
   }
   if (frame < 0) number.insert(0, 1, '-');
-  std::string path = s.file;
-  const std::string key = "{frame}";
-  const std::size_t at = path.find(key);
-  if (at == std::string::npos) return path + " (frame " + number + ")";  // grids made in memory
+  std::string path = pattern;
   path.replace(at, key.size(), number);
   return path;
+}
+
+namespace {
+
+// The name of frame `frame` in messages and, for files, the file to load.
+std::string framePath(const VectorField::Settings& s, int frame) {
+  if (!(s.fps > 0.0)) return s.file;
+  if (s.file.find("{frame}") == std::string::npos) {  // grids made in memory
+    return s.file + " (frame " + std::to_string(frame) + ")";
+  }
+  return sequenceFramePath(s.file, frame, s.framePadding);
 }
 
 Eigen::Vector3f toFloat(const openvdb::Vec3f& v) { return {v.x(), v.y(), v.z()}; }

@@ -11,6 +11,12 @@
 
 namespace tickfx {
 
+/// The file of frame `frame` of the sequence `pattern`: its first "{frame}" replaced by the frame
+/// number zero-padded to `padding` digits (a minus sign before the digits of a negative frame).
+/// `pattern` unchanged when it has no "{frame}". VectorField loads a sequence from these names;
+/// `tickfx bake-field` writes them.
+std::string sequenceFramePath(const std::string& pattern, int frame, int padding);
+
 /// Samples a Vec3 grid (vec3s or vec3d) in world space through the grid's own transform.
 ///
 /// Interpolation: trilinear (openvdb::tools::BoxSampler) by default, triquadratic on request;

@@ -1,11 +1,13 @@
-// VectorField's in-memory input: for code that makes OpenVDB grids itself (baking). Includes
-// OpenVDB, so it stays out of the installed headers and out of every other translation unit.
+// VectorField's in-memory input and baked grids: for code that works with OpenVDB grids itself.
+// Includes OpenVDB, so it stays out of the installed headers and out of every other translation
+// unit.
 #pragma once
 
 #include <openvdb/openvdb.h>
 
 #include <vector>
 
+#include "fields/AnalyticField.h"
 #include "fields/VectorField.h"
 
 namespace tickfx {
@@ -14,5 +16,10 @@ namespace tickfx {
 struct VectorField::Grids {
   std::vector<openvdb::GridBase::Ptr> grids;
 };
+
+/// The grid bakeField() writes and bakeVectorField() samples, for code that hands it to OpenVDB
+/// itself (tests and benches comparing with OpenVDB's tools).
+openvdb::Vec3fGrid::Ptr bakeGrid(const AnalyticField& field, const BakeSettings& settings,
+                                 double time = 0.0);
 
 }  // namespace tickfx

@@ -5,31 +5,6 @@
 
 namespace tickfx::io {
 
-double bakedVoxelCount(double voxelSize, const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
-  double count = 1.0;
-  for (int c = 0; c < 3; ++c) {
-    // The same centres as bakeField: indices ceil(min/h) to floor(max/h).
-    const double along = std::floor(max[c] / voxelSize) - std::ceil(min[c] / voxelSize) + 1.0;
-    count *= std::max(0.0, along);
-  }
-  return count;
-}
-
-std::string sequenceFramePath(const std::string& pattern, int frame, int padding) {
-  const std::string key = "{frame}";
-  const std::size_t at = pattern.find(key);
-  if (at == std::string::npos) return pattern;
-  // As fields/VectorField.cpp names the frames it loads.
-  std::string number = std::to_string(frame < 0 ? -static_cast<long long>(frame) : frame);
-  if (number.size() < static_cast<std::size_t>(padding)) {
-    number.insert(0, static_cast<std::size_t>(padding) - number.size(), '0');
-  }
-  if (frame < 0) number.insert(0, 1, '-');
-  std::string path = pattern;
-  path.replace(at, key.size(), number);
-  return path;
-}
-
 AnalyticField analyticField(const FieldBakeSettings& bake) {
   switch (bake.kind) {
     case FieldBakeSettings::Kind::Uniform:

@@ -20,17 +20,6 @@ inline constexpr double kMaxBakedVoxels = 1e8;
 /// coordinates (2³¹ ≈ 2.1e9) with room to spare.
 inline constexpr double kMaxBakedIndex = 1e9;
 
-/// The voxels of one baked frame of the box [min, max] (metres) at `voxelSize` (metres): per
-/// axis, the voxel centres i·voxelSize inside the box, as fields/AnalyticField's bakeField counts
-/// them. A double, since bad input can make it astronomically large; 0 when the box holds no
-/// centre on some axis.
-double bakedVoxelCount(double voxelSize, const Eigen::Vector3d& min, const Eigen::Vector3d& max);
-
-/// The file of frame `frame` of the sequence `pattern`: its first "{frame}" replaced by the frame
-/// number zero-padded to `padding` digits (a minus sign before the digits of a negative frame),
-/// the names VectorField loads a sequence from. `pattern` unchanged when it has no "{frame}".
-std::string sequenceFramePath(const std::string& pattern, int frame, int padding);
-
 /// The analytic field `bake` describes (its kind's parameters). Throws std::invalid_argument as
 /// AnalyticField does (a zero axis or direction): settings from parseEffect() never are.
 AnalyticField analyticField(const FieldBakeSettings& bake);

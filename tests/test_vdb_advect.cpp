@@ -4,11 +4,9 @@
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/PointAdvect.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <complex>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -288,16 +286,8 @@ float pointAdvectDifference(const std::string& scheme, unsigned order, bool thre
   openvdb::initialize();
   const AnalyticField noise = AnalyticField::curlNoise(11, 4.0, 1.0, 4);
   const auto bake = box(0.05, Eigen::Vector3d::Constant(-1.2), Eigen::Vector3d::Constant(1.2));
-  // PointAdvect gets the grid from a baked file, tickfx bakes in memory: the same bits.
-  // ctest runs the cases as parallel processes: one file each.
-  const std::string path = ::testing::TempDir() + "tickfx_pointadvect_" +
-                           std::to_string(::getpid()) + "_" + scheme + ".vdb";
-  bakeField(noise, bake, path);
-  openvdb::io::File file(path);
-  file.open(false);
-  const auto grid = openvdb::gridPtrCast<openvdb::Vec3fGrid>(file.readGrid(bake.gridName));
-  file.close();
-  std::remove(path.c_str());
+  // Each bakes the field for itself: PointAdvect the bare grid, tickfx its VectorField.
+  const openvdb::Vec3fGrid::Ptr grid = bakeGrid(noise, bake);
   std::unique_ptr<VectorField> field = bakeVectorField(noise, bake, advect());
 
   const std::size_t n = 10'000;
