@@ -4,6 +4,18 @@
 
 namespace tickfx::io {
 
+void FrameData::resize(std::size_t rows, std::vector<std::string> names) {
+  const auto n = static_cast<Eigen::Index>(rows);
+  id.resize(rows);
+  position.resize(n);
+  velocity.resize(n);
+  age.resize(n);
+  life.resize(n);
+  mass.resize(n);
+  attributeNames = std::move(names);
+  attributes.assign(attributeNames.size(), FloatColumn(n));
+}
+
 FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double timeSeconds) {
   const ParticlePool& pool = system.pool();
   const auto n = static_cast<Eigen::Index>(pool.size());

@@ -28,6 +28,9 @@ struct FrameData {
   std::vector<FloatColumn> attributes;
 
   std::size_t size() const { return id.size(); }
+  /// Sizes every column for `rows` particles, with one attribute column per name (values left
+  /// for the reader to fill).
+  void resize(std::size_t rows, std::vector<std::string> names);
 };
 
 /// Captures `system` as frame `frame` at time `timeSeconds`, interpolating positions with the

@@ -95,15 +95,7 @@ FrameData readPlyCache(const std::filesystem::path& path) {
   for (std::size_t k = 0; k < 9; ++k) {
     if (floats[k] != kFixedFloats[k]) fail("unexpected property order at '" + floats[k] + "'");
   }
-  const auto n = static_cast<Eigen::Index>(count);
-  frame.attributeNames.assign(floats.begin() + 9, floats.end());
-  frame.attributes.assign(frame.attributeNames.size(), FloatColumn(n));
-  frame.position.resize(n);
-  frame.velocity.resize(n);
-  frame.age.resize(n);
-  frame.life.resize(n);
-  frame.mass.resize(n);
-  frame.id.resize(count);
+  frame.resize(count, std::vector<std::string>(floats.begin() + 9, floats.end()));
   std::vector<FloatColumn*> cols = {&frame.position.x, &frame.position.y, &frame.position.z,
                                     &frame.velocity.x, &frame.velocity.y, &frame.velocity.z,
                                     &frame.age,        &frame.life,       &frame.mass};

@@ -354,15 +354,7 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
     });
   }
   FrameData frame;
-  const auto rows = static_cast<Eigen::Index>(n);
-  frame.position.resize(rows);
-  frame.velocity.resize(rows);
-  frame.age.resize(rows);
-  frame.life.resize(rows);
-  frame.mass.resize(rows);
-  frame.id.resize(n);
-  frame.attributeNames = customNames;
-  frame.attributes.assign(custom.size(), FloatColumn(rows));
+  frame.resize(n, customNames);
   for (std::size_t r = 0; r < n; ++r) {
     const std::size_t i = order[r];
     const auto row = static_cast<Eigen::Index>(r);
