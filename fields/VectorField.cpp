@@ -84,8 +84,16 @@ struct LeafBoxSampler {
 /// The grids, their precision hidden behind one virtual call per accumulate().
 struct VectorField::Impl {
   virtual ~Impl() = default;
-  virtual void run(const VectorField::Settings& s, const ForceInput& in, RowRange rows, Vec3Rows* a,
-                   Eigen::Vector3f* single, std::uint8_t* dead) const = 0;
+  /// Adds the module's contribution (mode and scale applied) for `rows` to `out`.
+  virtual void accumulate(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
+                          Vec3Rows& out) const = 0;
+  /// The field at `world` and time `t`, after the outside policy, before scale.
+  virtual Eigen::Vector3f sample(const VectorField::Settings& s, const Eigen::Vector3d& world,
+                                 double t) const = 0;
+  /// dead[row] = 1 for the rows of `rows` outside the active voxels of the frame at or before
+  /// in.time.
+  virtual void flagOutside(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
+                           std::uint8_t* dead) const = 0;
   std::string valueType;
   bool staggered = false;
   int frames = 1;
@@ -137,78 +145,103 @@ struct ImplT final : VectorField::Impl {
     return toFloat(u);
   }
 
+  // The frames around `time` and the blend weight of the second: in double, rounded once.
+  struct Frames {
+    std::size_t first = 0, second = 0;
+    float w = 0.0f;
+  };
+  Frames framesAt(const VectorField::Settings& s, double time) const {
+    Frames f;
+    if (grids.size() < 2) return f;
+    const double x = time * s.fps;
+    const double last = static_cast<double>(grids.size() - 1);
+    if (x >= last) {
+      f.first = f.second = grids.size() - 1;
+    } else if (x > 0.0) {
+      const double base = std::floor(x);
+      f.first = static_cast<std::size_t>(base);
+      f.second = f.first + 1;
+      f.w = static_cast<float>(x - base);
+    }
+    return f;
+  }
+
+  // The two frames' samplers for one call, and the sample at a world position, blended in time.
   template <class Sampler>
-  void kernel(const VectorField::Settings& s, const ForceInput& in, RowRange rows, Vec3Rows* a,
-              Eigen::Vector3f* single, std::uint8_t* dead, std::size_t f0, std::size_t f1,
-              float w) const {
-    Frame first(*grids[f0]);
-    Frame second(*grids[f1]);
-    const bool blend = f1 != f0 && w != 0.0f;
-    const bool zero = s.outside != VectorField::Outside::Background;
-    const float one = 1.0f - w;
+  struct Blend {
+    Blend(const ImplT& impl, const VectorField::Settings& s, double time)
+        : frames(impl.framesAt(s, time)),
+          first(*impl.grids[frames.first]),
+          second(*impl.grids[frames.second]),
+          blend(frames.second != frames.first && frames.w != 0.0f),
+          zero(s.outside != VectorField::Outside::Background) {}
+    Eigen::Vector3f operator()(const openvdb::Vec3d& world) {
+      const Eigen::Vector3f u = at<Sampler>(first, world, zero);
+      if (!blend) return u;
+      const Eigen::Vector3f u1 = at<Sampler>(second, world, zero);
+      const float w = frames.w, one = 1.0f - w;
+      return {one * u.x() + w * u1.x(), one * u.y() + w * u1.y(), one * u.z() + w * u1.z()};
+    }
+    Frames frames;
+    Frame first, second;
+    bool blend, zero;
+  };
+
+  template <class Sampler>
+  void add(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
+           Vec3Rows& out) const {
+    Blend<Sampler> field(*this, s, in.time);
+    const bool drag = s.mode == VectorField::Mode::Drag;
     const ConstVec3Rows p = in.position.rows(rows);
     const ConstVec3Rows v = in.velocity.rows(rows);
     for (Eigen::Index j = 0; j < rows.count(); ++j) {
       // float → double is exact; the sample is rounded to float once.
-      const openvdb::Vec3d world(p.x[j], p.y[j], p.z[j]);
-      if (dead != nullptr) {
-        const openvdb::Vec3d index = first.toIndex(world);
-        if (!first.acc.isValueOn(openvdb::Coord::round(index))) {
-          dead[rows.begin + static_cast<std::size_t>(j)] = 1;
-        }
-        continue;
-      }
-      Eigen::Vector3f u = at<Sampler>(first, world, zero);
-      if (blend) {
-        const Eigen::Vector3f u1 = at<Sampler>(second, world, zero);
-        u = Eigen::Vector3f(one * u.x() + w * u1.x(), one * u.y() + w * u1.y(),
-                            one * u.z() + w * u1.z());
-      }
-      if (single != nullptr) {
-        *single = u;
-        return;
-      }
-      if (s.mode != VectorField::Mode::Drag) {  // Force adds acceleration, Advect velocity
-        a->x[j] += s.scale * u.x();
-        a->y[j] += s.scale * u.y();
-        a->z[j] += s.scale * u.z();
-      } else {
-        a->x[j] += s.scale * (u.x() - v.x[j]);
-        a->y[j] += s.scale * (u.y() - v.y[j]);
-        a->z[j] += s.scale * (u.z() - v.z[j]);
+      const Eigen::Vector3f u = field(openvdb::Vec3d(p.x[j], p.y[j], p.z[j]));
+      if (drag) {
+        out.x[j] += s.scale * (u.x() - v.x[j]);
+        out.y[j] += s.scale * (u.y() - v.y[j]);
+        out.z[j] += s.scale * (u.z() - v.z[j]);
+      } else {  // Force adds acceleration, Advect velocity
+        out.x[j] += s.scale * u.x();
+        out.y[j] += s.scale * u.y();
+        out.z[j] += s.scale * u.z();
       }
     }
   }
 
-  void run(const VectorField::Settings& s, const ForceInput& in, RowRange rows, Vec3Rows* a,
-           Eigen::Vector3f* single, std::uint8_t* dead) const override {
-    // The frames around in.time and the blend weight: once per call, in double, rounded once.
-    std::size_t f0 = 0, f1 = 0;
-    float w = 0.0f;
-    if (grids.size() > 1) {
-      const double x = in.time * s.fps;
-      const double last = static_cast<double>(grids.size() - 1);
-      if (x >= last) {
-        f0 = f1 = grids.size() - 1;
-      } else if (x > 0.0) {
-        const double base = std::floor(x);
-        f0 = static_cast<std::size_t>(base);
-        f1 = f0 + 1;
-        w = static_cast<float>(x - base);
-      }
-    }
+  // Calls f(Sampler{}) with the sampler the grid class and the interpolation ask for.
+  template <class F>
+  decltype(auto) withSampler(const VectorField::Settings& s, F&& f) const {
     namespace vt = openvdb::tools;
     const bool quadratic = s.interpolation == VectorField::Interpolation::Quadratic;
     if (staggered) {
-      if (quadratic) {
-        kernel<vt::StaggeredQuadraticSampler>(s, in, rows, a, single, dead, f0, f1, w);
-      } else {
-        kernel<vt::StaggeredBoxSampler>(s, in, rows, a, single, dead, f0, f1, w);
+      return quadratic ? f(vt::StaggeredQuadraticSampler{}) : f(vt::StaggeredBoxSampler{});
+    }
+    return quadratic ? f(vt::QuadraticSampler{}) : f(LeafBoxSampler{});
+  }
+
+  void accumulate(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
+                  Vec3Rows& out) const override {
+    withSampler(s, [&](auto sampler) { add<decltype(sampler)>(s, in, rows, out); });
+  }
+
+  Eigen::Vector3f sample(const VectorField::Settings& s, const Eigen::Vector3d& world,
+                         double t) const override {
+    return withSampler(s, [&](auto sampler) {
+      Blend<decltype(sampler)> field(*this, s, t);
+      return field(openvdb::Vec3d(world.x(), world.y(), world.z()));
+    });
+  }
+
+  void flagOutside(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
+                   std::uint8_t* dead) const override {
+    Frame first(*grids[framesAt(s, in.time).first]);
+    const ConstVec3Rows p = in.position.rows(rows);
+    for (Eigen::Index j = 0; j < rows.count(); ++j) {
+      const openvdb::Vec3d index = first.toIndex(openvdb::Vec3d(p.x[j], p.y[j], p.z[j]));
+      if (!first.acc.isValueOn(openvdb::Coord::round(index))) {
+        dead[rows.begin + static_cast<std::size_t>(j)] = 1;
       }
-    } else if (quadratic) {
-      kernel<vt::QuadraticSampler>(s, in, rows, a, single, dead, f0, f1, w);
-    } else {
-      kernel<LeafBoxSampler>(s, in, rows, a, single, dead, f0, f1, w);
     }
   }
 };
@@ -298,13 +331,13 @@ VectorField::~VectorField() = default;
 
 void VectorField::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
   if (s_.mode == Mode::Advect) return;  // prescribes velocity: ForceSet never asks
-  impl_->run(s_, in, rows, &acceleration, nullptr, nullptr);
+  impl_->accumulate(s_, in, rows, acceleration);
 }
 
 void VectorField::accumulateVelocity(const ForceInput& in, RowRange rows,
                                      Vec3Rows& velocity) const {
   if (s_.mode != Mode::Advect) return;
-  impl_->run(s_, in, rows, &velocity, nullptr, nullptr);
+  impl_->accumulate(s_, in, rows, velocity);
 }
 
 void VectorField::endTick(ParticlePool& pool, std::int64_t tick, double time) {
@@ -318,16 +351,11 @@ void VectorField::endTick(ParticlePool& pool, std::int64_t tick, double time) {
 }
 
 Eigen::Vector3f VectorField::sample(const Eigen::Vector3f& x, double t) const {
-  ParticlePool none(0);
-  const float px = x.x(), py = x.y(), pz = x.z();
-  const ForceInput in{none, Vec3View{&px, &py, &pz, 0}, Vec3View{&px, &py, &pz, 0}, t, 0};
-  Eigen::Vector3f u = Eigen::Vector3f::Zero();
-  impl_->run(s_, in, RowRange{0, 1}, nullptr, &u, nullptr);
-  return u;
+  return impl_->sample(s_, x.cast<double>(), t);
 }
 
 void VectorField::flagOutside(const ForceInput& in, RowRange rows, std::uint8_t* dead) const {
-  impl_->run(s_, in, rows, nullptr, nullptr, dead);
+  impl_->flagOutside(s_, in, rows, dead);
 }
 
 const std::string& VectorField::valueType() const { return impl_->valueType; }
