@@ -279,26 +279,26 @@ int bakeFieldCommand(Arguments& args) {
 
   // The grid's size, as an effect's bake table is judged.
   const double h = bake.voxelSize;
-  const double reach = std::max(bake.min.cwiseAbs().maxCoeff(), bake.max.cwiseAbs().maxCoeff());
-  if (reach / h > io::kMaxBakedIndex) {
-    throw UsageError(p + "--voxel-size: " + numberText(h) + " m puts the bounds " +
-                     numberText(std::ceil(reach / h)) +
-                     " voxels from the origin (expected at least " +
-                     numberText(reach / io::kMaxBakedIndex) + " m for these bounds)");
-  }
-  const double perFrame = bakedVoxelCount(h, bake.min, bake.max);
-  if (perFrame < 1.0) {
-    throw UsageError(p + "--bounds: the box holds no voxel centre at --voxel-size " +
-                     numberText(h) + " (expected at least one point i*V on each axis)");
-  }
   const int count = last - first + 1;
-  if (perFrame * count > io::kMaxBakedVoxels) {
-    throw UsageError(p + "--voxel-size " + numberText(h) + " and --bounds make " +
-                     numberText(perFrame) + " voxels a frame, " + numberText(perFrame * count) +
-                     " over " + std::to_string(count) + (count == 1 ? " frame" : " frames") +
-                     " (expected at most 100000000)");
+  const io::BakeSize size = io::measureBake(bake, count);
+  switch (size.problem) {
+    case io::BakeSize::Problem::None:
+      break;
+    case io::BakeSize::Problem::IndexReach:
+      throw UsageError(p + "--voxel-size: " + numberText(h) + " m puts the bounds " +
+                       numberText(size.reachVoxels) +
+                       " voxels from the origin (expected at least " +
+                       numberText(size.minVoxelSize) + " m for these bounds)");
+    case io::BakeSize::Problem::EmptyBox:
+      throw UsageError(p + "--bounds: the box holds no voxel centre at --voxel-size " +
+                       numberText(h) + " (expected at least one point i*V on each axis)");
+    case io::BakeSize::Problem::TooManyVoxels:
+      throw UsageError(p + "--voxel-size " + numberText(h) + " and --bounds make " +
+                       numberText(size.perFrame) + " voxels a frame, " + numberText(size.total) +
+                       " over " + std::to_string(count) + (count == 1 ? " frame" : " frames") +
+                       " (expected at most 100000000)");
   }
-
+  const double perFrame = size.perFrame;
   const AnalyticField field = io::analyticField(bake);
   const BakeSettings settings = io::bakeSettings(bake, gridName);
   const std::filesystem::path parent = std::filesystem::path(*out).parent_path();

@@ -1119,31 +1119,32 @@ bool readBake(Context& cx, const toml::table& table, const std::string& path,
 void checkBakeSize(Context& cx, const std::string& path, const FieldBakeSettings& bake,
                    std::int64_t frames) {
   const std::string voxelPath = childPath(path, "voxel_size");
+  const std::string boundsPath = childPath(path, "bounds");
   const double h = bake.voxelSize;
-  const double reach = std::max(bake.min.cwiseAbs().maxCoeff(), bake.max.cwiseAbs().maxCoeff());
-  const SourceLocation at = cx.sources().find(voxelPath);
-  if (reach / h > kMaxBakedIndex) {
-    cx.error(at, voxelPath,
-             formatNumber(h) + " m puts the bounds " + formatNumber(std::ceil(reach / h)) +
-                 " voxels from the origin (expected a voxel_size of at least " +
-                 formatNumber(reach / kMaxBakedIndex) +
-                 " m for these bounds: voxel indices within 1e9)");
-    return;
-  }
-  const double perFrame = bakedVoxelCount(h, bake.min, bake.max);
-  if (perFrame < 1.0) {
-    cx.error(cx.sources().find(childPath(path, "bounds")), childPath(path, "bounds"),
-             "hold no voxel centre at voxel_size = " + formatNumber(h) +
-                 " m (expected a box holding at least one point i*voxel_size on each axis)");
-    return;
-  }
-  if (perFrame * static_cast<double>(frames) > kMaxBakedVoxels) {
-    cx.error(at, voxelPath,
-             formatNumber(h) + " m makes " + formatNumber(perFrame) + " voxels a frame, " +
-                 formatNumber(perFrame * static_cast<double>(frames)) + " over " +
-                 std::to_string(frames) + (frames == 1 ? " frame" : " frames") +
-                 " (expected at most 100000000 voxels over all frames: a larger voxel_size, "
-                 "smaller bounds or fewer frames)");
+  const BakeSize size = measureBake(bake, frames);
+  switch (size.problem) {
+    case BakeSize::Problem::None:
+      return;
+    case BakeSize::Problem::IndexReach:
+      cx.error(cx.sources().find(voxelPath), voxelPath,
+               formatNumber(h) + " m puts the bounds " + formatNumber(size.reachVoxels) +
+                   " voxels from the origin (expected a voxel_size of at least " +
+                   formatNumber(size.minVoxelSize) +
+                   " m for these bounds: voxel indices within 1e9)");
+      return;
+    case BakeSize::Problem::EmptyBox:
+      cx.error(cx.sources().find(boundsPath), boundsPath,
+               "hold no voxel centre at voxel_size = " + formatNumber(h) +
+                   " m (expected a box holding at least one point i*voxel_size on each axis)");
+      return;
+    case BakeSize::Problem::TooManyVoxels:
+      cx.error(cx.sources().find(voxelPath), voxelPath,
+               formatNumber(h) + " m makes " + formatNumber(size.perFrame) + " voxels a frame, " +
+                   formatNumber(size.total) + " over " + std::to_string(frames) +
+                   (frames == 1 ? " frame" : " frames") +
+                   " (expected at most 100000000 voxels over all frames: a larger voxel_size, "
+                   "smaller bounds or fewer frames)");
+      return;
   }
 }
 

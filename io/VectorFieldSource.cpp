@@ -5,6 +5,26 @@
 
 namespace tickfx::io {
 
+BakeSize measureBake(const FieldBakeSettings& bake, std::int64_t frames) {
+  BakeSize size;
+  const double h = bake.voxelSize;
+  const double reach = std::max(bake.min.cwiseAbs().maxCoeff(), bake.max.cwiseAbs().maxCoeff());
+  size.reachVoxels = std::ceil(reach / h);
+  size.minVoxelSize = reach / kMaxBakedIndex;
+  if (reach / h > kMaxBakedIndex) {
+    size.problem = BakeSize::Problem::IndexReach;
+    return size;
+  }
+  size.perFrame = bakedVoxelCount(h, bake.min, bake.max);
+  size.total = size.perFrame * static_cast<double>(frames);
+  if (size.perFrame < 1.0) {
+    size.problem = BakeSize::Problem::EmptyBox;
+  } else if (size.total > kMaxBakedVoxels) {
+    size.problem = BakeSize::Problem::TooManyVoxels;
+  }
+  return size;
+}
+
 AnalyticField analyticField(const FieldBakeSettings& bake) {
   switch (bake.kind) {
     case FieldBakeSettings::Kind::Uniform:

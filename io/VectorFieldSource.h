@@ -20,6 +20,20 @@ inline constexpr double kMaxBakedVoxels = 1e8;
 /// coordinates (2³¹ ≈ 2.1e9) with room to spare.
 inline constexpr double kMaxBakedIndex = 1e9;
 
+/// The size of a bake of `frames` frames, and the first of its limits it breaks (checked in this
+/// order: voxel indices past kMaxBakedIndex, a box holding no voxel centre, more than
+/// kMaxBakedVoxels over all frames). Effect files and `tickfx bake-field` word the problem their
+/// own way (keys or options) from these figures.
+struct BakeSize {
+  enum class Problem { None, IndexReach, EmptyBox, TooManyVoxels };
+  Problem problem = Problem::None;
+  double reachVoxels = 0.0;   // ⌈largest |bound| / voxel size⌉
+  double minVoxelSize = 0.0;  // metres: the voxel size that keeps the bounds within the indices
+  double perFrame = 0.0;      // voxels a frame
+  double total = 0.0;         // voxels over all frames
+};
+BakeSize measureBake(const FieldBakeSettings& bake, std::int64_t frames);
+
 /// The analytic field `bake` describes (its kind's parameters). Throws std::invalid_argument as
 /// AnalyticField does (a zero axis or direction): settings from parseEffect() never are.
 AnalyticField analyticField(const FieldBakeSettings& bake);
