@@ -63,8 +63,8 @@ constexpr const char* kHelp =
     "written), 1 failure at run time.\n";
 
 constexpr double kBig = 1e9;
-constexpr long long kMaxFrame = 1'000'000;
-constexpr long long kMaxFrames = 10'000;
+constexpr long long kMaxFrame = io::kMaxFieldFrameNumber;
+constexpr long long kMaxFrames = io::kMaxFieldFrames;
 
 const std::vector<std::pair<std::string, std::vector<std::string>>>& kindOptions() {
   static const std::vector<std::pair<std::string, std::vector<std::string>>> options = {
@@ -231,7 +231,7 @@ int bakeFieldCommand(Arguments& args) {
     bake.amplitude = parseNumber(*v, p + "--amplitude", 0.0, kBig);
   }
   if (const auto v = option("--octaves")) {
-    bake.octaves = static_cast<int>(parseInteger(*v, p + "--octaves", 1, 16));
+    bake.octaves = static_cast<int>(parseInteger(*v, p + "--octaves", 1, io::kMaxCurlOctaves));
   }
   if (const auto v = option("--evolution")) {
     bake.evolution = parseNumber(*v, p + "--evolution", 0.0, kBig);

@@ -981,9 +981,8 @@ void readEmitterEntry(Context& cx, const toml::table& table, std::size_t index,
 
 // ---- vector fields: [[forces]] of type "vector_field" -----------------------------------------
 
-constexpr std::int64_t kMaxFrameNumber = 1'000'000;
-constexpr std::int64_t kMaxSequenceFrames = 10'000;
-constexpr std::int64_t kMaxOctaves = 16;
+constexpr std::int64_t kMaxFrameNumber = kMaxFieldFrameNumber;
+constexpr std::int64_t kMaxSequenceFrames = kMaxFieldFrames;
 
 const std::vector<std::string> kFieldModes = {"force", "drag", "advect"};
 const std::vector<std::string> kFieldInterpolations = {"linear", "quadratic"};
@@ -1106,7 +1105,7 @@ bool readBake(Context& cx, const toml::table& table, const std::string& path,
     r.number("frequency", bake.frequency, "radians per metre, a number > 0 and <= 1e9",
              Range{0.0, kBig, true});
     r.number("amplitude", bake.amplitude, "m/s, a number from 0 to 1e9", Range{0.0, kBig});
-    r.integer("octaves", bake.octaves, "an integer from 1 to 16", 1, kMaxOctaves);
+    r.integer("octaves", bake.octaves, "an integer from 1 to 16", 1, kMaxCurlOctaves);
     r.number("evolution", bake.evolution, "radians per second, a number from 0 to 1e9",
              Range{0.0, kBig});
   }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -16,6 +17,12 @@ namespace tickfx::io {
 /// The most voxels a bake may hold over all its frames: 10⁸ vec3s voxels are about 1.2 GB of
 /// values, and baking them takes minutes. Effect files and `tickfx bake-field` refuse more.
 inline constexpr double kMaxBakedVoxels = 1e8;
+/// Limits an effect file's vector_field and `tickfx bake-field` share: frame numbers of a
+/// sequence within ±kMaxFieldFrameNumber, at most kMaxFieldFrames frames, and curl noise of at
+/// most kMaxCurlOctaves octaves.
+inline constexpr std::int64_t kMaxFieldFrameNumber = 1'000'000;
+inline constexpr std::int64_t kMaxFieldFrames = 10'000;
+inline constexpr std::int64_t kMaxCurlOctaves = 16;
 /// The largest |bound| / voxel_size a bake accepts: voxel indices must fit OpenVDB's 32-bit
 /// coordinates (2³¹ ≈ 2.1e9) with room to spare.
 inline constexpr double kMaxBakedIndex = 1e9;
