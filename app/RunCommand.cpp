@@ -64,16 +64,12 @@ std::vector<io::CacheFormat> parseFormats(const std::string& text) {
   std::stringstream list(text);
   std::string name;
   while (std::getline(list, name, ',')) {
-    if (name == "csv") {
-      formats.push_back(io::CacheFormat::Csv);
-    } else if (name == "ply") {
-      formats.push_back(io::CacheFormat::Ply);
-    } else if (name == "vdb") {
-      formats.push_back(io::CacheFormat::Vdb);
-    } else {
+    const std::optional<io::CacheFormat> f = io::cacheFormatFromName(name);
+    if (!f) {
       throw UsageError("run: --format: unknown format '" + name +
                        "' (expected csv, ply, vdb or none)");
     }
+    formats.push_back(*f);
   }
   if (formats.empty())
     throw UsageError("run: --format: empty list (expected csv, ply, vdb or none)");

@@ -42,7 +42,11 @@ constexpr std::int64_t kMaxFrameRatePart = 1'000'000;
 
 const std::vector<std::string> kShapes = {"point", "sphere", "box", "disc"};
 const std::vector<std::string> kOverrunPolicies = {"drop", "fall_behind"};
-const std::vector<std::string> kCacheFormats = {"csv", "ply", "vdb"};
+const std::vector<std::string> kCacheFormats = [] {
+  std::vector<std::string> names;
+  for (const CacheFormat f : kCacheFormatList) names.emplace_back(cacheFormatName(f));
+  return names;
+}();
 
 // The keys of a file emitter (type "file"): a particle emitter's, with `file` for the shape.
 const std::vector<std::string>& fileEmitterKeys() {
@@ -1466,9 +1470,7 @@ void readOutput(Context& cx, const toml::table& table, OutputSettings& out) {
           ok = false;
           continue;
         }
-        const CacheFormat f = *name == "csv"   ? CacheFormat::Csv
-                              : *name == "ply" ? CacheFormat::Ply
-                                               : CacheFormat::Vdb;
+        const CacheFormat f = *cacheFormatFromName(*name);  // checkChoice took a known name
         if (std::find(formats.begin(), formats.end(), f) != formats.end()) {
           cx.error(cx.at(*array->get(i)), entryPath,
                    quote(*name) + " is listed twice (expected each format at most once)");

@@ -89,6 +89,13 @@ std::string_view cacheFormatName(CacheFormat format) {
   return "csv";
 }
 
+std::optional<CacheFormat> cacheFormatFromName(std::string_view name) {
+  for (const CacheFormat f : kCacheFormatList) {
+    if (cacheFormatName(f) == name) return f;
+  }
+  return std::nullopt;
+}
+
 std::int64_t OutputSettings::frameCount() const {
   if (frames) return *frames;
   const double exact =

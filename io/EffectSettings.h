@@ -132,8 +132,13 @@ const std::vector<std::string>& clothPinsNames();
 double clusterNeighbours(const ClusterShape& cluster);
 
 enum class CacheFormat { Csv, Ply, Vdb };
+/// Every cache format, in the order names are listed to users.
+inline constexpr CacheFormat kCacheFormatList[] = {CacheFormat::Csv, CacheFormat::Ply,
+                                                   CacheFormat::Vdb};
 /// "csv", "ply" or "vdb".
 std::string_view cacheFormatName(CacheFormat format);
+/// The format called `name` (as cacheFormatName gives it), or nothing.
+std::optional<CacheFormat> cacheFormatFromName(std::string_view name);
 
 /// The [output] table: what `tickfx run` writes.
 struct OutputSettings {
