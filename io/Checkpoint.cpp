@@ -165,12 +165,13 @@ struct Parsed {
   std::int64_t maxTicksPerFrame = 0;
   std::uint32_t overrunPolicy = 0;
   std::int64_t tick = 0;
-  std::int64_t ticksIssued = 0, ticksDropped = 0, remainder = 0;
+  std::int64_t ticksIssued = 0, ticksDropped = 0, ticksDue = 0, remainder = 0;
   CheckpointInfo info;
   std::uint64_t size = 0, nextId = 0, droppedSpawns = 0;
   const char* floats[kFloatColumns] = {};
   const char* ids = nullptr;
   const char* births = nullptr;
+  const char* tickStartVelocities = nullptr;  // x, y, z columns, or none
   std::vector<std::pair<std::string_view, const char*>> attributes;
   std::vector<Spring> springs;
   std::uint64_t springsBroken = 0;
@@ -187,6 +188,7 @@ Parsed parsePayload(std::string_view payload) {
   p.tick = r.i64("the tick count");
   p.ticksIssued = r.i64("the driver state");
   p.ticksDropped = r.i64("the driver state");
+  p.ticksDue = r.i64("the driver state");
   p.remainder = r.i64("the driver state");
   p.info.frame = r.i64("the frame count");
   p.info.elapsed = r.i64("the elapsed time");
@@ -197,6 +199,11 @@ Parsed parsePayload(std::string_view payload) {
   for (const char*& column : p.floats) column = r.column(p.size, 4, "the particle columns");
   p.ids = r.column(p.size, 8, "the id column");
   p.births = r.column(p.size, 8, "the birth-tick column");
+  const std::uint32_t hasVelocities = r.u32("the tick-start velocities flag");
+  if (hasVelocities > 1) throw Malformed{"a tick-start velocities flag that is not 0 or 1"};
+  if (hasVelocities == 1) {
+    p.tickStartVelocities = r.column(p.size, 12, "the tick-start velocity columns");
+  }
   for (std::uint32_t a = 0; a < attributes; ++a) {
     const std::string_view name = r.str("an attribute name");
     p.attributes.emplace_back(name, r.column(p.size, 4, "an attribute column"));
@@ -218,7 +225,7 @@ Parsed parsePayload(std::string_view payload) {
   if (r.remaining() != 0) {
     throw Malformed{std::to_string(r.remaining()) + " bytes follow the last spring"};
   }
-  if (p.tick < 0 || p.ticksIssued < 0 || p.ticksDropped < 0 || p.remainder < 0) {
+  if (p.tick < 0 || p.ticksIssued < 0 || p.ticksDropped < 0 || p.ticksDue < 0 || p.remainder < 0) {
     throw Malformed{"negative tick count or driver state"};
   }
   if (p.overrunPolicy > 1)
@@ -313,8 +320,14 @@ void apply(const Parsed& p, ParticleSystem& system) {
   // Between ticks no particle is flagged; a used target may have stale flags past its old size.
   std::fill_n(pool.dead().begin(), n, std::uint8_t{0});
   if (system.springs() != nullptr) system.springs()->restore(p.springs, p.springsBroken);
-  system.driver().restore(p.ticksIssued, p.ticksDropped, p.remainder);
-  system.restoreTickCount(p.tick);
+  system.driver().restore(p.ticksIssued, p.ticksDropped, p.ticksDue, p.remainder);
+  Vec3Column velocities;
+  if (p.tickStartVelocities != nullptr) {
+    velocities.resize(static_cast<Eigen::Index>(n));
+    for (int k = 0; k < 3; ++k)
+      loadLittleEndian(p.tickStartVelocities + k * 4 * n, velocities[k].data(), n);
+  }
+  system.restoreClock(p.tick, p.tickStartVelocities != nullptr ? &velocities : nullptr);
 }
 
 [[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
@@ -374,6 +387,7 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   w.i64(system.tickCount());
   w.i64(driver.ticksIssued());
   w.i64(driver.ticksDroppedTotal());
+  w.i64(driver.ticksDue());
   w.i64(driver.remainder());
   w.i64(info.frame);
   w.i64(info.elapsed);
@@ -384,6 +398,12 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   forEachFloatColumn(pool, [&](const FloatColumn& column) { w.column(column.data(), n); });
   w.column(pool.id().data(), n);
   w.column(pool.birthTick().data(), n);
+  // What render copies interpolate velocities from, so that a resumed run's caches match.
+  const Vec3Column* velocities = system.tickStartVelocities();
+  w.u32(velocities != nullptr ? 1 : 0);
+  if (velocities != nullptr) {
+    for (int c = 0; c < 3; ++c) w.column((*velocities)[c].data(), n);
+  }
   for (std::size_t a = 0; a < pool.attributeCount(); ++a) {
     w.str(pool.attributeName(a));
     w.column(pool.attribute(a).data(), n);

@@ -23,7 +23,7 @@ struct CheckpointInfo {
 };
 
 /// The format version this build writes and the only one it reads.
-inline constexpr std::uint32_t kCheckpointVersion = 1;
+inline constexpr std::uint32_t kCheckpointVersion = 2;
 
 /// Writes the state of `system` (after its last completed tick) and `info` to `path`.
 ///
@@ -31,17 +31,20 @@ inline constexpr std::uint32_t kCheckpointVersion = 1;
 /// existing `path` is left as it was and no temporary stays behind. Throws std::runtime_error
 /// "PATH: error: cannot write checkpoint (...)".
 ///
-/// Layout, version 1, every integer little-endian, floats as their IEEE-754 bits:
+/// Layout, version 2, every integer little-endian, floats as their IEEE-754 bits:
 ///
 ///     header   "TICKFXCK"  u32 version  u32 flags (0)  u64 file length  u64 effect hash
 ///     payload  i64 step rate (Hz)   str integrator   u64 max particles
 ///              i64 max ticks per frame   u32 overrun policy (0 drop excess, 1 fall behind)
-///              i64 tick count   i64 ticks issued   i64 ticks dropped   i64 driver remainder
+///              i64 tick count   i64 ticks issued   i64 ticks dropped   i64 ticks due
+///              i64 driver remainder
 ///              i64 frame   i64 elapsed (flicks)
 ///              u64 particle count n   u64 next id   u64 dropped spawns   u32 attribute count
 ///              f32[n] × 16: position, velocity, previous position, acceleration (x, y, z each),
 ///                           age, lifetime, mass, inverse mass
 ///              u64[n] id   i64[n] birth tick
+///              u32 1 with f32[n] × 3: velocity at the start of the newest tick (x, y, z; what
+///                  render copies interpolate from), or u32 0 without
 ///              per attribute: str name, f32[n] values
 ///              u64 spring count s   u64 springs broken so far
 ///              s × (u64 id a, u64 id b, f32 rest length, f32 stiffness, f32 damping, f32 break
@@ -59,9 +62,9 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
 /// rate, integrator, max particles, max ticks per frame, overrun policy, the same attribute
 /// names, springs only where the effect has structures). Only then are the pool (every column and
 /// attribute, size, next id, dropped spawns), the spring network, the driver (ticks issued, ticks
-/// dropped, remainder) and the tick count replaced, so `system` continues exactly as the system
-/// that wrote the file would have. ParticleSystem::alpha() is not part of the state: it is that of
-/// the next advance().
+/// dropped, ticks due, remainder), the tick count and the tick-start velocities replaced, so
+/// `system` continues, and renders, exactly as the system that wrote the file would have.
+/// (Version 1 files, which lack the driver's ticks due, are refused.)
 ///
 /// On any refusal throws std::runtime_error "PATH: error: what (expected)", e.g.
 /// "ckpt.bin: error: checkpoint is truncated (expected 5120 bytes, found 1000)", and `system` is

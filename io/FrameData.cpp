@@ -23,10 +23,9 @@ FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double 
   data.frame = frame;
   data.timeSeconds = timeSeconds;
   data.id.assign(pool.id().begin(), pool.id().begin() + n);
-  system.interpolatedPositions(system.alpha(), data.position);
-  data.velocity.resize(n);
-  for (int c = 0; c < 3; ++c) data.velocity[c] = pool.velocity()[c].head(n);
-  data.age = pool.age().head(n);
+  system.renderPositions(data.position);
+  system.renderVelocities(data.velocity);
+  system.renderAges(data.age);
   data.life = pool.lifetime().head(n);
   data.mass = pool.mass().head(n);
   for (std::size_t a = 0; a < pool.attributeCount(); ++a) {

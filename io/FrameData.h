@@ -13,13 +13,13 @@ class ParticleSystem;
 
 namespace tickfx::io {
 
-/// A copy of the particles as a frame shows them: positions interpolated between the last two
-/// ticks, everything else as of the last tick. Rows are in id order.
+/// A copy of the particles as a frame shows them: the state at the frame's own time (see
+/// ParticleSystem::renderPositions). Rows are in id order.
 struct FrameData {
   std::int64_t frame = 0;    // frame number, from 1
   double timeSeconds = 0.0;  // the frame's time (for metadata only)
   std::vector<std::uint64_t> id;
-  Vec3Column position;  // metres, interpolated
+  Vec3Column position;  // metres
   Vec3Column velocity;  // metres per second
   FloatColumn age;      // seconds
   FloatColumn life;     // seconds (lifetime; +inf for immortal particles)
@@ -33,8 +33,8 @@ struct FrameData {
   void resize(std::size_t rows, std::vector<std::string> names);
 };
 
-/// Captures `system` as frame `frame` at time `timeSeconds`, interpolating positions with the
-/// system's current α.
+/// Captures `system` as frame `frame` at time `timeSeconds` (the time its last advance() reached):
+/// positions, velocities and ages at that time; mass, lifetime and attributes of the newest tick.
 FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double timeSeconds);
 
 }  // namespace tickfx::io

@@ -4,23 +4,14 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "particles/Clock.h"
 #include "particles/DetMath.h"
+#include "particles/ExactTime.h"
 #include "particles/Random.h"
 
 namespace tickfx {
 namespace {
 
 constexpr std::int64_t kMicros = 1'000'000;
-constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
-
-// First tick whose start time is at or after `seconds`, in exact integers once the time is in
-// flicks.
-std::int64_t tickAtOrAfter(double seconds, std::int64_t stepRate) {
-  if (std::isinf(seconds)) return kNever;
-  const __int128 units = static_cast<__int128>(flicksFromSeconds(seconds)) * stepRate;
-  return static_cast<std::int64_t>((units + kFlicksPerSecond - 1) / kFlicksPerSecond);
-}
 
 // Two unit vectors completing `n` (unit) to a right-handed orthonormal basis, without a branch
 // on a threshold that a tiny change of n could flip (Duff et al. 2017).
@@ -69,23 +60,20 @@ Emitter::Emitter(EmitterSettings settings, std::uint32_t index, std::int64_t ste
     for (const Eigen::Vector3f& v : list->velocities)
       require(v.allFinite(), "point list velocities must be finite");
   }
-  rateMicros_ = std::llround(s_.rate * static_cast<double>(kMicros));
-  startTick_ = tickAtOrAfter(s_.start, stepRate_);
-  stopTick_ = tickAtOrAfter(s_.stop, stepRate_);
+  require(s_.start <= 1.0e9 && (std::isinf(s_.stop) || s_.stop <= 1.0e9),
+          "emitter start and stop must be at most 1e9 s");
+  rate_ = EmissionRate(std::llround(s_.rate * static_cast<double>(kMicros)), s_.start, s_.stop,
+                       stepRate_);
   for (const Burst& b : s_.bursts) {
     require(std::isfinite(b.time) && b.time >= 0.0, "burst time must be >= 0");
-    burstTicks_.emplace_back(tickAtOrAfter(b.time, stepRate_), b.count);
+    burstTicks_.emplace_back(exact::tickAtOrAfter(b.time, stepRate_), b.count);
   }
   std::stable_sort(burstTicks_.begin(), burstTicks_.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
 }
 
 std::uint64_t Emitter::rateCountBefore(std::int64_t tick) const {
-  const std::int64_t end = std::min(tick, stopTick_);
-  if (end <= startTick_ || rateMicros_ == 0) return 0;
-  const __int128 active = end - startTick_;
-  return static_cast<std::uint64_t>(active * rateMicros_ /
-                                    (static_cast<__int128>(stepRate_) * kMicros));
+  return tick <= 0 ? 0 : rate_.madeThrough(tick - 1);
 }
 
 std::uint64_t Emitter::serialBefore(std::int64_t tick) const {
@@ -99,8 +87,12 @@ std::uint64_t Emitter::serialBefore(std::int64_t tick) const {
 std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick) const {
   const std::uint64_t first = serialBefore(tick);
   const std::uint64_t last = serialBefore(tick + 1);
-  for (std::uint64_t serial = first; serial < last; ++serial)
+  // Particles the pool has no room for are counted, not sampled.
+  const std::uint64_t room = pool.maxParticles() - pool.size();
+  const std::uint64_t tried = std::min<std::uint64_t>(last - first, room);
+  for (std::uint64_t serial = first; serial < first + tried; ++serial)
     pool.spawn(sample(seed, serial), tick);
+  pool.refuseSpawns(last - first - tried);
   return last - first;
 }
 

@@ -8,6 +8,7 @@
 #include <variant>
 #include <vector>
 
+#include "particles/EmissionRate.h"
 #include "particles/ParticlePool.h"
 
 namespace tickfx {
@@ -66,11 +67,11 @@ struct EmitterSettings {
   double mass = 1.0;                                          // kilograms
 };
 
-/// Spawns particles for one emitter. Emission is a pure function of the tick: the number of
-/// particles born in tick k is floor((k+1−k0)·R/H) − floor((k−k0)·R/H) in exact integers
-/// (R the rate in 10⁻⁶ particle/s, H the step rate), so T seconds of emission yield exactly
-/// floor(R·T) particles whatever the frame times, and each particle's serial (the input of its
-/// random numbers) is known without replaying earlier ticks.
+/// Spawns particles for one emitter. Emission is a pure function of the tick: rate emission as
+/// EmissionRate says (a whole emission makes ⌊rate·(stop − start)⌋ particles whatever the step
+/// rate), each burst at the first tick at or after its time (exact::tickAtOrAfter). So the
+/// count is the same for any frame times, and each particle's serial (the input of its random
+/// numbers) is known without replaying earlier ticks.
 class Emitter {
  public:
   /// `index` is the emitter's place in the effect (part of its random keys); throws
@@ -95,8 +96,7 @@ class Emitter {
   EmitterSettings s_;
   std::uint32_t index_;
   std::int64_t stepRate_;
-  std::int64_t rateMicros_;  // particles per 10⁶ s
-  std::int64_t startTick_, stopTick_;
+  EmissionRate rate_{0, 0.0, 0.0, 1};
   std::vector<std::pair<std::int64_t, std::uint64_t>> burstTicks_;  // (tick, count), sorted
 };
 

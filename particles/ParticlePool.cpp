@@ -129,12 +129,16 @@ void ParticlePool::updateAges(std::int64_t tick, std::int64_t stepRateHz) {
   });
 }
 
-std::size_t ParticlePool::removeDead() {
-  // Most ticks nobody dies: find that out with one byte scan and touch nothing else.
+std::size_t ParticlePool::firstDeadRow() const {
   const auto firstDead =
       std::find_if(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_),
                    [](std::uint8_t d) { return d != 0; });
-  const auto first = static_cast<std::size_t>(firstDead - dead_.begin());
+  return static_cast<std::size_t>(firstDead - dead_.begin());
+}
+
+std::size_t ParticlePool::removeDead() {
+  // Most ticks nobody dies: find that out with one byte scan and touch nothing else.
+  const std::size_t first = firstDeadRow();
   if (first == size_) return 0;
   for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_})
     compact(*c, dead_, first, size_);
@@ -152,6 +156,11 @@ std::size_t ParticlePool::removeDead() {
   size_ = kept;
   firstUnstepped_ = std::min(firstUnstepped_, size_);
   return removed;
+}
+
+void ParticlePool::applyRemovalTo(Vec3Column& column) const {
+  const std::size_t first = firstDeadRow();
+  if (first < size_) compact(column, dead_, first, size_);
 }
 
 std::size_t ParticlePool::addAttribute(const std::string& name, float initial) {

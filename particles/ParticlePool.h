@@ -60,6 +60,8 @@ class ParticlePool {
   /// Appends a particle born at `tick`; returns its row, or npos when the pool is full.
   std::size_t spawn(const ParticleInit& init, std::int64_t tick);
   static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  /// Counts `count` spawns refused without trying them (the caller saw the pool was full).
+  void refuseSpawns(std::uint64_t count) { droppedSpawns_ += count; }
 
   /// Rows [firstUnstepped(), size()) have not been through an integrator step yet (spawned this
   /// tick). Self-starting integrators (position Verlet, velocity Verlet) need to know.
@@ -73,6 +75,9 @@ class ParticlePool {
   /// Removes the particles flagged dead (by a module, or by updateAges at the end of their
   /// life), keeping the order of the rest. Returns how many were removed.
   std::size_t removeDead();
+  /// Applies to `column` (a caller's copy, rows matching the pool's) the removal removeDead()
+  /// is about to make, so the copy keeps matching the rows after it.
+  void applyRemovalTo(Vec3Column& column) const;
 
   // Columns. Storage may be longer than size(); only rows [0, size()) are meaningful.
   Vec3Column& position() { return position_; }
@@ -129,6 +134,7 @@ class ParticlePool {
   };
 
   void grow(std::size_t rows);
+  std::size_t firstDeadRow() const;  // size() when nobody is flagged
 
   std::size_t maxParticles_;
   std::size_t size_ = 0;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "particles/Clock.h"
+#include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
 
 namespace tickfx {
@@ -52,7 +53,8 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
       emitters_(makeEmitters(emitters, settings.stepRateHz)),
       forces_(std::move(forces)),
       integrator_(makeIntegrator(settings.integrator)),
-      driver_(settings.stepRateHz, settings.maxTicksPerFrame, settings.overrunPolicy),
+      driver_(settings.stepRateHz, settings.maxTicksPerFrame, settings.overrunPolicy,
+              settings.frameTiming),
       arena_(std::make_unique<ThreadArena>(settings.threads)) {
   if (settings.threads < 0) throw std::invalid_argument("threads must be >= 0");
   for (std::size_t i = 0; i < forces_.size() && springs_ == nullptr; ++i) {
@@ -64,10 +66,7 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
   for (std::size_t i = 0; i < structures.size(); ++i) {
     // Validate now, not at the structure's birth tick: bad settings fail the construction.
     buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
-    const Flicks at = flicksFromSeconds(structures[i].time);
-    const auto tick = static_cast<std::int64_t>(
-        (static_cast<__int128>(at) * settings.stepRateHz + kFlicksPerSecond - 1) /
-        kFlicksPerSecond);
+    const std::int64_t tick = exact::tickAtOrAfter(structures[i].time, settings.stepRateHz);
     structures_.push_back(PendingStructure{structures[i], tick, static_cast<std::uint32_t>(i)});
   }
 }
@@ -76,27 +75,42 @@ ParticleSystem::~ParticleSystem() = default;
 
 AdvanceResult ParticleSystem::advance(Flicks frame) {
   const AdvanceResult result = driver_.advance(frame);
-  stepTicks(result.ticks);
+  runTicks(result.ticks, /*keepVelocities=*/true);
   alpha_ = result.alpha;
+  frameOffset_ = driver_.frameOffset();
   return result;
 }
 
 void ParticleSystem::step() { stepTicks(1); }
 
 void ParticleSystem::stepTicks(std::int64_t ticks) {
+  runTicks(ticks, /*keepVelocities=*/false);
+  if (ticks > 0) {
+    alpha_ = 1.0f;
+    frameOffset_ = kFlicksPerSecond;
+  }
+}
+
+void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
   if (ticks <= 0) return;
   arena_->execute([&] {
     for (std::int64_t i = 0; i < ticks; ++i) {
-      runTick();
+      // Only the last tick of a frame needs its starting velocities, for interpolation.
+      runTick(keepVelocities && i == ticks - 1);
       if (tickObserver_) tickObserver_(*this);
     }
   });
 }
 
-void ParticleSystem::runTick() {
+void ParticleSystem::runTick(bool keepVelocities) {
   for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, tick_);
   for (const PendingStructure& p : structures_) {
     if (p.tick == tick_) spawnStructure(p);
+  }
+  if (keepVelocities) {
+    const auto n = static_cast<Eigen::Index>(pool_.size());
+    previousVelocity_.resize(n);
+    for (int c = 0; c < 3; ++c) previousVelocity_[c] = pool_.velocity()[c].head(n);
   }
   forces_.beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};
@@ -105,7 +119,19 @@ void ParticleSystem::runTick() {
   forces_.endTick(pool_, tick_, time.at(1.0));
   ++tick_;
   pool_.updateAges(tick_, settings_.stepRateHz);
+  if (keepVelocities) {
+    pool_.applyRemovalTo(previousVelocity_);
+    velocitiesTick_ = tick_;
+  }
   pool_.removeDead();
+}
+
+void ParticleSystem::restoreClock(std::int64_t tick, const Vec3Column* tickStartVelocities) {
+  tick_ = tick;
+  alpha_ = driver_.alpha();
+  frameOffset_ = driver_.frameOffset();
+  velocitiesTick_ = tickStartVelocities != nullptr ? tick : -1;
+  if (tickStartVelocities != nullptr) previousVelocity_ = *tickStartVelocities;
 }
 
 void ParticleSystem::spawnStructure(const PendingStructure& p) {
@@ -126,17 +152,73 @@ void ParticleSystem::spawnStructure(const PendingStructure& p) {
   }
 }
 
-void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
-  const std::size_t n = pool_.size();
+namespace {
+
+// previous + (current − previous) · α over rows [0, n), exactly `current` at α = 1 and
+// `previous` at α = 0 (the arithmetic would turn −0 into +0).
+void interpolate(const Vec3Column& previous, const Vec3Column& current, float alpha, std::size_t n,
+                 Vec3Column& out) {
   out.resize(static_cast<Eigen::Index>(n));
-  const Vec3Column& p = pool_.position();
-  const Vec3Column& prev = pool_.previousPosition();
   parallelForRows(n, [&](std::size_t b, std::size_t e) {
     const auto i = static_cast<Eigen::Index>(b), m = static_cast<Eigen::Index>(e - b);
     for (int c = 0; c < 3; ++c) {
-      out[c].segment(i, m) =
-          prev[c].segment(i, m) + (p[c].segment(i, m) - prev[c].segment(i, m)) * alpha;
+      if (alpha == 1.0f) {
+        out[c].segment(i, m) = current[c].segment(i, m);
+      } else if (alpha == 0.0f) {
+        out[c].segment(i, m) = previous[c].segment(i, m);
+      } else {
+        out[c].segment(i, m) = previous[c].segment(i, m) +
+                               (current[c].segment(i, m) - previous[c].segment(i, m)) * alpha;
+      }
     }
+  });
+}
+
+}  // namespace
+
+double ParticleSystem::shownSeconds() const {
+  const __int128 units = static_cast<__int128>(tick_ - 1) * kFlicksPerSecond + frameOffset_;
+  return static_cast<double>(units) /
+         (static_cast<double>(kFlicksPerSecond) * static_cast<double>(settings_.stepRateHz));
+}
+
+void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
+  arena_->execute(
+      [&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, pool_.size(), out); });
+}
+
+void ParticleSystem::renderPositions(Vec3Column& out) const {
+  interpolatedPositions(frameOffset_ == kFlicksPerSecond ? 1.0f : alpha_, out);
+}
+
+void ParticleSystem::renderVelocities(Vec3Column& out) const {
+  const bool onTick = frameOffset_ == kFlicksPerSecond || velocitiesTick_ != tick_;
+  const Vec3Column& previous = onTick ? pool_.velocity() : previousVelocity_;
+  arena_->execute(
+      [&] { interpolate(previous, pool_.velocity(), onTick ? 1.0f : alpha_, pool_.size(), out); });
+}
+
+void ParticleSystem::renderAges(FloatColumn& out) const {
+  const std::size_t n = pool_.size();
+  if (frameOffset_ == kFlicksPerSecond) {
+    out = pool_.age().head(static_cast<Eigen::Index>(n));
+    return;
+  }
+  // age = ((tick − 1 − birth) · F + offset) / (F · H) seconds: an exact integer numerator, one
+  // division in double, one rounding to float. No float time is read back.
+  out.resize(static_cast<Eigen::Index>(n));
+  const std::int64_t* birth = pool_.birthTick().data();
+  const double unitsPerSecond =
+      static_cast<double>(kFlicksPerSecond) * static_cast<double>(settings_.stepRateHz);
+  const std::int64_t last = tick_ - 1, offset = frameOffset_;
+  float* age = out.data();
+  arena_->execute([&] {
+    parallelForRows(n, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const __int128 units = static_cast<__int128>(last - birth[i]) * kFlicksPerSecond + offset;
+        age[i] = static_cast<float>(static_cast<double>(units) / unitsPerSecond);
+      }
+    });
   });
 }
 

@@ -22,16 +22,18 @@ struct SystemSettings {
   std::string integrator = "semi_implicit_euler";  // see integratorNames()
   std::uint64_t seed = 0;                          // the effect seed of every random number
   std::size_t maxParticles = 1'000'000;            // spawns past this are dropped, counted
-  std::int64_t maxTicksPerFrame = 16;              // cap on ticks per advance()
+  std::int64_t maxTicksPerFrame = 16;              // cap on ticks per advance() (real-time hosts)
   OverrunPolicy overrunPolicy = OverrunPolicy::DropExcess;
-  int threads = 0;  // 0: all cores
+  FrameTiming frameTiming = FrameTiming::AtFrameTime;  // which time advance() leaves on show
+  int threads = 0;                                     // 0: all cores
 };
 
 /// The simulation. One tick does, in this order: emit the tick's particles, let the forces
 /// rebuild their tables, integrate every particle from t_k to t_{k+1} (or advect it, when the
 /// forces prescribe velocity), let the forces flag particles dead at the new state (a field's
-/// kill region), recompute ages from the tick count and remove the dead. Nothing in a tick reads the frame time, so the state after
-/// tick k is the same for any sequence of frames that reaches it.
+/// kill region), recompute ages from the tick count and remove the dead. Nothing in a tick reads
+/// the frame time, so the state after tick k is the same for any sequence of frames that reaches
+/// it.
 ///
 /// Not thread-safe: one thread drives a system; the system uses its own TBB arena inside a tick.
 class ParticleSystem {
@@ -46,12 +48,14 @@ class ParticleSystem {
   ParticleSystem(const ParticleSystem&) = delete;
   ParticleSystem& operator=(const ParticleSystem&) = delete;
 
-  /// Feeds one frame of `frame` flicks to the driver and runs the ticks it asks for.
+  /// Feeds one frame of `frame` flicks to the driver and runs the ticks it asks for. The render
+  /// copies below then show the frame's time (see FrameTiming).
   AdvanceResult advance(Flicks frame);
 
-  /// Runs exactly one tick, bypassing the driver's clock (tests, offline baking).
+  /// Runs exactly one tick, bypassing the driver's clock (tests, offline baking). Render copies
+  /// then show the state after that tick.
   void step();
-  /// Runs `ticks` ticks.
+  /// Runs `ticks` ticks, as step() does.
   void stepTicks(std::int64_t ticks);
 
   /// Ticks completed so far: the state is the state after tick tickCount() − 1 (or the initial
@@ -60,10 +64,24 @@ class ParticleSystem {
   double timeSeconds() const {
     return static_cast<double>(tick_) / static_cast<double>(settings_.stepRateHz);
   }
-  /// α of the last advance(): where the last frame lies between the previous and current tick.
+  /// α of the last advance(): where the frame lies between the previous and the current tick,
+  /// in [0, 1]; 1 after step() and whenever the frame falls on the current tick.
   float alpha() const { return alpha_; }
+  /// Seconds the render copies show: the last frame's time (or the current tick's after step()).
+  double shownSeconds() const;
 
-  /// Positions for rendering: previous + (current − previous) · α, rows [0, pool().size()).
+  /// Render copies of the shown time, rows [0, pool().size()) in id order. Between two ticks
+  /// positions and velocities are interpolated by α and ages computed from integers; on a tick
+  /// (α = 1) they are the tick's own values, bit for bit. A frame between ticks k and k + 1
+  /// shows the particles alive after tick k + 1: those born in that tick move from their birth
+  /// state, and those removed by it (they die or leave a kill region within it) are not shown.
+  /// Other columns (mass, lifetime, attributes) are those of the current tick.
+  void renderPositions(Vec3Column& out) const;
+  void renderVelocities(Vec3Column& out) const;
+  void renderAges(FloatColumn& out) const;
+
+  /// Positions interpolated by any `alpha` in [0, 1] between the previous and the current tick:
+  /// previous + (current − previous) · α, exactly previous at 0 and current at 1.
   void interpolatedPositions(float alpha, Vec3Column& out) const;
 
   const ParticlePool& pool() const { return pool_; }
@@ -82,12 +100,19 @@ class ParticleSystem {
   void setTickObserver(std::function<void(const ParticleSystem&)> observer) {
     tickObserver_ = std::move(observer);
   }
-  /// Restores the tick counter (with the pool and the driver, a saved state is complete).
-  void restoreTickCount(std::int64_t tick) { tick_ = tick; }
+  /// Velocities at the start of the newest tick, rows matching the pool's, when advance() kept
+  /// them for interpolating render copies; nullptr otherwise.
+  const Vec3Column* tickStartVelocities() const {
+    return velocitiesTick_ == tick_ ? &previousVelocity_ : nullptr;
+  }
+  /// Restores the tick counter and what tickStartVelocities() gave (null for none), after the
+  /// pool and driver(): with them a saved state is complete, render copies included.
+  void restoreClock(std::int64_t tick, const Vec3Column* tickStartVelocities);
 
  private:
   struct PendingStructure;
-  void runTick();
+  void runTicks(std::int64_t ticks, bool keepVelocities);
+  void runTick(bool keepVelocities);
   void spawnStructure(const PendingStructure& p);
 
   SystemSettings settings_;
@@ -107,7 +132,14 @@ class ParticleSystem {
   std::unique_ptr<ThreadArena> arena_;
   std::function<void(const ParticleSystem&)> tickObserver_;
   std::int64_t tick_ = 0;
-  float alpha_ = 0.0f;
+  float alpha_ = 1.0f;
+  // The shown time as the driver's frameOffset(): past tick tick_ − 1, kFlicksPerSecond = on
+  // tick_.
+  std::int64_t frameOffset_ = kFlicksPerSecond;
+  // Velocities at the start of the newest tick (after its births), rows matching the pool's,
+  // kept by advance() for interpolation; valid while velocitiesTick_ == tick_.
+  Vec3Column previousVelocity_;
+  std::int64_t velocitiesTick_ = -1;
 };
 
 }  // namespace tickfx

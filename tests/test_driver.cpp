@@ -53,9 +53,31 @@ TEST(Clock, CommonFrameRatesAreWholeFlicks) {
   EXPECT_THROW(flicksFromSeconds(std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
 }
 
-// Any frame sequence: after frames totalling T flicks exactly floor(T · rate / kFlicksPerSecond)
-// ticks have been issued, and α is the fraction left over.
-TEST(FixedStepDriver, TicksAreTheFloorOfTheTotalTimeForAnyFrames) {
+// ⌈T · rate / kFlicksPerSecond⌉: the ticks a frame at T needs to show the state at T.
+std::int64_t ticksToShow(Flicks total, std::int64_t rate) {
+  const __int128 units = static_cast<__int128>(total) * rate;
+  return static_cast<std::int64_t>((units + kFlicksPerSecond - 1) / kFlicksPerSecond);
+}
+
+// α is the float nearest the exact fraction (rounded once): neither neighbour is closer.
+::testing::AssertionResult isNearestFloat(float alpha, Flicks total, std::int64_t rate) {
+  const __int128 units = static_cast<__int128>(total) * rate;
+  const auto r = static_cast<long double>(static_cast<std::int64_t>(units % kFlicksPerSecond));
+  const long double exact = r / kFlicksPerSecond;
+  const long double miss = std::fabs(static_cast<long double>(alpha) - exact);
+  for (float neighbour : {std::nextafter(alpha, 0.0f), std::nextafter(alpha, 2.0f)}) {
+    if (std::fabs(static_cast<long double>(neighbour) - exact) < miss) {
+      return ::testing::AssertionFailure()
+             << "α " << alpha << " is not the float nearest " << static_cast<double>(exact);
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// Any frame sequence, frames shown at their own time: after frames totalling T flicks the
+// driver has issued ⌈T · rate⌉ ticks (the tick at or after T), and α places T between the last
+// two: the exact fraction rounded once, or 1 when T falls on a tick.
+TEST(FixedStepDriver, AtFrameTimeRunsTheTickAtOrAfterTheFrame) {
   for (std::int64_t rate : {1, 7, 60, 144, 1000, 1'000'000}) {
     for (const auto& [minFrame, maxFrame] : std::vector<std::pair<Flicks, Flicks>>{
              {0, 100}, {0, kSecond / 5}, {kSecond, 3 * kSecond}}) {
@@ -68,41 +90,85 @@ TEST(FixedStepDriver, TicksAreTheFloorOfTheTotalTimeForAnyFrames) {
         const AdvanceResult r = driver.advance(frame);
         total += frame;
         ticks += r.ticks;
-        ASSERT_EQ(ticks, ticksIn(total, rate)) << rate << " Hz, frame " << f;
+        ASSERT_EQ(ticks, ticksToShow(total, rate)) << rate << " Hz, frame " << f;
         ASSERT_EQ(driver.ticksIssued(), ticks);
+        ASSERT_EQ(driver.ticksDue(), ticksIn(total, rate));
         ASSERT_EQ(r.ticksDropped, 0);
         ASSERT_EQ(r.ticksPending, 0);
-        ASSERT_GE(r.alpha, 0.0f);
-        ASSERT_LT(r.alpha, 1.0f);
-        ASSERT_NEAR(r.alpha, fractionIn(total, rate), kAlphaTolerance)
-            << rate << " Hz, frame " << f;
+        if (fractionIn(total, rate) == 0.0) {
+          ASSERT_EQ(r.alpha, 1.0f) << "on a tick: its own state";
+          ASSERT_EQ(driver.frameOffset(), kFlicksPerSecond);
+        } else {
+          ASSERT_GT(r.alpha, 0.0f);
+          ASSERT_TRUE(isNearestFloat(r.alpha, total, rate)) << rate << " Hz, frame " << f;
+        }
       }
     }
   }
+}
+
+// One tick behind: the classic loop never runs a tick past the frame (⌊T · rate⌋ ticks) and α
+// is the fraction past the newest tick, in [0, 1).
+TEST(FixedStepDriver, OneTickBehindRunsTheTicksBeforeTheFrame) {
+  for (std::int64_t rate : {1, 7, 60, 144, 1000, 1'000'000}) {
+    FixedStepDriver driver(rate, std::int64_t{1} << 40, OverrunPolicy::DropExcess,
+                           FrameTiming::OneTickBehind);
+    test::JitteredFrames frames(static_cast<std::uint64_t>(rate), 0, kSecond / 5);
+    Flicks total = 0;
+    for (int f = 0; f < 500; ++f) {
+      const Flicks frame = frames.next();
+      const AdvanceResult r = driver.advance(frame);
+      total += frame;
+      ASSERT_EQ(driver.ticksIssued(), ticksIn(total, rate)) << rate << " Hz, frame " << f;
+      ASSERT_GE(r.alpha, 0.0f);
+      ASSERT_LT(r.alpha, 1.0f);
+      if (r.alpha < std::nextafter(1.0f, 0.0f)) {
+        ASSERT_TRUE(isNearestFloat(r.alpha, total, rate)) << rate << " Hz, frame " << f;
+      }
+    }
+  }
+}
+
+// Regression (issue 10, item 16): α was float(remainder) / float(kFlicksPerSecond), rounded
+// twice (the remainder has up to 30 bits, a float 24): for 1546 of these 4096 frames it was not
+// the float nearest the fraction.
+TEST(FixedStepDriver, AlphaIsTheExactFractionRoundedOnce) {
+  int checked = 0;
+  for (Flicks frame = kSecond - 4096; frame < kSecond; ++frame) {
+    FixedStepDriver driver(1, 16);
+    const AdvanceResult r = driver.advance(frame);
+    ASSERT_TRUE(isNearestFloat(r.alpha, frame, 1)) << frame << " flicks";
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4096);
+  FixedStepDriver driver(1, 16);
+  // 705599999 / 705600000 = 1 − 1.4e-9: 1.0f is the nearest float, so α is 1.
+  EXPECT_EQ(driver.advance(kSecond - 1).alpha, 1.0f);
+  EXPECT_EQ(driver.frameOffset(), kSecond - 1) << "the exact offset keeps the truth";
 }
 
 TEST(FixedStepDriver, DropExcessCapsAOneSecondFrameAndKeepsTheFraction) {
   FixedStepDriver driver(60, 16, OverrunPolicy::DropExcess);
   const Flicks tick = frameDuration(FrameRate{60, 1});
   AdvanceResult r = driver.advance(tick / 2);
-  EXPECT_EQ(r.ticks, 0);
+  EXPECT_EQ(r.ticks, 1);  // the tick that ends after the frame, to show it
   EXPECT_EQ(r.alpha, 0.5f);
-  r = driver.advance(kSecond);  // 60.5 ticks owed
+  r = driver.advance(kSecond);  // the clock at 60.5 ticks: tick 61 shows it
   EXPECT_EQ(r.ticks, 16);
   EXPECT_EQ(r.ticksDropped, 44);
   EXPECT_EQ(r.ticksPending, 0);
   EXPECT_EQ(r.alpha, 0.5f);
   EXPECT_EQ(driver.ticksDroppedTotal(), 44);
-  r = driver.advance(tick / 2);
-  EXPECT_EQ(r.ticks, 1);
+  r = driver.advance(tick / 2);  // on a tick: no new tick needed
+  EXPECT_EQ(r.ticks, 0);
   EXPECT_EQ(r.ticksDropped, 0);
-  EXPECT_EQ(r.alpha, 0.0f);
+  EXPECT_EQ(r.alpha, 1.0f);
   r = driver.advance(3 * kSecond);
   EXPECT_EQ(r.ticks, 16);
   EXPECT_EQ(r.ticksDropped, 164);
   EXPECT_EQ(driver.ticksIssued(), 33);
   EXPECT_EQ(driver.ticksDroppedTotal(), 208);
-  // Issued plus dropped is still the floor of the total time.
+  // Issued plus dropped is the clock's whole ticks (the frame is on a tick).
   EXPECT_EQ(driver.ticksIssued() + driver.ticksDroppedTotal(), ticksIn(tick + 4 * kSecond, 60));
 }
 
@@ -113,19 +179,32 @@ TEST(FixedStepDriver, FallBehindReportsTheDebtAndLaterFramesCatchUp) {
   EXPECT_EQ(r.ticks, 16);
   EXPECT_EQ(r.ticksPending, 44);
   EXPECT_EQ(r.ticksDropped, 0);
-  EXPECT_GE(r.alpha, 0.0f);
-  EXPECT_LT(r.alpha, 1.0f);
+  EXPECT_EQ(r.alpha, 1.0f) << "behind: the newest state, not an extrapolation";
   const std::vector<std::pair<std::int64_t, std::int64_t>> expected{
       {16, 29}, {16, 14}, {15, 0}, {1, 0}};
   for (const auto& [ticks, pending] : expected) {
     r = driver.advance(tick);
     EXPECT_EQ(r.ticks, ticks);
     EXPECT_EQ(r.ticksPending, pending);
-    EXPECT_LT(r.alpha, 1.0f);
   }
-  EXPECT_EQ(r.alpha, 0.0f);
+  EXPECT_EQ(r.alpha, 1.0f);
   EXPECT_EQ(driver.ticksIssued(), ticksIn(kSecond + 4 * tick, 60));  // 64: nothing was lost
   EXPECT_EQ(driver.ticksDroppedTotal(), 0);
+}
+
+// Regression (issue 10, item 6): the debt was kept in flick·Hz units in 64 bits, and four
+// 3600 s frames at 10⁶ Hz (2.5·10¹⁸ units each) overflowed it: 5 ticks ran where 6 were owed.
+TEST(FixedStepDriver, FallBehindKeepsADebtPastSixtyFourBitsOfFlickUnits) {
+  FixedStepDriver driver(1'000'000, 1, OverrunPolicy::FallBehind);
+  const Flicks hour = 3600 * kSecond;
+  std::int64_t ran = 0;
+  for (int f = 0; f < 4; ++f) ran += driver.advance(hour).ticks;
+  EXPECT_EQ(ran, 4);
+  EXPECT_EQ(driver.ticksPending(), 4 * 3'600'000'000LL - 4);
+  for (int f = 0; f < 2; ++f) ran += driver.advance(0).ticks;
+  EXPECT_EQ(ran, 6) << "every frame runs the cap while ticks are owed";
+  EXPECT_EQ(driver.ticksPending(), 4 * 3'600'000'000LL - 6);
+  EXPECT_EQ(driver.ticksDue(), 4 * 3'600'000'000LL);
 }
 
 TEST(FixedStepDriver, RejectsInvalidArguments) {
@@ -136,16 +215,21 @@ TEST(FixedStepDriver, RejectsInvalidArguments) {
   EXPECT_EQ(driver.advance(0).ticks, 0);
 }
 
-// NTSC: 1001 frames of 30000/1001 fps are 33.4 s exactly; every prefix issues the floor.
+// NTSC: 1001 frames of 30000/1001 fps are 33.4 s exactly; every prefix issues the ceiling.
 TEST(FixedStepDriver, NtscFrameRateAddsUpExactly) {
   const Flicks frame = frameDuration(FrameRate{30000, 1001});
   FixedStepDriver driver(60, 16);
   for (int f = 1; f <= 1001; ++f) {
     const AdvanceResult r = driver.advance(frame);
-    ASSERT_EQ(driver.ticksIssued(), ticksIn(f * frame, 60)) << "frame " << f;
-    ASSERT_NEAR(r.alpha, fractionIn(f * frame, 60), kAlphaTolerance);
+    ASSERT_EQ(driver.ticksIssued(), ticksToShow(f * frame, 60)) << "frame " << f;
+    if (fractionIn(f * frame, 60) == 0.0) {
+      ASSERT_EQ(r.alpha, 1.0f);
+    } else {
+      ASSERT_TRUE(isNearestFloat(r.alpha, f * frame, 60));
+    }
   }
-  EXPECT_EQ(driver.ticksIssued(), 2004);  // 1001 · 1001/30000 s · 60 Hz = 2004.002
+  EXPECT_EQ(driver.ticksIssued(), 2005);  // 1001 · 1001/30000 s · 60 Hz = 2004.002
+  EXPECT_EQ(driver.ticksDue(), 2004);
 }
 
 // ---- the system under the driver -------------------------------------------------------------
@@ -184,11 +268,11 @@ Checkpoints advanceByFrames(const SystemSettings& settings, const std::function<
       const AdvanceResult r = system->advance(frame);
       elapsed += frame;
       EXPECT_EQ(r.ticksDropped, 0);
-      EXPECT_EQ(system->tickCount(), ticksIn(elapsed, settings.stepRateHz));
-      EXPECT_GE(system->alpha(), 0.0f);
-      EXPECT_LT(system->alpha(), 1.0f);
+      EXPECT_EQ(system->tickCount(), ticksToShow(elapsed, settings.stepRateHz));
+      EXPECT_GT(system->alpha(), 0.0f);
+      EXPECT_LE(system->alpha(), 1.0f);
     }
-    EXPECT_EQ(system->alpha(), 0.0f);  // whole seconds are whole ticks
+    EXPECT_EQ(system->alpha(), 1.0f);  // whole seconds are whole ticks, shown as they are
     c.hash[s] = stateHash(system->pool());
     c.alive[s] = system->pool().size();
   }
@@ -233,12 +317,12 @@ TEST(SystemDriver, NtscFramesReachTheSameStates) {
   const Flicks frame = frameDuration(FrameRate{30000, 1001});
   for (int f = 1; f <= 150; ++f) {
     system->advance(frame);
-    ASSERT_EQ(system->tickCount(), ticksIn(f * frame, 60));
+    ASSERT_EQ(system->tickCount(), ticksToShow(f * frame, 60));
     ASSERT_LT(system->alpha(), 1.0f);
   }
-  EXPECT_EQ(system->tickCount(), 300);  // 150 frames = 5.005 s
+  EXPECT_EQ(system->tickCount(), 301);  // 150 frames = 5.005 s, shown between ticks 300 and 301
   EXPECT_NEAR(system->alpha(), 0.3, kAlphaTolerance);
-  reference->stepTicks(300);
+  reference->stepTicks(301);
   EXPECT_EQ(stateHash(system->pool()), stateHash(reference->pool()));
 }
 

@@ -83,22 +83,29 @@ AdvanceResult frame(ParticleSystem& system, JitteredFrames& frames, Flicks* elap
 struct Snapshot {
   std::uint64_t hash = 0;
   std::int64_t tick = 0;
-  std::int64_t ticksIssued = 0, ticksDropped = 0, remainder = 0;
+  std::int64_t ticksIssued = 0, ticksDropped = 0, ticksDue = 0, remainder = 0;
   std::size_t size = 0, firstUnstepped = 0;
+  float alpha = 0.0f;
 
   static Snapshot of(const ParticleSystem& s) {
-    return {stateHash(s.pool()),      s.tickCount(),
-            s.driver().ticksIssued(), s.driver().ticksDroppedTotal(),
-            s.driver().remainder(),   s.pool().size(),
-            s.pool().firstUnstepped()};
+    return {stateHash(s.pool()),
+            s.tickCount(),
+            s.driver().ticksIssued(),
+            s.driver().ticksDroppedTotal(),
+            s.driver().ticksDue(),
+            s.driver().remainder(),
+            s.pool().size(),
+            s.pool().firstUnstepped(),
+            s.alpha()};
   }
   bool operator==(const Snapshot&) const = default;
 };
 
 void PrintTo(const Snapshot& s, std::ostream* os) {
   *os << "{hash " << hashToHex(s.hash) << ", tick " << s.tick << ", issued " << s.ticksIssued
-      << ", dropped " << s.ticksDropped << ", remainder " << s.remainder << ", size " << s.size
-      << ", firstUnstepped " << s.firstUnstepped << "}";
+      << ", dropped " << s.ticksDropped << ", due " << s.ticksDue << ", remainder " << s.remainder
+      << ", alpha " << s.alpha << ", size " << s.size << ", firstUnstepped " << s.firstUnstepped
+      << "}";
 }
 
 std::string readBytes(const fs::path& path) {
@@ -135,7 +142,7 @@ void reseal(std::string& bytes) {
 
 // Offset of the particle count: header, step rate, integrator name, then 68 bytes of scalars.
 std::size_t particleCountOffset(const std::string& integrator) {
-  return 32 + 8 + 4 + integrator.size() + 68;
+  return 32 + 8 + 4 + integrator.size() + 76;
 }
 
 class ioCheckpoint : public ::testing::Test {
@@ -199,7 +206,7 @@ TEST_P(ioCheckpointResume, ResumedRunMatchesTheUninterruptedOneBitForBit) {
     if (policy == OverrunPolicy::DropExcess) {
       ASSERT_GT(b->driver().ticksDroppedTotal(), 0);
     } else {
-      ASSERT_GT(b->driver().remainder(), kFlicksPerSecond) << "ticks should be owed";
+      ASSERT_GT(b->driver().ticksPending(), 0) << "ticks should be owed";
     }
     if (integrator == "velocity_verlet") {
       ASSERT_NE(b->pool().acceleration().y[0], 0.0f) << "velocity Verlet keeps a(t) between ticks";
@@ -343,19 +350,21 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
   const std::size_t n = pool.size();
   ASSERT_GT(n, 0u);
 
-  const std::size_t payload = 8 + (4 + 15) + 68 + 3 * 8 + 4 + n * (16 * 4 + 8 + 8) +
+  ASSERT_NE(a->tickStartVelocities(), nullptr) << "advance() keeps them";
+  const std::size_t payload = 8 + (4 + 15) + 76 + 3 * 8 + 4 + n * (16 * 4 + 8 + 8) + 4 + n * 12 +
                               (4 + 4 + 4 * n) * 2  // "heat", "spin"
                               + 8 + 8;             // no springs
   ASSERT_EQ(bytes.size(), 32 + payload + 8);
   EXPECT_EQ(bytes.substr(0, 8), "TICKFXCK");
-  EXPECT_EQ(bytes.substr(8, 8), std::string("\x01\0\0\0\0\0\0\0", 8));
+  EXPECT_EQ(bytes.substr(8, 8), std::string("\x02\0\0\0\0\0\0\0", 8));
   EXPECT_EQ(loadU64(bytes, 16), bytes.size());
   EXPECT_EQ(loadU64(bytes, 24), kEffect);
   EXPECT_EQ(loadU64(bytes, 32), 60u);
   EXPECT_EQ(bytes.substr(40, 4 + 15), std::string("\x0f\0\0\0velocity_verlet", 19));
   const std::size_t count = particleCountOffset("velocity_verlet");
-  EXPECT_EQ(loadU64(bytes, count - 48), static_cast<std::uint64_t>(a->tickCount()));
-  EXPECT_EQ(loadU64(bytes, count - 40), static_cast<std::uint64_t>(a->driver().ticksIssued()));
+  EXPECT_EQ(loadU64(bytes, count - 56), static_cast<std::uint64_t>(a->tickCount()));
+  EXPECT_EQ(loadU64(bytes, count - 48), static_cast<std::uint64_t>(a->driver().ticksIssued()));
+  EXPECT_EQ(loadU64(bytes, count - 32), static_cast<std::uint64_t>(a->driver().ticksDue()));
   EXPECT_EQ(loadU64(bytes, count - 24), static_cast<std::uint64_t>(a->driver().remainder()));
   EXPECT_EQ(loadU64(bytes, count - 16), 25u);  // frame
   EXPECT_EQ(loadU64(bytes, count - 8), 123456789012345u);
@@ -480,9 +489,9 @@ TEST_F(ioCheckpointRefusal, AFlippedHeaderBitNamesTheField) {
     if (at < 8) {
       expectRefused(bad, "not a tickfx checkpoint (it does not start with TICKFXCK)");
     } else if (at < 12) {
-      const std::uint32_t version = 1u ^ (1u << (8 * (at - 8) + bit));
-      expectRefused(
-          bad, "checkpoint format version " + std::to_string(version) + " (this build reads 1)");
+      const std::uint32_t version = kCheckpointVersion ^ (1u << (8 * (at - 8) + bit));
+      expectRefused(bad, "checkpoint format version " + std::to_string(version) +
+                             " (this build reads " + std::to_string(kCheckpointVersion) + ")");
     } else if (at < 16) {
       expectRefused(bad, "checkpoint has unknown flags " +
                              std::to_string(1ull << (8 * (at - 12) + bit)) +
@@ -514,13 +523,14 @@ TEST_F(ioCheckpointRefusal, NotACheckpoint) {
 }
 
 TEST_F(ioCheckpointRefusal, OtherFormatVersions) {
-  for (std::uint32_t version : {0u, 2u, 9u, 0xffffffffu}) {
+  // Version 1 lacks the driver's ticks due and the tick-start velocities.
+  for (std::uint32_t version : {0u, 1u, 3u, 9u, 0xffffffffu}) {
     SCOPED_TRACE(version);
     std::string bad = bytes_;
     storeU32(bad, 8, version);
     reseal(bad);  // otherwise well-formed: the version alone is refused
     expectRefused(bad,
-                  "checkpoint format version " + std::to_string(version) + " (this build reads 1)");
+                  "checkpoint format version " + std::to_string(version) + " (this build reads 2)");
   }
 }
 
