@@ -50,9 +50,7 @@ std::vector<DriveCase> standardDriveCases(Flicks total, const std::vector<int>& 
 
 DriveTrace traceDrive(const io::EffectSettings& effect, const DriveCase& drive,
                       const std::vector<std::int64_t>& onlyTicks) {
-  io::EffectSettings lifted = effect;
-  lifted.simulation.maxTicksPerFrame = std::numeric_limits<std::int64_t>::max() / 2;
-  const auto system = io::buildSystem(lifted, drive.threads);
+  const auto system = io::buildOfflineSystem(effect, drive.threads);
   DriveTrace trace;
   trace.label = drive.label;
   trace.threads = drive.threads;

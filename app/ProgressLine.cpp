@@ -10,7 +10,7 @@ ProgressLine::ProgressLine()
 
 ProgressLine::~ProgressLine() { finish(); }
 
-void ProgressLine::update(std::int64_t frame, std::int64_t frames, double simSeconds,
+void ProgressLine::update(std::int64_t frame, double simSeconds, double totalSeconds,
                           std::size_t particles) {
   if (!enabled_) return;
   const Clock::time_point now = Clock::now();
@@ -18,9 +18,8 @@ void ProgressLine::update(std::int64_t frame, std::int64_t frames, double simSec
     return;
   last_ = now;
   shown_ = true;
-  std::fprintf(stderr, "\r\033[Kframe %lld/%lld  t = %.3f s  particles: %zu",
-               static_cast<long long>(frame), static_cast<long long>(frames), simSeconds,
-               particles);
+  std::fprintf(stderr, "\r\033[Kframe %lld  t = %.3f of %.3f s  particles: %zu",
+               static_cast<long long>(frame), simSeconds, totalSeconds, particles);
   std::fflush(stderr);
 }
 

@@ -12,7 +12,7 @@ class ProgressLine {
  public:
   ProgressLine();
   ~ProgressLine();
-  void update(std::int64_t frame, std::int64_t frames, double simSeconds, std::size_t particles);
+  void update(std::int64_t frame, double simSeconds, double totalSeconds, std::size_t particles);
   /// Erases the line.
   void finish();
 

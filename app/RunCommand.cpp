@@ -77,10 +77,12 @@ std::vector<io::CacheFormat> parseFormats(const std::string& text) {
 }
 
 struct FramePlan {
-  std::vector<Flicks> frames;
+  io::FrameSchedule schedule;
   std::string description;
 };
 
+// The run's length comes from the effect (or --seconds / --frames), whatever the frame rate:
+// --fps only says how that length is cut into frames.
 FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::string>& seconds,
                      const std::optional<std::string>& frames,
                      const std::optional<std::string>& fps,
@@ -94,11 +96,9 @@ FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::
     throw UsageError("run: --frame-times sets the length; drop --seconds/--frames");
   if (jitter && frames) throw UsageError("run: --jitter needs a length in --seconds, not --frames");
 
-  FramePlan plan;
   if (frameTimes) {
-    plan.frames = io::readFrameTimes(*frameTimes);
-    plan.description = "frame times from " + *frameTimes;
-    return plan;
+    return {io::FrameSchedule::recorded(io::readFrameTimes(*frameTimes)),
+            "frame times from " + *frameTimes};
   }
   FrameRate rate = output.fps;
   if (fps) {
@@ -108,30 +108,24 @@ FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::
       throw UsageError(std::string("run: --fps: ") + e.what());
     }
   }
-  const double defaultSeconds = output.durationSeconds();
-  const double length =
-      seconds ? parseNumber(*seconds, "run: --seconds", 0.0, 1.0e6) : defaultSeconds;
-  const Flicks total = flicksFromSeconds(length);
+  Flicks total = 0;
+  if (seconds) {
+    total = flicksFromSeconds(parseNumber(*seconds, "run: --seconds", 0.0, io::kMaxRunSeconds));
+  } else if (frames) {
+    const long long count = parseInteger(*frames, "run: --frames", 0, io::kMaxRunFrames);
+    total = io::lengthOfFrames(rate, count, "run: --frames");
+  } else {
+    total = io::lengthOfFrames(output.fps, output.frameCount(), "output length");
+  }
   if (jitter) {
     const auto seed =
         static_cast<std::uint64_t>(parseInteger(*jitter, "run: --jitter", 0, INT64_MAX));
-    plan.frames = io::jitteredFrames(seed, total);
-    plan.description = "jittered frames (seed " + *jitter + ")";
-    return plan;
+    return {io::FrameSchedule::jittered(seed, total), "jittered frames (seed " + *jitter + ")"};
   }
   const std::string rateText =
       std::to_string(rate.numerator) +
       (rate.denominator == 1 ? "" : "/" + std::to_string(rate.denominator));
-  if (frames) {
-    plan.frames =
-        io::fixedRateFrameCount(rate, parseInteger(*frames, "run: --frames", 0, 100'000'000));
-  } else if (seconds) {
-    plan.frames = io::fixedRateFrames(rate, total);
-  } else {
-    plan.frames = io::fixedRateFrameCount(rate, output.frameCount());
-  }
-  plan.description = "at " + rateText + " fps";
-  return plan;
+  return {io::FrameSchedule::fixedRate(rate, total), "at " + rateText + " fps"};
 }
 
 std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t frame,
@@ -191,15 +185,18 @@ int runCommand(Arguments& args) {
       format ? parseFormats(*format) : effect.output.formats;
   const std::filesystem::path outDir = out ? *out : effect.output.directory;
   std::optional<int> threadOverride;
-  if (threads) threadOverride = static_cast<int>(parseInteger(*threads, "run: --threads", 0, 256));
-  FramePlan plan;
+  if (threads) {
+    threadOverride = static_cast<int>(parseInteger(*threads, "run: --threads", 0, io::kMaxThreads));
+  }
+  std::optional<FramePlan> plan;
   try {
-    plan = planFrames(effect.output, seconds, frames, fps, jitter, frameTimes);
+    plan.emplace(planFrames(effect.output, seconds, frames, fps, jitter, frameTimes));
   } catch (const std::runtime_error& e) {
     if (dynamic_cast<const UsageError*>(&e) != nullptr) throw;
     std::fprintf(stderr, "%s\n", e.what());
     return kExitUsage;
   }
+  io::FrameSchedule& schedule = plan->schedule;
 
   std::int64_t every = 0;
   if (checkpointEvery)
@@ -216,10 +213,11 @@ int runCommand(Arguments& args) {
 
   // Building loads the effect's vector fields: a file that does not load is bad input, reported
   // like an effect error, before anything is written. The lint comes after, so that such a file
-  // is reported once, as the error.
+  // is reported once, as the error. An offline run has no wall clock to keep up with: every
+  // tick its frames cover runs (the effect's max_ticks_per_frame is for real-time hosts).
   std::unique_ptr<ParticleSystem> system;
   try {
-    system = io::buildSystem(effect, threadOverride);
+    system = io::buildOfflineSystem(effect, threadOverride);
   } catch (const io::BuildError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitUsage;
@@ -227,7 +225,7 @@ int runCommand(Arguments& args) {
   for (const io::Diagnostic& d : io::lintEffect(effect, &system->forces()))
     std::fprintf(stderr, "%s\n", d.format().c_str());
   std::int64_t firstFrame = 1;
-  Flicks resumedAt = 0;
+  Flicks elapsed = 0;
   if (resume) {
     // Verified whole before anything is written; a refusal is bad input (exit 2).
     io::CheckpointInfo info;
@@ -237,22 +235,34 @@ int runCommand(Arguments& args) {
       std::fprintf(stderr, "%s\n", e.what());
       return kExitUsage;
     }
-    Flicks planned = 0;
-    for (std::int64_t f = 0; f < info.frame && f < static_cast<std::int64_t>(plan.frames.size());
-         ++f) {
-      planned += plan.frames[static_cast<std::size_t>(f)];
+    for (std::int64_t f = 0; f < info.frame; ++f) {
+      const std::optional<Flicks> d = schedule.next();
+      if (!d) break;
+      elapsed += *d;
     }
-    if (info.frame > static_cast<std::int64_t>(plan.frames.size()) || planned != info.elapsed) {
+    if (schedule.framesDone() != info.frame || elapsed != info.elapsed) {
       std::fprintf(
           stderr,
           "%s: error: the checkpoint is at frame %lld (%.9g s) but this run's frame %lld ends at "
           "%.9g s (give the frame options of the run that wrote it)\n",
           resume->c_str(), static_cast<long long>(info.frame), secondsFromFlicks(info.elapsed),
-          static_cast<long long>(info.frame), secondsFromFlicks(planned));
+          static_cast<long long>(info.frame), secondsFromFlicks(elapsed));
       return kExitUsage;
     }
     firstFrame = info.frame + 1;
-    resumedAt = info.elapsed;
+  }
+  // Every output is checked before the first tick: an unwritable --dump must not turn up after
+  // hours of caches.
+  try {
+    if (!formats.empty()) std::filesystem::create_directories(outDir);
+    if (every > 0) std::filesystem::create_directories(checkpoints);
+    if (!formats.empty()) io::requireWritable(cachePath(outDir, firstFrame, "tmp"));
+    if (every > 0) io::requireWritable(checkpointPath(checkpoints, firstFrame));
+    if (dump) io::requireWritable(*dump);
+    if (trace) io::requireWritable(*trace);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitUsage;
   }
   std::vector<std::pair<std::int64_t, std::uint64_t>> tickHashes;
   if (trace) {
@@ -260,18 +270,15 @@ int runCommand(Arguments& args) {
       tickHashes.emplace_back(s.tickCount(), stateHash(s.pool()));
     });
   }
-  if (!formats.empty()) std::filesystem::create_directories(outDir);
-  if (every > 0) std::filesystem::create_directories(checkpoints);
 
   const auto wallStart = std::chrono::steady_clock::now();
   ProgressLine progress;
-  Flicks elapsed = resumedAt;
-  std::int64_t ticksDropped = 0;
-  const auto frameCount = static_cast<std::int64_t>(plan.frames.size());
-  for (std::int64_t f = firstFrame; f <= frameCount; ++f) {
-    const Flicks duration = plan.frames[static_cast<std::size_t>(f - 1)];
-    ticksDropped += system->advance(duration).ticksDropped;
-    elapsed += duration;
+  std::int64_t lastFrame = firstFrame - 1;
+  while (const std::optional<Flicks> duration = schedule.next()) {
+    const std::int64_t f = schedule.framesDone();
+    system->advance(*duration);
+    elapsed += *duration;
+    lastFrame = f;
     if (!formats.empty()) {
       const io::FrameData data = io::captureFrame(*system, f, secondsFromFlicks(elapsed));
       for (io::CacheFormat fmt : formats) {
@@ -285,13 +292,16 @@ int runCommand(Arguments& args) {
       io::writeCheckpoint(checkpointPath(checkpoints, f), *system,
                           io::CheckpointInfo{effectHash, f, elapsed});
     }
-    progress.update(f, frameCount, secondsFromFlicks(elapsed), system->pool().size());
+    progress.update(f, secondsFromFlicks(elapsed), secondsFromFlicks(schedule.total()),
+                    system->pool().size());
   }
   progress.finish();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
 
-  if (dump) io::writeStateDump(system->pool(), *dump);
+  // The dump shows the run's end time, as the last cache frame does.
+  if (dump)
+    io::writeStateDump(io::captureFrame(*system, lastFrame, secondsFromFlicks(elapsed)), *dump);
   if (trace) {
     io::writeFileAtomically(*trace, [&](std::ostream& os) {
       os << "tick,state_hash\n";
@@ -300,21 +310,18 @@ int runCommand(Arguments& args) {
   }
   const ParticlePool& pool = system->pool();
   if (!quiet) {
-    std::printf("%s: %lld ticks at %lld Hz (%s), %lld frames %s, %.6g s simulated\n",
-                effectPath.c_str(), static_cast<long long>(system->tickCount()),
+    std::printf("%s: %lld frames %s, %.6g s simulated (%lld ticks at %lld Hz, %s)\n",
+                effectPath.c_str(), static_cast<long long>(lastFrame), plan->description.c_str(),
+                secondsFromFlicks(elapsed), static_cast<long long>(system->tickCount()),
                 static_cast<long long>(effect.simulation.stepRateHz),
-                effect.simulation.integrator.c_str(), static_cast<long long>(frameCount),
-                plan.description.c_str(), secondsFromFlicks(elapsed));
+                effect.simulation.integrator.c_str());
     std::printf("particles alive: %zu (emitted %llu, refused by max_particles: %llu)\n",
                 pool.size(), static_cast<unsigned long long>(pool.nextId() + pool.droppedSpawns()),
                 static_cast<unsigned long long>(pool.droppedSpawns()));
-    std::printf("ticks dropped by the cap (max_ticks_per_frame = %lld): %lld\n",
-                static_cast<long long>(effect.simulation.maxTicksPerFrame),
-                static_cast<long long>(ticksDropped));
     std::printf("wall time: %.3f s\n", wall);
-    if (!formats.empty() && frameCount > 0) {
-      std::printf("caches: %s (frame_0001 to frame_%04lld)\n", outDir.string().c_str(),
-                  static_cast<long long>(frameCount));
+    if (!formats.empty() && lastFrame >= firstFrame) {
+      std::printf("caches: %s (frame_%04lld to frame_%04lld)\n", outDir.string().c_str(),
+                  static_cast<long long>(firstFrame), static_cast<long long>(lastFrame));
     }
     if (dump) std::printf("state dump: %s\n", dump->c_str());
   }

@@ -1,8 +1,12 @@
 #include "io/AtomicFile.h"
 
 #include <unistd.h>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
+#include <string>
 #include <system_error>
 
 namespace tickfx::io {
@@ -31,6 +35,22 @@ void writeFileAtomicallyByName(const std::filesystem::path& path,
     std::filesystem::remove(temp, ignored);
     throw;
   }
+}
+
+void requireWritable(const std::filesystem::path& path) {
+  auto fail = [&](const std::string& why) {
+    throw std::runtime_error(path.string() + ": error: cannot write (" + why + ")");
+  };
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) fail("it is a directory");
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
+  if (!std::filesystem::is_directory(dir, ec)) fail("no directory " + dir.string());
+  // The writers create a temporary beside the file and rename it: try exactly that permission.
+  std::string probe = (dir / ".tickfx-probe-XXXXXX").string();
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) fail(std::strerror(errno));
+  ::close(fd);
+  std::filesystem::remove(probe, ec);
 }
 
 }  // namespace tickfx::io

@@ -18,4 +18,9 @@ void writeFileAtomically(const std::filesystem::path& path,
 void writeFileAtomicallyByName(const std::filesystem::path& path,
                                const std::function<void(const std::filesystem::path&)>& write);
 
+/// Checks, before anything is written, that `path` could be written atomically: its folder
+/// exists and takes a new file, and `path` is not a folder. Throws std::runtime_error
+/// "PATH: error: cannot write (REASON)" otherwise; leaves nothing behind.
+void requireWritable(const std::filesystem::path& path);
+
 }  // namespace tickfx::io

@@ -1,5 +1,6 @@
 #include "io/EffectBuilder.h"
 
+#include <limits>
 #include <stdexcept>
 
 #include "fields/AnchorSpring.h"
@@ -80,6 +81,13 @@ std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
   }
   return std::make_unique<ParticleSystem>(settings, effect.emitters, std::move(forces),
                                           effect.structures);
+}
+
+std::unique_ptr<ParticleSystem> buildOfflineSystem(const EffectSettings& effect,
+                                                   std::optional<int> threadsOverride) {
+  EffectSettings offline = effect;
+  offline.simulation.maxTicksPerFrame = std::numeric_limits<std::int64_t>::max();
+  return buildSystem(offline, threadsOverride);
 }
 
 }  // namespace tickfx::io

@@ -41,4 +41,9 @@ ForceSet buildForces(const std::vector<ForceSettings>& forces);
 std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
                                             std::optional<int> threadsOverride = std::nullopt);
 
+/// buildSystem() for an offline run (caches, determinism checks): no wall clock to keep up with,
+/// so max_ticks_per_frame is lifted and every tick a frame covers runs.
+std::unique_ptr<ParticleSystem> buildOfflineSystem(const EffectSettings& effect,
+                                                   std::optional<int> threadsOverride);
+
 }  // namespace tickfx::io

@@ -72,6 +72,29 @@ void lintWind(const EffectSettings& effect, const WindSettings& wind, const std:
                   " Hz wind (use a step_rate of at least " + std::to_string(needed) + " Hz)"));
 }
 
+// A real-time host that advances the effect at its output fps runs up to ⌈H / fps⌉ ticks a frame;
+// past max_ticks_per_frame it drops ticks (`tickfx run` never does: it lifts the cap).
+void lintTickCap(const EffectSettings& effect, std::vector<Diagnostic>& out) {
+  const SystemSettings& sim = effect.simulation;
+  const FrameRate fps = effect.output.fps;
+  const __int128 perFrame = static_cast<__int128>(sim.stepRateHz) * fps.denominator;
+  const auto needed = static_cast<std::int64_t>((perFrame + fps.numerator - 1) / fps.numerator);
+  if (needed <= sim.maxTicksPerFrame) return;
+  const auto fastest = static_cast<std::int64_t>(static_cast<__int128>(sim.maxTicksPerFrame) *
+                                                 fps.numerator / fps.denominator);
+  const std::string rate = std::to_string(fps.numerator) +
+                           (fps.denominator == 1 ? "" : "/" + std::to_string(fps.denominator));
+  out.push_back(warning(
+      effect, "simulation.max_ticks_per_frame",
+      "a real-time host advancing at the output's " + rate + " fps needs up to " +
+          std::to_string(needed) + " ticks a frame at " + std::to_string(sim.stepRateHz) +
+          " Hz, more than max_ticks_per_frame = " + std::to_string(sim.maxTicksPerFrame) +
+          ", and would drop ticks (`tickfx run` runs them all; use a max_ticks_per_frame of at "
+          "least " +
+          std::to_string(needed) + " or a step_rate of at most " + std::to_string(fastest) +
+          " Hz)"));
+}
+
 // A vector field, loaded (or baked) as the builder will: a file that will not load, and a field
 // that carries particles across more than a voxel a step (drag and advect modes: the particles
 // follow the field's velocity, so a step longer than a voxel skips its structure, the CFL
@@ -346,6 +369,7 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet*
     }
   }
   lintStructures(effect, out);
+  lintTickCap(effect, out);
   sortDiagnostics(out);
   return out;
 }

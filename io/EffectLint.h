@@ -73,6 +73,9 @@ StructureStiffness structureStiffness(const StructureSettings& structure);
 ///     largest |u| over all frames (times |scale| for advect) and h its voxel size, the CFL
 ///     condition of advection: a step_rate of at least ⌈speed / h⌉ Hz. Fields are loaded (or
 ///     baked) to know this, as the builder will load them.
+///   - output fps and step rate that need more ticks a frame than max_ticks_per_frame allows
+///     (⌈step_rate / fps⌉): what a real-time host advancing at that fps would drop. The fix:
+///     that many ticks a frame, or a step_rate of at most ⌊max_ticks_per_frame · fps⌋ Hz.
 /// An anchor spring's mass m is the lightest of the emitters' and the structures'.
 /// Positions come from effect.sources (the value's line, else its table's header).
 ///

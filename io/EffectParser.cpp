@@ -35,7 +35,6 @@ constexpr double kBig = 1e9;
 constexpr std::int64_t kMaxStepRate = 1'000'000;
 constexpr std::int64_t kMaxParticles = 1'000'000'000;
 constexpr std::int64_t kMaxTicksPerFrame = 100'000;
-constexpr std::int64_t kMaxThreads = 1024;
 constexpr std::size_t kMaxEntries = 10'000;  // emitters, forces
 constexpr std::size_t kMaxBursts = 100'000;  // per emitter
 constexpr std::int64_t kMaxFrameRatePart = 1'000'000;
@@ -1447,10 +1446,10 @@ void readFps(Context& cx, TableReader& r, OutputSettings& out) {
 void readOutput(Context& cx, const toml::table& table, OutputSettings& out) {
   TableReader r(cx, table, "output");
   readFps(cx, r, out);
-  const bool hasSeconds =
-      r.number("seconds", out.seconds, "seconds, a number > 0 and <= 1e9", Range{0.0, kBig, true});
+  const bool hasSeconds = r.number("seconds", out.seconds, "seconds, a number > 0 and <= 1e9",
+                                   Range{0.0, kMaxRunSeconds, true});
   std::int64_t frames = 0;
-  if (r.integer("frames", frames, "an integer from 1 to 1000000000", 1, 1'000'000'000)) {
+  if (r.integer("frames", frames, "an integer from 1 to 1000000000", 1, kMaxRunFrames)) {
     if (hasSeconds || table.get("seconds") != nullptr) {
       cx.error(cx.at(*table.get("frames")), r.pathOf("frames"),
                "given together with output.seconds (expected either seconds or frames)");

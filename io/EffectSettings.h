@@ -140,6 +140,11 @@ std::string_view cacheFormatName(CacheFormat format);
 /// The format called `name` (as cacheFormatName gives it), or nothing.
 std::optional<CacheFormat> cacheFormatFromName(std::string_view name);
 
+/// Limits of a run, the same in effect files and on the command line.
+inline constexpr double kMaxRunSeconds = 1e9;
+inline constexpr std::int64_t kMaxRunFrames = 1'000'000'000;
+inline constexpr std::int64_t kMaxThreads = 1024;
+
 /// The [output] table: what `tickfx run` writes.
 struct OutputSettings {
   FrameRate fps{24, 1};  // frames per second, an exact ratio

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/EffectSettings.h"
 #include "particles/Random.h"
 
 namespace tickfx::io {
@@ -35,32 +36,78 @@ FrameRate parseFrameRate(std::string_view text) {
   return rate;
 }
 
-std::vector<Flicks> fixedRateFrames(FrameRate rate, Flicks total) {
-  const Flicks frame = frameDuration(rate);
-  std::vector<Flicks> frames(static_cast<std::size_t>(total / frame), frame);
-  if (total % frame != 0) frames.push_back(total % frame);
+Flicks lengthOfFrames(FrameRate rate, std::int64_t count, const std::string& what) {
+  const __int128 length =
+      static_cast<__int128>(frameDuration(rate)) * std::max<std::int64_t>(count, 0);
+  if (length > static_cast<__int128>(kMaxRunSeconds) * kFlicksPerSecond) {
+    throw std::runtime_error(what + ": " + std::to_string(count) +
+                             " frames last longer than 1e9 s (the longest run)");
+  }
+  return static_cast<Flicks>(length);
+}
+
+FrameSchedule FrameSchedule::fixedRate(FrameRate rate, Flicks total) {
+  FrameSchedule s(Kind::Fixed, total);
+  s.frame_ = frameDuration(rate);
+  return s;
+}
+
+FrameSchedule FrameSchedule::jittered(std::uint64_t seed, Flicks total) {
+  FrameSchedule s(Kind::Jittered, total);
+  s.seed_ = seed;
+  return s;
+}
+
+FrameSchedule FrameSchedule::recorded(std::vector<Flicks> frames) {
+  Flicks total = 0;
+  for (Flicks f : frames) total += f;
+  FrameSchedule s(Kind::Recorded, total);
+  s.list_ = std::move(frames);
+  return s;
+}
+
+std::optional<Flicks> FrameSchedule::next() {
+  Flicks d = 0;
+  if (kind_ == Kind::Recorded) {
+    if (index_ == static_cast<std::int64_t>(list_.size())) return std::nullopt;
+    d = list_[static_cast<std::size_t>(index_)];
+  } else {
+    if (elapsed_ >= total_) return std::nullopt;
+    if (kind_ == Kind::Fixed) {
+      d = frame_;
+    } else {
+      constexpr Flicks kShortest = kFlicksPerSecond / 240;
+      constexpr Flicks kLongest = kFlicksPerSecond / 10;
+      // The frame index is the serial: the sequence is a pure function of the seed, like
+      // emission.
+      const std::uint64_t bits =
+          randomBits(RandomKey{seed_, 0xF4A3E5u, static_cast<std::uint64_t>(index_), 0});
+      d = kShortest +
+          static_cast<Flicks>(bits % static_cast<std::uint64_t>(kLongest - kShortest + 1));
+    }
+    d = std::min(d, total_ - elapsed_);
+  }
+  elapsed_ += d;
+  ++index_;
+  return d;
+}
+
+namespace {
+
+std::vector<Flicks> allFrames(FrameSchedule schedule) {
+  std::vector<Flicks> frames;
+  while (const std::optional<Flicks> d = schedule.next()) frames.push_back(*d);
   return frames;
 }
 
-std::vector<Flicks> fixedRateFrameCount(FrameRate rate, std::int64_t count) {
-  return std::vector<Flicks>(static_cast<std::size_t>(std::max<std::int64_t>(count, 0)),
-                             frameDuration(rate));
+}  // namespace
+
+std::vector<Flicks> fixedRateFrames(FrameRate rate, Flicks total) {
+  return allFrames(FrameSchedule::fixedRate(rate, total));
 }
 
 std::vector<Flicks> jitteredFrames(std::uint64_t seed, Flicks total) {
-  constexpr Flicks kShortest = kFlicksPerSecond / 240;
-  constexpr Flicks kLongest = kFlicksPerSecond / 10;
-  std::vector<Flicks> frames;
-  Flicks sum = 0;
-  for (std::uint64_t i = 0; sum < total; ++i) {
-    // The frame index is the serial: the sequence is a pure function of the seed, like emission.
-    const std::uint64_t bits = randomBits(RandomKey{seed, 0xF4A3E5u, i, 0});
-    const Flicks d = kShortest + static_cast<Flicks>(
-                                     bits % static_cast<std::uint64_t>(kLongest - kShortest + 1));
-    frames.push_back(std::min(d, total - sum));
-    sum += frames.back();
-  }
-  return frames;
+  return allFrames(FrameSchedule::jittered(seed, total));
 }
 
 std::vector<Flicks> readFrameTimes(const std::filesystem::path& path) {

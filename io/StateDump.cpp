@@ -6,18 +6,19 @@
 
 namespace tickfx::io {
 
-void writeStateDump(const ParticlePool& pool, const std::filesystem::path& path) {
+void writeStateDump(const FrameData& frame, const std::filesystem::path& path) {
   writeFileAtomically(path, [&](std::ostream& out) {
     out << "id,px,py,pz,vx,vy,vz,age\n";
     char line[320];
-    for (std::size_t i = 0; i < pool.size(); ++i) {
+    const Vec3Column& p = frame.position;
+    const Vec3Column& v = frame.velocity;
+    for (std::size_t i = 0; i < frame.size(); ++i) {
       const auto r = static_cast<Eigen::Index>(i);
-      std::snprintf(
-          line, sizeof line, "%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-          static_cast<unsigned long long>(pool.id()[i]), static_cast<double>(pool.position().x[r]),
-          static_cast<double>(pool.position().y[r]), static_cast<double>(pool.position().z[r]),
-          static_cast<double>(pool.velocity().x[r]), static_cast<double>(pool.velocity().y[r]),
-          static_cast<double>(pool.velocity().z[r]), static_cast<double>(pool.age()[r]));
+      std::snprintf(line, sizeof line, "%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+                    static_cast<unsigned long long>(frame.id[i]), static_cast<double>(p.x[r]),
+                    static_cast<double>(p.y[r]), static_cast<double>(p.z[r]),
+                    static_cast<double>(v.x[r]), static_cast<double>(v.y[r]),
+                    static_cast<double>(v.z[r]), static_cast<double>(frame.age[r]));
       out << line;
     }
   });

@@ -1,6 +1,8 @@
 // `tickfx run`, `check` and `study` as processes: exit codes, output, and files written or not.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -59,7 +61,9 @@ TEST_F(Cli, RunWritesOneCachePerFrameAndReportsTheHash) {
   EXPECT_TRUE(fs::exists(path("c/frame_0024.csv")));
   EXPECT_TRUE(fs::exists(path("c/frame_0024.ply")));
   EXPECT_FALSE(fs::exists(path("c/frame_0025.csv")));
-  EXPECT_NE(r.out.find("ticks dropped by the cap (max_ticks_per_frame = 16): 0"), std::string::npos)
+  EXPECT_NE(r.out.find("samples/fountain.toml: 24 frames at 24 fps, 1 s simulated (120 ticks at "
+                       "120 Hz, semi_implicit_euler)"),
+            std::string::npos)
       << r.out;
   EXPECT_EQ(r.err.find('\r'), std::string::npos)
       << "no progress line when stderr is not a terminal";
@@ -189,10 +193,126 @@ TEST_F(Cli, UsageErrorsExitTwoAndWriteNothing) {
 }
 
 TEST_F(Cli, FailureAtRunTimeExitsOne) {
-  writeFile("occupied", "a file where the cache folder should go");
-  const Result r = run("run samples/fountain.toml --frames 2 --out " + path("occupied"));
+  // The second frame's cache cannot be written (a folder holds its name): found only then.
+  fs::create_directories(path("c/frame_0002.csv"));
+  const Result r = run("run samples/fountain.toml --frames 2 --out " + path("c"));
   EXPECT_EQ(r.exit, 1) << r.err;
   EXPECT_NE(r.err.find("error:"), std::string::npos);
+  EXPECT_TRUE(fs::exists(path("c/frame_0001.csv")));
+}
+
+// ---- issue 10: what a run simulates and shows ------------------------------------------------
+
+// Regression (item 0): the cap (max_ticks_per_frame = 16) dropped 1232 of 2000 ticks of an
+// offline run and the summary still said 2 s. An offline run now runs every tick its frames
+// cover: the same state as frames that never reach the cap.
+TEST_F(Cli, AnOfflineRunSimulatesEveryTickItsFramesCover) {
+  const std::string effect =
+      "run samples/fountain.toml --set simulation.step_rate=1000 --seconds 2 "
+      "--format none --hash";
+  const Result at24 = run(effect + " --fps 24");
+  ASSERT_EQ(at24.exit, 0) << at24.err;
+  EXPECT_NE(at24.out.find("48 frames at 24 fps, 2 s simulated (2000 ticks at 1000 Hz"),
+            std::string::npos)
+      << at24.out;
+  EXPECT_EQ(hashOf(at24).substr(17), "2000");
+  EXPECT_EQ(hashOf(at24), hashOf(run(effect + " --fps 250")));  // 4 ticks a frame
+  EXPECT_EQ(hashOf(at24), hashOf(run(effect + " --fps 2")));    // 500 ticks a frame
+  // `check` names what a real-time host at the output's 24 fps would drop.
+  const Result check = run("check samples/fountain.toml --set simulation.step_rate=1000");
+  EXPECT_EQ(check.exit, 0);
+  EXPECT_NE(check.err.find(
+                "warning: simulation.max_ticks_per_frame: a real-time host advancing at the "
+                "output's 24 fps needs up to 42 ticks a frame at 1000 Hz, more than "
+                "max_ticks_per_frame = 16, and would drop ticks (`tickfx run` runs them all; use a "
+                "max_ticks_per_frame of at least 42 or a step_rate of at most 384 Hz)"),
+            std::string::npos)
+      << check.err;
+  EXPECT_NE(check.out.find("ok, 1 warning(s)"), std::string::npos) << check.out;
+}
+
+// Regression (item 3): --fps alone replayed the file's frame count at the new rate (--fps 60
+// simulated 2 s of the fountain's 5, --fps 1 simulated 120 s).
+TEST_F(Cli, FpsAloneKeepsTheEffectsLength) {
+  for (const auto& [fps, frames] : std::vector<std::pair<std::string, std::string>>{
+           {"60", "300"}, {"1", "5"}, {"30000/1001", "150"}, {"24", "120"}}) {
+    const Result r = run("run samples/fountain.toml --format none --hash --fps " + fps);
+    ASSERT_EQ(r.exit, 0) << r.err;
+    EXPECT_NE(r.out.find(": " + frames + " frames at " + fps + " fps, 5 s simulated"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(hashOf(r).substr(17), "600") << fps << " fps: 5 s at 120 Hz";
+  }
+}
+
+// Regression (item 2): frame 1 at 50 fps held the state of tick 2 (x = 0.01167 m) where the
+// particle is at 0.02 m, and at 24 fps its position was a tick older than its age. The dump, like
+// every cache, shows the state at the frame's own time.
+TEST_F(Cli, ADumpShowsTheStateAtTheEndTime) {
+  const std::string effect =
+      writeFile("line.toml",
+                "format_version = 1\n[simulation]\nstep_rate = 120\n[[emitters]]\n"
+                "bursts = [{ time = 0.0, count = 1 }]\ndirection = [1, 0, 0]\nspeed = 1.0\n");
+  for (const auto& [fps, seconds, x] : std::vector<std::tuple<std::string, std::string, float>>{
+           {"50", "0.02", 0.02f}, {"24", "0.041666666666666667", 1.0f / 24.0f}}) {
+    const Result r = run("run " + effect + " --format none --fps " + fps + " --seconds " + seconds +
+                         " --dump " + path("d.csv"));
+    ASSERT_EQ(r.exit, 0) << r.err;
+    std::ifstream in(path("d.csv"));
+    std::string header, row;
+    std::getline(in, header);
+    std::getline(in, row);
+    float px = 0, age = 0;
+    ASSERT_EQ(std::sscanf(row.c_str(), "0,%g,%*g,%*g,%*g,%*g,%*g,%g", &px, &age), 2) << row;
+    EXPECT_NEAR(px, x, 2e-7f) << fps << " fps";
+    EXPECT_NEAR(age, x, 2e-7f) << "position and age at one time, " << fps << " fps";
+  }
+}
+
+// Regressions (items 10 and 11): output.seconds = 10⁹ built the whole list of frames first (192
+// GB), and an unwritable --dump was found after every cache had been written. Now every output path
+// is checked before the first tick, and frames are made as they are needed.
+TEST_F(Cli, OutputPathsAreCheckedBeforeTheFirstTick) {
+  const Result dump = run("run samples/fountain.toml --set output.seconds=1e9 --out " + path("c") +
+                          " --dump " + path("no/such/dir/d.csv"));
+  EXPECT_EQ(dump.exit, 2);
+  EXPECT_NE(dump.err.find(path("no/such/dir/d.csv") + ": error: cannot write (no directory " +
+                          path("no/such/dir") + ")"),
+            std::string::npos)
+      << dump.err;
+  EXPECT_FALSE(fs::exists(path("c/frame_0001.csv"))) << "nothing written";
+  const Result trace = run("run samples/fountain.toml --frames 3 --out " + path("c") + " --trace " +
+                           path("c"));  // a folder
+  EXPECT_EQ(trace.exit, 2);
+  EXPECT_NE(trace.err.find(path("c") + ": error: cannot write (it is a directory)"),
+            std::string::npos)
+      << trace.err;
+  EXPECT_FALSE(fs::exists(path("c/frame_0001.csv")));
+}
+
+// Regression (item 12): --threads stopped at 256 and --seconds at 10⁶ where effect files allow
+// 1024 threads and 10⁹ s; a resumed run's summary named frames it did not write.
+TEST_F(Cli, CommandLineLimitsAgreeWithTheEffectFile) {
+  const Result threads = run("run samples/fountain.toml --threads 1025 --format none");
+  EXPECT_EQ(threads.exit, 2);
+  EXPECT_NE(threads.err.find("run: --threads: '1025' is not a whole number in [0, 1024]"),
+            std::string::npos)
+      << threads.err;
+  const Result seconds = run("run samples/fountain.toml --seconds 2e9 --format none");
+  EXPECT_EQ(seconds.exit, 2);
+  EXPECT_NE(seconds.err.find("run: --seconds: '2e9' is not a number in [0, 1e+09]"),
+            std::string::npos)
+      << seconds.err;
+  ASSERT_EQ(run("run samples/smoke_drift.toml --frames 12 --format none --checkpoint-every 6 "
+                "--checkpoint-dir " +
+                path("ck"))
+                .exit,
+            0);
+  const Result resumed = run("run samples/smoke_drift.toml --frames 12 --format csv --out " +
+                             path("c") + " --resume " + path("ck/checkpoint_000006.tfxc"));
+  ASSERT_EQ(resumed.exit, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find("(frame_0007 to frame_0012)"), std::string::npos) << resumed.out;
+  EXPECT_FALSE(fs::exists(path("c/frame_0006.csv")));
 }
 
 TEST_F(Cli, DeterminismPrintsTheTableAndAVerdict) {

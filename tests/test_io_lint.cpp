@@ -124,7 +124,11 @@ TEST(ioLint, ExplicitEulerSpringGainsEnergy) {
   // Already fast enough for 1 % over the output: the warning keeps the other fixes only.
   EXPECT_EQ(
       warnings(springEffect("explicit_euler", 2000, 1.0)),
-      (Lines{"lint.toml:11:13: warning: forces.0.stiffness: explicit_euler adds energy to this "
+      (Lines{"lint.toml:2:1: warning: simulation.max_ticks_per_frame: a real-time host advancing "
+             "at the output's 24 fps needs up to 84 ticks a frame at 2000 Hz, more than "
+             "max_ticks_per_frame = 16, and would drop ticks (`tickfx run` runs them all; use a "
+             "max_ticks_per_frame of at least 84 or a step_rate of at most 384 Hz)",
+             "lint.toml:11:13: warning: forces.0.stiffness: explicit_euler adds energy to this "
              "spring every step (x1.00000025 per step, x1.01 over the 10 s of output) (use "
              "semi_implicit_euler, position_verlet or velocity_verlet, damping of at least "
              "0.0005 N·s/m (k·dt))"}));

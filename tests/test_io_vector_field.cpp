@@ -509,8 +509,10 @@ TEST_F(ioVectorField, LintWarnsAboutAFileThatDoesNotLoad) {
 // A uniform field of `speed` m/s baked at voxel size `h` in mode `mode` at `rate` Hz.
 std::string cflEffect(const std::string& mode, double speed, double h, int rate,
                       double scale = 1.0) {
+  // A cap no CFL case reaches: the lint's tick-cap warning is not what these tests are about.
   return "format_version = 1\n[simulation]\nstep_rate = " + std::to_string(rate) +
-         "\n[[emitters]]\nbursts = [{ time = 0.0, count = 1 }]\n[[forces]]\ntype = "
+         "\nmax_ticks_per_frame = 100000\n[[emitters]]\nbursts = [{ time = 0.0, count = 1 "
+         "}]\n[[forces]]\ntype = "
          "\"vector_field\"\nmode = \"" +
          mode + "\"\nscale = " + std::to_string(scale) +
          "\nbake = { kind = \"uniform\", velocity = [0, " + std::to_string(speed) +
@@ -520,18 +522,18 @@ std::string cflEffect(const std::string& mode, double speed, double h, int rate,
 TEST(ioVectorFieldLint, CflNamesTheStepRateThatKeepsAStepWithinAVoxel) {
   // Advection: 12 m/s at 60 Hz is 0.2 m a step through voxels of 0.1 m: 120 Hz is the fix.
   EXPECT_EQ(lint(load(cflEffect("advect", 12.0, 0.1, 60))),
-            (Lines{"fx.toml:6:1: warning: forces.0: the field carries particles up to 12 m/s, "
+            (Lines{"fx.toml:7:1: warning: forces.0: the field carries particles up to 12 m/s, "
                    "12·dt = 0.2 m a step, more than a voxel (0.1 m) (use a step_rate of at least "
                    "120 Hz)"}));
   EXPECT_TRUE(lint(load(cflEffect("advect", 12.0, 0.1, 120))).empty());  // exactly a voxel
   // Advection's speed is scaled, whatever the scale's sign.
   EXPECT_EQ(lint(load(cflEffect("advect", 3.0, 0.125, 24, -2.0))),
-            (Lines{"fx.toml:6:1: warning: forces.0: the field carries particles up to 6 m/s, "
+            (Lines{"fx.toml:7:1: warning: forces.0: the field carries particles up to 6 m/s, "
                    "6·dt = 0.25 m a step, more than a voxel (0.125 m) (use a step_rate of at least "
                    "48 Hz)"}));
   // Drag pulls toward the field's own velocity: its scale is a rate, not a speed.
   EXPECT_EQ(lint(load(cflEffect("drag", 7.0, 0.1, 60, 5.0))),
-            (Lines{"fx.toml:6:1: warning: forces.0: the field carries particles up to 7 m/s, "
+            (Lines{"fx.toml:7:1: warning: forces.0: the field carries particles up to 7 m/s, "
                    "7·dt = 0.1167 m a step, more than a voxel (0.1 m) (use a step_rate of at least "
                    "70 Hz)"}));
   EXPECT_TRUE(lint(load(cflEffect("drag", 7.0, 0.1, 70, 5.0))).empty());
