@@ -193,7 +193,8 @@ int main(int argc, char** argv) {
     arena.execute([&] {
       for (std::int64_t i = 0; i < ticks; ++i) {
         const tickfx::ForceInput in{evalPool, tickfx::Vec3View::of(evalPool.position()),
-                                    tickfx::Vec3View::of(evalPool.velocity()), 0.0, 1};
+                                    tickfx::Vec3View::of(evalPool.velocity()),
+                                    tickfx::TickInstant{1, 0, 60}};
         tickfx::parallelForRows(particles, [&](std::size_t b, std::size_t e) {
           tickfx::Vec3Rows a = tickfx::Vec3Rows::of(acceleration, tickfx::RowRange{b, e});
           evalForces.evaluate(in, tickfx::RowRange{b, e}, a);

@@ -133,7 +133,7 @@ void AnalyticForce::add(const ForceInput& in, RowRange rows, Vec3Rows& a) const 
   for (Eigen::Index j = 0; j < rows.count(); ++j) {
     // float → double widening is exact; the field value is rounded to float once.
     const Eigen::Vector3d x(p.x[j], p.y[j], p.z[j]);
-    const Eigen::Vector3f u = field_.at(x, in.time).cast<float>();
+    const Eigen::Vector3f u = field_.at(x, in.time()).cast<float>();
     if (mode_ != Mode::Drag) {
       a.x[j] += gain_ * u.x();
       a.y[j] += gain_ * u.y();

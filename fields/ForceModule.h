@@ -64,15 +64,31 @@ struct Vec3View {
   }
 };
 
+/// An instant of a tick in integers: `halves` half-steps (0, 1 or 2: t, t + dt/2, t + dt, the
+/// times the integrators' stages are at) past tick `tick` at `stepRateHz`. Modules that must place
+/// the time exactly (a field sequence's frame) use the integers; the rest seconds().
+struct TickInstant {
+  std::int64_t tick = 0;
+  int halves = 0;
+  std::int64_t stepRateHz = 60;
+
+  /// (tick + halves/2) / stepRateHz seconds, rounded once from exact operands.
+  double seconds() const {
+    return (static_cast<double>(tick) + 0.5 * halves) / static_cast<double>(stepRateHz);
+  }
+};
+
 /// The state at which an integrator asks for accelerations: the pool's own columns or an
 /// integrator's stage values (RK4's midpoints). Everything else (mass, ids, attributes) comes
 /// from `pool`, indexed by pool row.
 struct ForceInput {
   const ParticlePool& pool;
-  Vec3View position;      // metres
-  Vec3View velocity;      // metres per second
-  double time = 0.0;      // seconds since tick 0, for the stage asked (t, t + dt/2, t + dt)
-  std::int64_t tick = 0;  // the tick being integrated
+  Vec3View position;  // metres
+  Vec3View velocity;  // metres per second
+  TickInstant at;     // the stage asked (t, t + dt/2, t + dt) of the tick being integrated
+
+  /// Seconds since tick 0 at the stage asked.
+  double time() const { return at.seconds(); }
 };
 
 /// A force module adds acceleration (m/s²) to particles. Modules are composed in an ordered list
@@ -118,10 +134,10 @@ class ForceModule {
   virtual void accumulateVelocity(const ForceInput& /*in*/, RowRange /*rows*/,
                                   Vec3Rows& /*velocity*/) const {}
 
-  /// Called once per tick after the step, with the state at the end of the tick (`time` =
-  /// (tick + 1)/rate seconds): a module may flag particles dead here (a field's kill region).
+  /// Called once per tick after the step, with the state at the end of the tick (`end` is
+  /// the tick's instant t + dt): a module may flag particles dead here (a field's kill region).
   /// The pool removes them before the next tick. Must give the same flags on any thread count.
-  virtual void endTick(ParticlePool& /*pool*/, std::int64_t /*tick*/, double /*time*/) {}
+  virtual void endTick(ParticlePool& /*pool*/, const TickInstant& /*end*/) {}
 };
 
 }  // namespace tickfx

@@ -72,8 +72,8 @@ void ForceSet::evaluateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& v
   if (anyPinned_) holdPinned(in, rows, velocity);
 }
 
-void ForceSet::endTick(ParticlePool& pool, std::int64_t tick, double time) {
-  for (auto& m : modules_) m->endTick(pool, tick, time);
+void ForceSet::endTick(ParticlePool& pool, const TickInstant& end) {
+  for (auto& m : modules_) m->endTick(pool, end);
 }
 
 }  // namespace tickfx

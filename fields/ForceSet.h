@@ -44,7 +44,7 @@ class ForceSet {
   void evaluateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const;
 
   /// Once per tick after the step: the modules' endTick, in order (see ForceModule::endTick).
-  void endTick(ParticlePool& pool, std::int64_t tick, double time);
+  void endTick(ParticlePool& pool, const TickInstant& end);
 
  private:
   std::vector<std::unique_ptr<ForceModule>> modules_;

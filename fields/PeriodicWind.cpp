@@ -21,13 +21,13 @@ float PeriodicWind::strength(double t) const {
 }
 
 bool PeriodicWind::uniformAcceleration(const ForceInput& in, Eigen::Vector3f& a) const {
-  const float w = strength(in.time);
+  const float w = strength(in.time());
   a = Eigen::Vector3f(s_.direction.x() * w, s_.direction.y() * w, s_.direction.z() * w);
   return true;
 }
 
 void PeriodicWind::accumulate(const ForceInput& in, RowRange /*rows*/, Vec3Rows& a) const {
-  const float w = strength(in.time);
+  const float w = strength(in.time());
   a.x += s_.direction.x() * w;
   a.y += s_.direction.y() * w;
   a.z += s_.direction.z() * w;

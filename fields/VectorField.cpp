@@ -2,6 +2,7 @@
 
 #include "fields/VdbGridFile.h"
 #include "fields/VectorFieldGrids.h"
+#include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
 
 #include <openvdb/openvdb.h>
@@ -13,6 +14,8 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace tickfx {
@@ -83,16 +86,18 @@ struct LeafBoxSampler {
 
 /// The grids, their precision hidden behind one virtual call per accumulate().
 struct VectorField::Impl {
+  using Frames = VectorField::Frames;
   virtual ~Impl() = default;
-  /// Adds the module's contribution (mode and scale applied) for `rows` to `out`.
-  virtual void accumulate(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
-                          Vec3Rows& out) const = 0;
-  /// The field at `world` and time `t`, after the outside policy, before scale.
-  virtual Eigen::Vector3f sample(const VectorField::Settings& s, const Eigen::Vector3d& world,
-                                 double t) const = 0;
-  /// dead[row] = 1 for the rows of `rows` outside the active voxels of the frame at or before
-  /// in.time.
-  virtual void flagOutside(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
+  /// Adds the module's contribution (mode and scale applied) for `rows` to `out`, sampling
+  /// between `frames`.
+  virtual void accumulate(const VectorField::Settings& s, const Frames& frames,
+                          const ForceInput& in, RowRange rows, Vec3Rows& out) const = 0;
+  /// The field at `world` between `frames`, after the outside policy, before scale.
+  virtual Eigen::Vector3f sample(const VectorField::Settings& s, const Frames& frames,
+                                 const Eigen::Vector3d& world) const = 0;
+  /// dead[row] = 1 for the rows of `rows` outside the active voxels of frames.first (the frame
+  /// at or before the instant).
+  virtual void flagOutside(const Frames& frames, const ForceInput& in, RowRange rows,
                            std::uint8_t* dead) const = 0;
   std::string valueType;
   bool staggered = false;
@@ -145,41 +150,20 @@ struct ImplT final : VectorField::Impl {
     return toFloat(u);
   }
 
-  // The frames around `time` and the blend weight of the second: in double, rounded once.
-  struct Frames {
-    std::size_t first = 0, second = 0;
-    float w = 0.0f;
-  };
-  Frames framesAt(const VectorField::Settings& s, double time) const {
-    Frames f;
-    if (grids.size() < 2) return f;
-    const double x = time * s.fps;
-    const double last = static_cast<double>(grids.size() - 1);
-    if (x >= last) {
-      f.first = f.second = grids.size() - 1;
-    } else if (x > 0.0) {
-      const double base = std::floor(x);
-      f.first = static_cast<std::size_t>(base);
-      f.second = f.first + 1;
-      f.w = static_cast<float>(x - base);
-    }
-    return f;
-  }
-
   // The two frames' samplers for one call, and the sample at a world position, blended in time.
   template <class Sampler>
   struct Blend {
-    Blend(const ImplT& impl, const VectorField::Settings& s, double time)
-        : frames(impl.framesAt(s, time)),
+    Blend(const ImplT& impl, const VectorField::Settings& s, const Frames& at)
+        : frames(at),
           first(*impl.grids[frames.first]),
           second(*impl.grids[frames.second]),
-          blend(frames.second != frames.first && frames.w != 0.0f),
+          blend(frames.second != frames.first && frames.weight != 0.0f),
           zero(s.outside != VectorField::Outside::Background) {}
     Eigen::Vector3f operator()(const openvdb::Vec3d& world) {
       const Eigen::Vector3f u = at<Sampler>(first, world, zero);
       if (!blend) return u;
       const Eigen::Vector3f u1 = at<Sampler>(second, world, zero);
-      const float w = frames.w, one = 1.0f - w;
+      const float w = frames.weight, one = 1.0f - w;
       return {one * u.x() + w * u1.x(), one * u.y() + w * u1.y(), one * u.z() + w * u1.z()};
     }
     Frames frames;
@@ -188,9 +172,9 @@ struct ImplT final : VectorField::Impl {
   };
 
   template <class Sampler>
-  void add(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
-           Vec3Rows& out) const {
-    Blend<Sampler> field(*this, s, in.time);
+  void add(const VectorField::Settings& s, const Frames& frames, const ForceInput& in,
+           RowRange rows, Vec3Rows& out) const {
+    Blend<Sampler> field(*this, s, frames);
     const bool drag = s.mode == VectorField::Mode::Drag;
     const ConstVec3Rows p = in.position.rows(rows);
     const ConstVec3Rows v = in.velocity.rows(rows);
@@ -220,22 +204,22 @@ struct ImplT final : VectorField::Impl {
     return quadratic ? f(vt::QuadraticSampler{}) : f(LeafBoxSampler{});
   }
 
-  void accumulate(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
-                  Vec3Rows& out) const override {
-    withSampler(s, [&](auto sampler) { add<decltype(sampler)>(s, in, rows, out); });
+  void accumulate(const VectorField::Settings& s, const Frames& frames, const ForceInput& in,
+                  RowRange rows, Vec3Rows& out) const override {
+    withSampler(s, [&](auto sampler) { add<decltype(sampler)>(s, frames, in, rows, out); });
   }
 
-  Eigen::Vector3f sample(const VectorField::Settings& s, const Eigen::Vector3d& world,
-                         double t) const override {
+  Eigen::Vector3f sample(const VectorField::Settings& s, const Frames& frames,
+                         const Eigen::Vector3d& world) const override {
     return withSampler(s, [&](auto sampler) {
-      Blend<decltype(sampler)> field(*this, s, t);
+      Blend<decltype(sampler)> field(*this, s, frames);
       return field(openvdb::Vec3d(world.x(), world.y(), world.z()));
     });
   }
 
-  void flagOutside(const VectorField::Settings& s, const ForceInput& in, RowRange rows,
+  void flagOutside(const Frames& frames, const ForceInput& in, RowRange rows,
                    std::uint8_t* dead) const override {
-    Frame first(*grids[framesAt(s, in.time).first]);
+    Frame first(*grids[frames.first]);
     const ConstVec3Rows p = in.position.rows(rows);
     for (Eigen::Index j = 0; j < rows.count(); ++j) {
       const openvdb::Vec3d index = first.toIndex(openvdb::Vec3d(p.x[j], p.y[j], p.z[j]));
@@ -298,16 +282,71 @@ std::unique_ptr<const VectorField::Impl> makeImpl(const VectorField::Settings& s
 }
 
 int frameSpan(const VectorField::Settings& s) {
+  if (s.fps != 0.0 && !(s.fps >= 1e-6 && s.fps <= 1e6)) {
+    throw std::invalid_argument(s.file + ": a field sequence's fps must be from 1e-6 to 1e6");
+  }
   if (s.fps > 0.0 && s.lastFrame < s.firstFrame) {
     throw std::invalid_argument(s.file + ": a field sequence needs lastFrame >= firstFrame");
   }
   return s.fps > 0.0 ? s.lastFrame - s.firstFrame + 1 : 1;
 }
 
+// fps as numerator / 2^shift exactly: fps = m · 2^e with m < 2^53 (frexp and ldexp are exact),
+// and 1e-6 <= fps <= 1e6 keeps the shift below 73.
+std::pair<unsigned __int128, int> exactFps(double fps) {
+  if (!(fps > 0.0)) return {0, 0};
+  int e = 0;
+  const double m = std::frexp(fps, &e);
+  const auto numerator = static_cast<std::uint64_t>(std::ldexp(m, 53));
+  const int shift = 53 - e;
+  if (shift < 0) return {static_cast<unsigned __int128>(numerator) << -shift, 0};
+  return {numerator, shift};
+}
+
+}  // namespace
+
+VectorField::Frames VectorField::framesAt(const TickInstant& at) const {
+  Frames f;
+  const auto count = static_cast<std::size_t>(frameCount());
+  if (count < 2) return f;
+  // t·fps = (2·tick + halves) · numerator / (2·H · 2^shift): below 2^105 over below 2^94.
+  using u128 = unsigned __int128;
+  const u128 num = static_cast<u128>(2 * at.tick + at.halves) * fpsNumerator_;
+  const u128 den = static_cast<u128>(2 * at.stepRateHz) << fpsShift_;
+  const u128 base = num / den;
+  if (base >= count - 1) {
+    f.first = f.second = count - 1;
+  } else {
+    f.first = static_cast<std::size_t>(base);
+    f.second = f.first + 1;
+    f.weight = exact::fractionToFloat(num % den, den);
+  }
+  return f;
+}
+
+namespace {
+
+VectorField::Frames framesAtSeconds(const VectorField& field, double t) {
+  VectorField::Frames f;
+  const auto count = static_cast<std::size_t>(field.frameCount());
+  if (count < 2) return f;
+  const double x = t * field.settings().fps;
+  if (x >= static_cast<double>(count - 1)) {
+    f.first = f.second = count - 1;
+  } else if (x > 0.0) {
+    const double base = std::floor(x);
+    f.first = static_cast<std::size_t>(base);
+    f.second = f.first + 1;
+    f.weight = static_cast<float>(x - base);
+  }
+  return f;
+}
+
 }  // namespace
 
 VectorField::VectorField(const Settings& settings) : s_(settings) {
   const int frames = frameSpan(s_);
+  std::tie(fpsNumerator_, fpsShift_) = exactFps(s_.fps);
   if (s_.fps > 0.0 && s_.file.find("{frame}") == std::string::npos) {
     throw std::invalid_argument(s_.file + ": a field sequence needs {frame} in the file name");
   }
@@ -320,6 +359,7 @@ VectorField::VectorField(const Settings& settings) : s_(settings) {
 
 VectorField::VectorField(const Settings& settings, const Grids& grids) : s_(settings) {
   const int frames = frameSpan(s_);
+  std::tie(fpsNumerator_, fpsShift_) = exactFps(s_.fps);
   if (grids.grids.size() != static_cast<std::size_t>(frames)) {
     throw std::invalid_argument(s_.file + ": " + std::to_string(grids.grids.size()) +
                                 " grids given for " + std::to_string(frames) + " frames");
@@ -331,19 +371,18 @@ VectorField::~VectorField() = default;
 
 void VectorField::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
   if (s_.mode == Mode::Advect) return;  // prescribes velocity: ForceSet never asks
-  impl_->accumulate(s_, in, rows, acceleration);
+  impl_->accumulate(s_, framesAt(in.at), in, rows, acceleration);
 }
 
 void VectorField::accumulateVelocity(const ForceInput& in, RowRange rows,
                                      Vec3Rows& velocity) const {
   if (s_.mode != Mode::Advect) return;
-  impl_->accumulate(s_, in, rows, velocity);
+  impl_->accumulate(s_, framesAt(in.at), in, rows, velocity);
 }
 
-void VectorField::endTick(ParticlePool& pool, std::int64_t tick, double time) {
+void VectorField::endTick(ParticlePool& pool, const TickInstant& end) {
   if (s_.outside != Outside::Kill) return;
-  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), time,
-                      tick};
+  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), end};
   std::uint8_t* dead = pool.dead().data();
   parallelForRows(pool.size(), [&](std::size_t b, std::size_t e) {
     flagOutside(in, RowRange{b, e}, dead);
@@ -351,11 +390,11 @@ void VectorField::endTick(ParticlePool& pool, std::int64_t tick, double time) {
 }
 
 Eigen::Vector3f VectorField::sample(const Eigen::Vector3f& x, double t) const {
-  return impl_->sample(s_, x.cast<double>(), t);
+  return impl_->sample(s_, framesAtSeconds(*this, t), x.cast<double>());
 }
 
 void VectorField::flagOutside(const ForceInput& in, RowRange rows, std::uint8_t* dead) const {
-  impl_->flagOutside(s_, in, rows, dead);
+  impl_->flagOutside(framesAt(in.at), in, rows, dead);
 }
 
 const std::string& VectorField::valueType() const { return impl_->valueType; }

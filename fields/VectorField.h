@@ -37,7 +37,9 @@ std::string sequenceFramePath(const std::string& pattern, int frame, int padding
 /// Sequences: with `fps > 0`, `file` holds "{frame}", replaced by the frame number zero-padded
 /// to `framePadding` digits, for frames firstFrame..lastFrame (all loaded on construction).
 /// Frame f is at time (f − firstFrame)/fps seconds; between frames the two samples are
-/// interpolated linearly at in.time; before the first and after the last frame, clamped.
+/// interpolated linearly; before the first and after the last frame, clamped. The frames and the
+/// weight come from the integer tick clock (framesAt), with fps taken as the exact binary
+/// fraction it is: a tick on a frame's time samples that frame alone.
 ///
 /// Loading errors (missing file, missing grid, wrong value type, unreadable data) throw
 /// std::runtime_error naming the file and the grid. Thread safety: accumulate() builds its own
@@ -55,7 +57,7 @@ class VectorField final : public ForceModule {
     float scale = 1.0f;  // Force: unit of the field → m/s²; Drag: k in 1/s; Advect: unit → m/s
     Interpolation interpolation = Interpolation::Linear;
     Outside outside = Outside::Background;
-    // Sequences (fps > 0 only).
+    // Sequences (fps > 0 only; from 1e-6 to 1e6 frames a second).
     double fps = 0.0;
     int firstFrame = 0;
     int lastFrame = 0;
@@ -76,9 +78,19 @@ class VectorField final : public ForceModule {
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   bool prescribesVelocity() const override { return s_.mode == Mode::Advect; }
   void accumulateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const override;
-  void endTick(ParticlePool& pool, std::int64_t tick, double time) override;
+  void endTick(ParticlePool& pool, const TickInstant& end) override;
 
-  /// The field value (after the outside policy, before scale) at world position `x`, time `t`.
+  /// The frames of a sequence around an instant: indices from 0 (frame firstFrame) and the
+  /// weight of `second`, the exact fraction t·fps − ⌊t·fps⌋ rounded to float once.
+  struct Frames {
+    std::size_t first = 0, second = 0;
+    float weight = 0.0f;
+  };
+  /// The frames at `at`, in exact integers (what the simulation samples).
+  Frames framesAt(const TickInstant& at) const;
+
+  /// The field value (after the outside policy, before scale) at world position `x`, time `t`
+  /// (for inspection: t·fps is computed in double here).
   Eigen::Vector3f sample(const Eigen::Vector3f& x, double t = 0.0) const;
   /// Sets dead[row] = 1 for the rows of `rows` whose position is outside the active voxels (of
   /// the frame at or before in.time); leaves the other flags alone. `dead` is pool-indexed.
@@ -98,6 +110,9 @@ class VectorField final : public ForceModule {
 
  private:
   Settings s_;
+  // fps = fpsNumerator_ / 2^fpsShift_ exactly (sequences only).
+  unsigned __int128 fpsNumerator_ = 0;
+  int fpsShift_ = 0;
   std::unique_ptr<const Impl> impl_;
 };
 

@@ -45,11 +45,11 @@ void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime&
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  const double t0 = time.at(0.0), tHalf = time.at(0.5), t1 = time.at(1.0);
+  const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
 
   // k_out = u(X_in, t)
-  auto sample = [&](int xIn, double t, int out) {
-    return flowPass(pool, forces, xIn, t, time.tick, out);
+  auto sample = [&](int xIn, TickInstant t, int out) {
+    return flowPass(pool, forces, xIn, t, out);
   };
   // X_out = x + step·K_in
   auto predict = [&](int kIn, float step, int out) {

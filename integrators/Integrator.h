@@ -20,10 +20,8 @@ struct StepTime {
 
   /// The step length in seconds, rounded to float once.
   float dt() const { return static_cast<float>(1.0 / static_cast<double>(stepRateHz)); }
-  /// Seconds at `fraction` of the way through the tick (0, 1/2, 1), from integers.
-  double at(double fraction) const {
-    return (static_cast<double>(tick) + fraction) / static_cast<double>(stepRateHz);
-  }
+  /// The instant `halves` half-steps into the tick (0, 1, 2: t, t + dt/2, t + dt).
+  TickInstant stage(int halves) const { return {tick, halves, stepRateHz}; }
 };
 
 /// A time-stepping scheme. An integrator advances rows [0, pool.size()) by one tick, asking the

@@ -12,31 +12,31 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = pool.firstUnstepped();
   const std::size_t n = pool.size();
-  const double t0 = time.at(0.0);
-  runPasses(
-      n, forces.isLocal(), scratch_,
-      {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, time.tick, 0), [&](const Tile& tile) {
-         const RowRange r = tile.rows();
-         // A new particle has no history: give it the position it would have had a step ago.
-         const RowRange started = intersect(r, fresh, n);
-         if (started.count() > 0) {
-           const std::size_t i = started.begin - r.begin;
-           Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started), vr = rowsOf(v, started);
-           Vec3Rows a = tile.stage(0);
-           for (int c = 0; c < 3; ++c) {
-             old[c] = pr[c] - vr[c] * dt +
-                      a[c].segment(static_cast<Eigen::Index>(i), started.count()) * halfDt2;
-           }
-         }
-         Vec3Rows a = tile.stage(0), next = tile.stage(1), pr = rowsOf(p, r), vr = rowsOf(v, r),
-                  old = rowsOf(prev, r);
-         for (int c = 0; c < 3; ++c) {
-           next[c] = (pr[c] * 2.0f - old[c]) + a[c] * dt2;
-           old[c] = pr[c];
-           pr[c] = next[c];
-           vr[c] = (pr[c] - old[c]) * invDt;
-         }
-       }});
+  const TickInstant t0 = time.stage(0);
+  runPasses(n, forces.isLocal(), scratch_,
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
+               const RowRange r = tile.rows();
+               // A new particle has no history: give it the position it would have had a step ago.
+               const RowRange started = intersect(r, fresh, n);
+               if (started.count() > 0) {
+                 const std::size_t i = started.begin - r.begin;
+                 Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started),
+                          vr = rowsOf(v, started);
+                 Vec3Rows a = tile.stage(0);
+                 for (int c = 0; c < 3; ++c) {
+                   old[c] = pr[c] - vr[c] * dt +
+                            a[c].segment(static_cast<Eigen::Index>(i), started.count()) * halfDt2;
+                 }
+               }
+               Vec3Rows a = tile.stage(0), next = tile.stage(1), pr = rowsOf(p, r),
+                        vr = rowsOf(v, r), old = rowsOf(prev, r);
+               for (int c = 0; c < 3; ++c) {
+                 next[c] = (pr[c] * 2.0f - old[c]) + a[c] * dt2;
+                 old[c] = pr[c];
+                 pr[c] = next[c];
+                 vr[c] = (pr[c] - old[c]) * invDt;
+               }
+             }});
 }
 
 }  // namespace tickfx

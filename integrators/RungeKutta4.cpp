@@ -15,14 +15,14 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  const double t0 = time.at(0.0), tHalf = time.at(0.5), t1 = time.at(1.0);
+  const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
 
   auto velocityRows = [&](const Tile& tile, int slot) {
     return slot == kState ? rowsOf(v, tile.rows()) : tile.stage(slot);
   };
   // k_out = a(P_in, V_in, t)
-  auto evaluate = [&](int pIn, int vIn, double t, int out) {
-    return forcePass(pool, forces, pIn, vIn, t, time.tick, out);
+  auto evaluate = [&](int pIn, int vIn, TickInstant t, int out) {
+    return forcePass(pool, forces, pIn, vIn, t, out);
   };
   // (P_out, V_out) = (p + V_in · step, v + K_in · step)
   auto advance = [&](int vIn, int kIn, int pOut, int vOut, float step) {

@@ -8,18 +8,17 @@ void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces,
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  const double t0 = time.at(0.0);
-  runPasses(
-      pool.size(), forces.isLocal(), scratch_,
-      {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, time.tick, 0), [&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                  old = rowsOf(prev, tile.rows());
-         for (int c = 0; c < 3; ++c) {
-           old[c] = pr[c];
-           vr[c] += a[c] * dt;
-           pr[c] += vr[c] * dt;
-         }
-       }});
+  const TickInstant t0 = time.stage(0);
+  runPasses(pool.size(), forces.isLocal(), scratch_,
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
+               Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                        old = rowsOf(prev, tile.rows());
+               for (int c = 0; c < 3; ++c) {
+                 old[c] = pr[c];
+                 vr[c] += a[c] * dt;
+                 pr[c] += vr[c] * dt;
+               }
+             }});
 }
 
 }  // namespace tickfx

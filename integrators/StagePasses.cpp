@@ -56,21 +56,21 @@ Vec3View viewOf(const Tile& tile, const Vec3Column& column, int slot) {
 }  // namespace
 
 RowPass forcePass(const ParticlePool& pool, const ForceSet& forces, int position, int velocity,
-                  double t, std::int64_t tick, int out) {
-  return [&pool, &forces, position, velocity, t, tick, out](const Tile& tile) {
+                  TickInstant at, int out) {
+  return [&pool, &forces, position, velocity, at, out](const Tile& tile) {
     Vec3Rows a = tile.stage(out);
     const ForceInput in{pool, viewOf(tile, pool.position(), position),
-                        viewOf(tile, pool.velocity(), velocity), t, tick};
+                        viewOf(tile, pool.velocity(), velocity), at};
     forces.evaluate(in, tile.rows(), a);
   };
 }
 
-RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position, double t,
-                 std::int64_t tick, int out) {
-  return [&pool, &forces, position, t, tick, out](const Tile& tile) {
+RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position, TickInstant at,
+                 int out) {
+  return [&pool, &forces, position, at, out](const Tile& tile) {
     Vec3Rows u = tile.stage(out);
     const ForceInput in{pool, viewOf(tile, pool.position(), position),
-                        Vec3View::of(pool.velocity()), t, tick};
+                        Vec3View::of(pool.velocity()), at};
     forces.evaluateVelocity(in, tile.rows(), u);
   };
 }

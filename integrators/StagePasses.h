@@ -68,14 +68,14 @@ void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
 inline constexpr int kPoolColumn = -1;
 
 /// The pass that writes the forces' total acceleration (ForceSet::evaluate) at the positions
-/// `position` and velocities `velocity` (stage slots, or kPoolColumn) and time `t` into stage
-/// value `out`.
+/// `position` and velocities `velocity` (stage slots, or kPoolColumn) and instant `at` into
+/// stage value `out`.
 RowPass forcePass(const ParticlePool& pool, const ForceSet& forces, int position, int velocity,
-                  double t, std::int64_t tick, int out);
+                  TickInstant at, int out);
 
 /// The same for the velocity that advection modules prescribe (ForceSet::evaluateVelocity).
-RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position, double t,
-                 std::int64_t tick, int out);
+RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position, TickInstant at,
+                 int out);
 
 /// Rows of `r` that are also in [begin, end).
 RowRange intersect(RowRange r, std::size_t begin, std::size_t end);

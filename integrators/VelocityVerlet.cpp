@@ -12,7 +12,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = pool.firstUnstepped();
   const std::size_t n = pool.size();
-  const double t0 = time.at(0.0), t1 = time.at(1.0);
+  const TickInstant t0 = time.stage(0), t1 = time.stage(2);
   runPasses(
       n, forces.isLocal(), scratch_,
       {[&](const Tile& tile) {
@@ -20,7 +20,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
          const RowRange started = intersect(tile.rows(), fresh, n);
          if (started.count() == 0) return;
          Vec3Rows out = rowsOf(a, started);
-         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0, time.tick}, started, out);
+         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0}, started, out);
        },
        [&](const Tile& tile) {
          Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
@@ -31,7 +31,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            vPred[c] = vr[c] + ar[c] * dt;
          }
        },
-       forcePass(pool, forces, kPoolColumn, 0, t1, time.tick, 1),
+       forcePass(pool, forces, kPoolColumn, 0, t1, 1),
        [&](const Tile& tile) {
          Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
          for (int c = 0; c < 3; ++c) {

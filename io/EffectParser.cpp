@@ -1222,8 +1222,8 @@ void readVectorField(Context& cx, TableReader& r, VectorFieldSettings& f) {
   }
 
   // Sequences: fps makes one; the frame keys mean nothing without it.
-  const bool hasFps = r.number("fps", f.fps, "frames per second, a number > 0 and <= 1000000",
-                               Range{0.0, 1e6, true});
+  const bool hasFps =
+      r.number("fps", f.fps, "frames per second, a number from 1e-6 to 1000000", Range{1e-6, 1e6});
   const toml::node* fpsNode = table.get("fps");
   const std::string frameText = "a frame number, an integer from -1000000 to 1000000";
   for (const char* key : {"first_frame", "last_frame", "frame_padding"}) {

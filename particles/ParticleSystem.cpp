@@ -116,7 +116,7 @@ void ParticleSystem::runTick(bool keepVelocities) {
   const StepTime time{tick_, settings_.stepRateHz};
   integrator_->step(pool_, forces_, time);
   pool_.markAllStepped();
-  forces_.endTick(pool_, tick_, time.at(1.0));
+  forces_.endTick(pool_, time.stage(2));
   ++tick_;
   pool_.updateAges(tick_, settings_.stepRateHz);
   if (keepVelocities) {

@@ -213,9 +213,9 @@ TEST(IntegratorRegistry, NamesMakeTheirSchemes) {
 TEST(IntegratorRegistry, StepTimeIsExactFromIntegers) {
   const StepTime t{7, 60};
   EXPECT_EQ(t.dt(), static_cast<float>(1.0 / 60.0));
-  EXPECT_EQ(t.at(0.0), 7.0 / 60.0);
-  EXPECT_EQ(t.at(0.5), 7.5 / 60.0);
-  EXPECT_EQ(t.at(1.0), 8.0 / 60.0);
+  EXPECT_EQ(t.stage(0).seconds(), 7.0 / 60.0);
+  EXPECT_EQ(t.stage(1).seconds(), 7.5 / 60.0);
+  EXPECT_EQ(t.stage(2).seconds(), 8.0 / 60.0);
 }
 
 }  // namespace

@@ -280,7 +280,7 @@ TEST(ioVectorFieldParse, SequenceErrors) {
       messages(
           fieldEffect("file = \"a.{frame}.vdb\"\nfps = 0\nfirst_frame = 5\nlast_frame = 4.0\n")),
       (Lines{"fx.toml:9:7: error: forces.0.fps: 0 is out of range (expected frames per second, a "
-             "number > 0 and <= 1000000)",
+             "number from 1e-6 to 1000000)",
              "fx.toml:11:14: error: forces.0.last_frame: 4.0 is not an integer (expected a frame "
              "number, an integer from -1000000 to 1000000)"}));
   EXPECT_EQ(

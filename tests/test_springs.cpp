@@ -564,7 +564,8 @@ TEST(Gather, AnIsolatedPairGetsBitwiseOppositeAccelerations) {
   const Spring spring{0, 1, 0.8f, 37.0f, 0.3f, 0.0f};
   addNetwork(forces).add(spring);
   forces.beginTick(pool, 0);
-  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), 0.0, 0};
+  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()),
+                      TickInstant{}};
 
   Vec3Column together, single;
   together.resize(2);
@@ -651,8 +652,9 @@ TEST(Pinning, APinnedParticleGetsNoAccelerationFromAnyForce) {
   Vec3Column a;
   a.resize(2);
   Vec3Rows rows = Vec3Rows::of(a, RowRange{0, 2});
-  forces.evaluate({pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), 0.0, 0},
-                  RowRange{0, 2}, rows);
+  forces.evaluate(
+      {pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), TickInstant{}},
+      RowRange{0, 2}, rows);
   for (int c = 0; c < 3; ++c) EXPECT_EQ(bitsOf(a[c][0]), 0u) << "component " << c;
   // The free end: gravity, drag 0.5·(3 − 1) = 1 along x, and the spring (stretch 0.5) pulling up
   // 20·0.5/1 = 10.

@@ -60,7 +60,7 @@ void run(ParticlePool& pool, const std::string& scheme, ForceSet& forces, std::i
     forces.beginTick(pool, k);
     integrator->step(pool, forces, StepTime{k, rate});
     pool.markAllStepped();
-    forces.endTick(pool, k, StepTime{k, rate}.at(1.0));
+    forces.endTick(pool, StepTime{k, rate}.stage(2));
     pool.removeDead();
   }
 }
@@ -229,12 +229,70 @@ TEST(VdbAdvect, KillAddsNothingOutsideDuringTheStep) {
   euler->step(b, background, StepTime{0, 10});
   EXPECT_EQ(positionOf(a, 1).x(), 3.0f);
   EXPECT_EQ(positionOf(b, 1).x(), 3.5f);
-  kill.endTick(a, 0, 0.1);
+  kill.endTick(a, TickInstant{0, 2, 10});  // the end of tick 0 at 10 Hz: 0.1 s
   EXPECT_EQ(a.dead()[0], 0);
   EXPECT_EQ(a.dead()[1], 1);
   a.removeDead();
   ASSERT_EQ(a.size(), 1u);
   EXPECT_EQ(positionOf(a, 0).x(), 0.1f);
+}
+
+// A one-voxel grid active at x (voxels of 0.5 m): a kill region that moves between frames.
+openvdb::Vec3fGrid::Ptr activeAt(float x) {
+  auto grid = openvdb::Vec3fGrid::create();
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(0.5));
+  grid->tree().setValueOn(openvdb::Coord(static_cast<int>(x / 0.5f), 0, 0), openvdb::Vec3f(0.0f));
+  return grid;
+}
+
+// Regression (issue 10, item 4): a sequence's frame was ⌊t·fps⌋ in double. At t = 1/49 s and
+// fps = 49, 1/49 · 49 = 0.9999999999999999: frame 1's active region decided the kill test at the
+// end of tick 0 instead of frame 2's, and a particle inside frame 2's region died.
+TEST(VdbAdvect, ASequencesFrameComesFromTheIntegerClock) {
+  VectorField::Settings s = advect(VectorField::Outside::Kill);
+  s.fps = 49.0;
+  s.firstFrame = 1;
+  s.lastFrame = 2;
+  const VectorField field(s, VectorField::Grids{{activeAt(0.0f), activeAt(3.0f)}});
+  ParticlePool pool(1);
+  ParticleInit init;
+  init.position = Eigen::Vector3f(3.0f, 0.0f, 0.0f);
+  pool.spawn(init, 0);
+  ForceSet forces;
+  VectorField::Frames f = field.framesAt(TickInstant{0, 2, 49});  // the end of tick 0: 1/49 s
+  EXPECT_EQ(f.first, 1u);
+  EXPECT_EQ(f.second, 1u);
+  VectorField& killer = static_cast<VectorField&>(forces.add(
+      std::make_unique<VectorField>(s, VectorField::Grids{{activeAt(0.0f), activeAt(3.0f)}})));
+  killer.endTick(pool, TickInstant{0, 2, 49});
+  EXPECT_EQ(pool.dead()[0], 0) << "inside frame 2's region at frame 2's time";
+  killer.endTick(pool, TickInstant{0, 1, 49});  // half a tick: frame 1 still decides
+  EXPECT_EQ(pool.dead()[0], 1);
+  f = field.framesAt(TickInstant{0, 1, 49});
+  EXPECT_EQ(f.first, 0u);
+  EXPECT_EQ(f.second, 1u);
+  EXPECT_EQ(f.weight, 0.5f);
+
+  // 24 Hz ticks through a 30 fps sequence: tick 196 is 8 1/6 s, frame 245 exactly (in double,
+  // 196/24 · 30 = 244.99999999999997). Weights are the exact fraction rounded once.
+  VectorField::Settings many = advect();
+  many.fps = 30.0;
+  many.firstFrame = 0;
+  many.lastFrame = 299;
+  const VectorField sequence(
+      many, VectorField::Grids{std::vector<openvdb::GridBase::Ptr>(300, activeAt(0.0f))});
+  f = sequence.framesAt(TickInstant{196, 0, 24});
+  EXPECT_EQ(f.first, 245u);
+  EXPECT_EQ(f.weight, 0.0f);
+  f = sequence.framesAt(TickInstant{197, 1, 24});  // 8.229166... s: 246.875 frames
+  EXPECT_EQ(f.first, 246u);
+  EXPECT_EQ(f.weight, 0.875f);
+  f = sequence.framesAt(TickInstant{1, 0, 7});  // 30/7 = 4 + 2/7
+  EXPECT_EQ(f.first, 4u);
+  EXPECT_EQ(f.weight, 2.0f / 7.0f);
+  f = sequence.framesAt(TickInstant{1000, 0, 24});  // past the last frame: clamped
+  EXPECT_EQ(f.first, 299u);
+  EXPECT_EQ(f.second, 299u);
 }
 
 // ---- rules ------------------------------------------------------------------------------------

@@ -176,7 +176,8 @@ TEST_F(VdbField, OutsidePolicies) {
   pool.spawn({Eigen::Vector3f(0.0f, 0.0f, 0.0f)}, 0);
   pool.spawn({Eigen::Vector3f(0.0f, 1.5f, 0.0f)}, 0);
   pool.spawn({Eigen::Vector3f(0.9f, -0.9f, 0.9f)}, 0);
-  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), 0.0, 0};
+  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()),
+                      TickInstant{}};
   std::uint8_t dead[3] = {0, 0, 0};
   zero.flagOutside(in, RowRange{0, 3}, dead);
   EXPECT_EQ(dead[0], 0);
