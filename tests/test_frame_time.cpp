@@ -108,6 +108,20 @@ TEST(EmissionRate, EachTickMakesThoseThatAccrueInIt) {
   EXPECT_EQ(rate.madeThrough(-1), 0u);
 }
 
+// Regression (item 16): emit() sampled every particle of a tick, including those the full pool
+// would refuse. A burst of 10¹² into a pool of ten took hours; now the refused are counted.
+TEST(EmissionRate, SpawnsThePoolRefusesAreCountedNotSampled) {
+  SystemSettings settings = test::referenceSettings();
+  settings.maxParticles = 10;
+  EmitterSettings e;
+  e.bursts = {Burst{0.0, 1'000'000'000'000}};
+  ParticleSystem system(settings, {e}, ForceSet{});
+  system.step();
+  EXPECT_EQ(system.pool().size(), 10u);
+  EXPECT_EQ(system.pool().nextId(), 10u);
+  EXPECT_EQ(system.pool().droppedSpawns(), 1'000'000'000'000u - 10u);
+}
+
 // ---- frames at their own time (item 2) -------------------------------------------------------
 
 struct Shown {
