@@ -168,6 +168,49 @@ TEST(BuildStructure, RopeIsEvenlySpacedJoinedNeighbourToNeighbourAndPinnedAtItsS
   EXPECT_THROW(buildStructure(s, kSeed, 0), std::invalid_argument);
 }
 
+TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
+  StructureSettings s;
+  RopeShape rope;
+  rope.start = Eigen::Vector3d(1e-200, 0.0, 0.0);
+  rope.end = Eigen::Vector3d(0.0, 1e-200, 0.0);  // 1.41e-200 m apart: no length in double
+  s.shape = rope;
+  s.breakRatio = 0.5;
+  const SettingProblems problems = s.validate();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].text(),
+            "break_ratio: 0.5 is out of range (expected 0 (never breaks) or a ratio of the rest "
+            "length > 1)");
+  EXPECT_EQ(problems[1].text(),
+            "end: is 1.41e-200 m from start, too close to give the rope a length in double "
+            "precision (expected [x, y, z] in metres, at least 1.5e-154 m from start)");
+  try {
+    buildStructure(s, kSeed, 0);
+    ADD_FAILURE() << "built";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "rope " + problems[0].text());
+  }
+  // Cloth axes: each must normalise, and then not be parallel.
+  ClothShape cloth;
+  cloth.axisU = Eigen::Vector3d(1e-200, 0.0, 0.0);
+  s = StructureSettings{};
+  s.shape = cloth;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].key, "axis_u");
+  EXPECT_FALSE(clothAxesParallel(cloth));  // too short to have a direction at all
+  cloth.axisU = Eigen::Vector3d(0.0, 3.0, 0.0);
+  s.shape = cloth;
+  EXPECT_TRUE(clothAxesParallel(cloth));
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(
+      s.validate()[0].text(),
+      "axis_v: is parallel to axis_u (expected a direction [x, y, z] not parallel to axis_u)");
+  // A structure's birth time is its own to check (the system turns it into a tick).
+  s = StructureSettings{};
+  s.time = -1.0;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].key, "time");
+}
+
 TEST(BuildStructure, ClothHasStructuralShearAndBendSpringsWithTheirScales) {
   StructureSettings s;
   ClothShape cloth;
