@@ -62,13 +62,15 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     springs_ = static_cast<SpringNetwork*>(&forces_.add(std::make_unique<SpringNetwork>()));
   }
   for (std::size_t i = 0; i < structures.size(); ++i) {
-    // Validate now, not at the structure's birth tick: bad settings fail the construction.
-    buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
+    // Built now, not at the structure's birth tick: bad settings fail the construction, and the
+    // build is kept for the birth.
+    StructureBuild build =
+        buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
     const Flicks at = flicksFromSeconds(structures[i].time);
     const auto tick = static_cast<std::int64_t>(
         (static_cast<__int128>(at) * settings.stepRateHz + kFlicksPerSecond - 1) /
         kFlicksPerSecond);
-    structures_.push_back(PendingStructure{structures[i], tick, static_cast<std::uint32_t>(i)});
+    structures_.push_back(PendingStructure{std::move(build), tick});
   }
 }
 
@@ -95,8 +97,9 @@ void ParticleSystem::stepTicks(std::int64_t ticks) {
 
 void ParticleSystem::runTick() {
   for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, tick_);
-  for (const PendingStructure& p : structures_) {
-    if (p.tick == tick_) spawnStructure(p);
+  for (PendingStructure& p : structures_) {
+    if (p.tick == tick_) spawnStructure(p.build);
+    if (p.tick <= tick_) p.build = {};  // born (or before a restored tick): not needed again
   }
   forces_.beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};
@@ -108,8 +111,7 @@ void ParticleSystem::runTick() {
   pool_.removeDead();
 }
 
-void ParticleSystem::spawnStructure(const PendingStructure& p) {
-  const StructureBuild build = buildStructure(p.settings, settings_.seed, p.index);
+void ParticleSystem::spawnStructure(const StructureBuild& build) {
   std::vector<std::uint64_t> ids(build.particles.size());
   std::vector<bool> spawned(build.particles.size(), false);
   for (std::size_t i = 0; i < build.particles.size(); ++i) {

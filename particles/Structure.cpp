@@ -4,12 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
 #include <stdexcept>
-#include <tuple>
 #include <utility>
 
 #include "particles/DetMath.h"
+#include "particles/NeighbourPairs.h"
 #include "particles/Random.h"
 
 namespace tickfx {
@@ -112,33 +111,9 @@ void buildCluster(Builder& b, const ClusterShape& c, std::uint64_t seed, std::ui
     at.push_back(c.center + r * Eigen::Vector3d(rxy * det::cos(phi), rxy * det::sin(phi), z));
     b.particle(at.back(), false);
   }
-  // Neighbours through a grid of cells one link radius wide; pairs are sorted so the springs'
-  // order does not depend on the map's.
-  using Cell = std::tuple<long long, long long, long long>;
-  std::map<Cell, std::vector<int>> cells;
-  auto cellOf = [&](const Eigen::Vector3d& q) {
-    const Eigen::Vector3d t = (q - c.center) / c.linkRadius;
-    return Cell{static_cast<long long>(std::floor(t.x())),
-                static_cast<long long>(std::floor(t.y())),
-                static_cast<long long>(std::floor(t.z()))};
-  };
-  for (int i = 0; i < c.count; ++i) cells[cellOf(at[i])].push_back(i);
-  std::vector<std::pair<int, int>> pairs;
-  for (int i = 0; i < c.count; ++i) {
-    const auto [cx, cy, cz] = cellOf(at[i]);
-    for (long long dx = -1; dx <= 1; ++dx) {
-      for (long long dy = -1; dy <= 1; ++dy) {
-        for (long long dz = -1; dz <= 1; ++dz) {
-          const auto it = cells.find(Cell{cx + dx, cy + dy, cz + dz});
-          if (it == cells.end()) continue;
-          for (int j : it->second) {
-            if (j > i && (at[j] - at[i]).norm() <= c.linkRadius) pairs.emplace_back(i, j);
-          }
-        }
-      }
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
+  // Every pair born within the link radius, in (i, j) order: the order of the springs is part
+  // of the sum each particle forms.
+  const std::vector<std::pair<int, int>> pairs = neighbourPairs(at, c.linkRadius);
   for (const auto& [i, j] : pairs) b.spring(i, j, b.s.stiffness, at[i], at[j]);
 }
 
