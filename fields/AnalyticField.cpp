@@ -16,12 +16,8 @@ namespace tickfx {
 
 namespace {
 
-Eigen::Vector3d unit(const Eigen::Vector3d& v, const char* what) {
-  const double n = v.norm();
-  if (!(n > 0.0) || !std::isfinite(n))
-    throw std::invalid_argument(std::string(what) + " must not be zero");
-  return v / n;
-}
+// v normalised, once validate*() has made sure it can be.
+Eigen::Vector3d unit(const Eigen::Vector3d& v) { return v / v.norm(); }
 
 Eigen::Matrix3d cross(const Eigen::Vector3d& a) {  // [a]×, so that [a]×·x = a × x
   Eigen::Matrix3d m;
@@ -43,27 +39,54 @@ AnalyticField AnalyticField::uniform(const Eigen::Vector3d& u) {
   return f;
 }
 
+SettingProblems AnalyticField::validateVortex(const Eigen::Vector3d& axis) {
+  SettingProblems out;
+  checkDirection(axis, "axis", out);
+  return out;
+}
+
+SettingProblems AnalyticField::validateShear(const Eigen::Vector3d& direction,
+                                             const Eigen::Vector3d& gradient) {
+  SettingProblems out;
+  checkDirection(direction, "direction", out);
+  checkDirection(gradient, "gradient", out);
+  return out;
+}
+
+SettingProblems AnalyticField::validateCurlNoise(double frequency, int octaves) {
+  SettingProblems out;
+  if (!(frequency > 0.0 && std::isfinite(frequency))) {
+    out.push_back({"frequency", settingNumber(frequency) + " is out of range",
+                   "radians per metre, a finite number > 0"});
+  }
+  if (octaves < 1) {
+    out.push_back(
+        {"octaves", std::to_string(octaves) + " is out of range", "an integer of at least 1"});
+  }
+  return out;
+}
+
 AnalyticField AnalyticField::vortex(const Eigen::Vector3d& centre, const Eigen::Vector3d& axis,
                                     double omega) {
+  throwIfAny("vortex", validateVortex(axis));
   AnalyticField f;
   f.c_ = centre;
-  f.m_ = omega * cross(unit(axis, "vortex axis"));
+  f.m_ = omega * cross(unit(axis));
   return f;
 }
 
 AnalyticField AnalyticField::shear(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                                    const Eigen::Vector3d& gradient, double rate) {
+  throwIfAny("shear", validateShear(direction, gradient));
   AnalyticField f;
   f.c_ = origin;
-  f.m_ = rate * unit(direction, "shear direction") * unit(gradient, "shear gradient").transpose();
+  f.m_ = rate * unit(direction) * unit(gradient).transpose();
   return f;
 }
 
 AnalyticField AnalyticField::curlNoise(std::uint64_t seed, double frequency, double amplitude,
                                        int octaves, double evolution) {
-  if (!(frequency > 0.0) || octaves < 1) {
-    throw std::invalid_argument("curl noise needs a positive frequency and at least one octave");
-  }
+  throwIfAny("curl noise", validateCurlNoise(frequency, octaves));
   AnalyticField f;
   std::uint64_t counter = 0;
   const double scale = amplitude / (frequency * std::sqrt(3.0 * octaves));

@@ -10,6 +10,7 @@
 
 #include "fields/ForceModule.h"
 #include "fields/VectorField.h"
+#include "particles/SettingProblem.h"
 
 namespace tickfx {
 
@@ -23,11 +24,11 @@ class AnalyticField {
   /// u(x) = u.
   static AnalyticField uniform(const Eigen::Vector3d& u);
   /// Rigid rotation at `omega` rad/s about the line through `centre` along `axis` (normalised):
-  /// u(x) = ω · â × (x − c). Throws std::invalid_argument for a zero axis.
+  /// u(x) = ω · â × (x − c). Throws std::invalid_argument for an axis validateVortex() refuses.
   static AnalyticField vortex(const Eigen::Vector3d& centre, const Eigen::Vector3d& axis,
                               double omega);
   /// Simple shear: u(x) = rate · (n̂·(x − origin)) · d̂, with d̂ the flow direction and n̂ the
-  /// direction the speed grows along (both normalised; throws for zero vectors).
+  /// direction the speed grows along (both normalised; throws for vectors validateShear() refuses).
   static AnalyticField shear(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                              const Eigen::Vector3d& gradient, double rate);
   /// Divergence-free noise: ψ_i(x) = Σ_k a_ik · sin(k_ik·x + φ_ik) over `octaves` terms per
@@ -38,6 +39,15 @@ class AnalyticField {
   /// renews over about 1/ω seconds.
   static AnalyticField curlNoise(std::uint64_t seed, double frequency, double amplitude,
                                  int octaves = 4, double evolution = 0.0);
+
+  /// What vortex(), shear() and curlNoise() refuse (empty: they accept the parameters), keyed as
+  /// bake tables write them: an `axis`, `direction` or `gradient` too short to normalise in
+  /// double (normalisable()), a `frequency` that is not > 0, fewer than one of `octaves`. The
+  /// factories throw std::invalid_argument with the first.
+  static SettingProblems validateVortex(const Eigen::Vector3d& axis);
+  static SettingProblems validateShear(const Eigen::Vector3d& direction,
+                                       const Eigen::Vector3d& gradient);
+  static SettingProblems validateCurlNoise(double frequency, int octaves);
 
   /// The field at `x` (metres → the field's unit) and time `time` (seconds; only evolving curl
   /// noise depends on it).

@@ -1,15 +1,18 @@
 #include "fields/PeriodicWind.h"
 
-#include <stdexcept>
-
 #include "particles/DetMath.h"
 
 namespace tickfx {
 
+SettingProblems PeriodicWind::Settings::validate() const {
+  SettingProblems out;
+  checkDirection(direction, "direction", out);
+  return out;
+}
+
 PeriodicWind::PeriodicWind(const Settings& settings) : s_(settings) {
-  const float norm = s_.direction.norm();
-  if (!(norm > 0.0f)) throw std::invalid_argument("wind direction must not be zero");
-  s_.direction /= norm;
+  throwIfAny("wind", s_.validate());
+  s_.direction /= s_.direction.norm();
 }
 
 float PeriodicWind::strength(double t) const {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "fields/ForceModule.h"
+#include "particles/SettingProblem.h"
 
 namespace tickfx {
 
@@ -18,8 +19,14 @@ class PeriodicWind final : public ForceModule {
     float amplitude = 1.0f;                                         // m/s²
     double frequency = 1.0;                                         // Hz
     double phase = 0.0;                                             // radians
+
+    /// What PeriodicWind refuses (empty: it accepts them): a `direction` too short to normalise
+    /// in float, the precision the wind keeps it in (normalisable<float>: at least 1.1e-19 long;
+    /// [1e-50, 0, 0] is zero once rounded to float).
+    SettingProblems validate() const;
   };
 
+  /// Throws std::invalid_argument with the first of settings.validate().
   explicit PeriodicWind(const Settings& settings);
   std::string_view typeName() const override { return "wind"; }
   bool uniformAcceleration(const ForceInput& in, Eigen::Vector3f& a) const override;

@@ -20,13 +20,7 @@ struct MakeModule {
     return std::make_unique<LinearDrag>(static_cast<float>(d.k), d.airVelocity.cast<float>());
   }
   std::unique_ptr<ForceModule> operator()(const WindSettings& w) const {
-    PeriodicWind::Settings s;
-    s.direction = w.direction.cast<float>();
-    s.base = static_cast<float>(w.base);
-    s.amplitude = static_cast<float>(w.amplitude);
-    s.frequency = w.frequency;
-    s.phase = w.phase;
-    return std::make_unique<PeriodicWind>(s);
+    return std::make_unique<PeriodicWind>(windModuleSettings(w));
   }
   std::unique_ptr<ForceModule> operator()(const AnchorSpringSettings& a) const {
     return std::make_unique<AnchorSpring>(a.rest.cast<float>(), static_cast<float>(a.stiffness),
@@ -38,6 +32,28 @@ struct MakeModule {
 };
 
 }  // namespace
+
+PeriodicWind::Settings windModuleSettings(const WindSettings& wind) {
+  PeriodicWind::Settings s;
+  s.direction = wind.direction.cast<float>();
+  s.base = static_cast<float>(wind.base);
+  s.amplitude = static_cast<float>(wind.amplitude);
+  s.frequency = wind.frequency;
+  s.phase = wind.phase;
+  return s;
+}
+
+SettingProblems forceProblems(const ForceSettings& force) {
+  if (const auto* wind = std::get_if<WindSettings>(&force)) {
+    return windModuleSettings(*wind).validate();
+  }
+  if (const auto* field = std::get_if<VectorFieldSettings>(&force); field && field->bake) {
+    SettingProblems problems = analyticFieldProblems(*field->bake);
+    for (SettingProblem& p : problems) p.key = "bake." + p.key;
+    return problems;
+  }
+  return {};
+}
 
 BuildError::BuildError(Diagnostic diagnostic)
     : std::runtime_error(diagnostic.format()), diagnostic_(std::move(diagnostic)) {}

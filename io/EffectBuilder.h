@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fields/ForceSet.h"
+#include "fields/PeriodicWind.h"
 #include "io/Diagnostics.h"
 #include "io/EffectSettings.h"
 #include "particles/ParticleSystem.h"
@@ -26,11 +27,21 @@ class BuildError : public std::runtime_error {
   Diagnostic diagnostic_;
 };
 
+/// The wind module's settings for `wind`: values rounded from double to float once (the module
+/// works in float), as buildForces() makes them.
+PeriodicWind::Settings windModuleSettings(const WindSettings& wind);
+
+/// What the modules buildForces() would make of `force` refuse (empty: they accept it), keyed
+/// within the force's table as the modules' validate() functions give them: a wind direction
+/// too short to normalise in float once rounded to it ("direction"), a bake's axis, direction or
+/// gradient too short to normalise in double ("bake.axis"). parseEffect() reports these at load.
+SettingProblems forceProblems(const ForceSettings& force);
+
 /// The force modules of `forces`, in order. Values are rounded from double to float once, here
 /// (the modules work in float). Vector fields are loaded from their files (or baked) now. Throws
 /// BuildError (without a position: key path "forces.<i>.file" or ".bake") when a field cannot be
-/// loaded, and std::invalid_argument for settings the modules refuse (a zero wind direction):
-/// settings from parseEffect() never are.
+/// loaded, and std::invalid_argument for settings the modules refuse (forceProblems()): settings
+/// from parseEffect() never are.
 ForceSet buildForces(const std::vector<ForceSettings>& forces);
 
 /// A new system for `effect`: its [simulation] settings (with `threadsOverride`, when given, in

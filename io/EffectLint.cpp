@@ -142,31 +142,67 @@ std::optional<double> lightestMass(const EffectSettings& effect) {
   return mass;
 }
 
-void lintSpring(const EffectSettings& effect, const AnchorSpringSettings& spring,
-                const std::string& path, std::vector<Diagnostic>& out) {
+// A stiffness or a rate to 4 significant digits, large ones as whole numbers ("20000", not
+// "2e+04").
+std::string quantity(double value) {
+  if (std::abs(value) >= 1e4 && std::abs(value) < 1e15) return std::to_string(std::llround(value));
+  return rounded(value, 4);
+}
+
+// "forces.0", "forces.0 and forces.2", "forces.0, forces.2 and forces.5", and past three "...
+// and 4 more".
+std::string listOf(const std::vector<std::string>& paths) {
+  constexpr std::size_t kListed = 3;
+  std::string out;
+  for (std::size_t i = 0; i < paths.size() && i < kListed; ++i) {
+    const bool last = i + 1 == paths.size() || i + 1 == kListed;
+    out += (i == 0 ? "" : (last && paths.size() <= kListed ? " and " : ", ")) + paths[i];
+  }
+  if (paths.size() > kListed) out += " and " + std::to_string(paths.size() - kListed) + " more";
+  return out;
+}
+
+// Every anchor spring pulls on every particle, so the springs of an effect act as one spring of
+// their stiffnesses and dampings added up: two springs each under the stability limit can be past
+// it together. They are checked as that one spring (with ω = √(k/m), m the lightest mass), and a
+// warning is shown at the first spring's stiffness, naming the others.
+void lintAnchorSprings(const EffectSettings& effect, std::vector<Diagnostic>& out) {
+  std::vector<std::string> paths;
+  double k = 0.0, c = 0.0;
+  for (std::size_t i = 0; i < effect.forces.size(); ++i) {
+    if (const auto* a = std::get_if<AnchorSpringSettings>(&effect.forces[i])) {
+      paths.push_back("forces." + std::to_string(i));
+      k += a->stiffness;
+      c += a->damping;
+    }
+  }
   const std::optional<double> lightest = lightestMass(effect);
-  if (!lightest) return;
+  if (paths.empty() || !lightest) return;
+  const bool one = paths.size() == 1;
+  const std::string springs = "the anchor springs " + listOf(paths);
   const double mass = *lightest;
   const std::string& integrator = effect.simulation.integrator;
   const std::int64_t stepRate = effect.simulation.stepRateHz;
   const double rate = static_cast<double>(stepRate);
-  const double k = spring.stiffness, c = spring.damping;
   const double omega = std::sqrt(k / mass);
   const double omegaDt = omega / rate;
-  const std::string where = path + ".stiffness";
+  const std::string where = paths.front() + ".stiffness";
   const std::string stable = "semi_implicit_euler, position_verlet or velocity_verlet";
 
   if (const std::optional<double> limit = springStabilityLimit(integrator);
       limit && omegaDt >= *limit) {
     const auto needed = static_cast<std::int64_t>(std::floor(omega / *limit)) + 1;
+    const std::string together = one ? " "
+                                     : " with k = " + quantity(k) + " N/m, the stiffnesses of " +
+                                           springs + " added up (each pulls on every particle), ";
     out.push_back(warning(
         effect, where,
         "omega*dt = " + rounded(omegaDt, 4) + " is past " + integrator + "'s stability limit of " +
-            rounded(*limit, 4) + " (omega = sqrt(k/m) = " + rounded(omega, 4) +
-            " rad/s for the lightest mass, " + rounded(mass, 4) + " kg, and dt = 1/" +
-            std::to_string(stepRate) +
-            " s): the spring's motion grows without bound (use a step_rate of at least " +
-            std::to_string(needed) + " Hz)"));
+            rounded(*limit, 4) + " (omega = sqrt(k/m) = " + rounded(omega, 4) + " rad/s" +
+            together + "for the lightest mass, " + rounded(mass, 4) + " kg, and dt = 1/" +
+            std::to_string(stepRate) + " s): the " + (one ? "spring's" : "springs'") +
+            " motion grows without bound (use a step_rate of at least " + std::to_string(needed) +
+            " Hz)"));
     return;
   }
 
@@ -175,15 +211,20 @@ void lintSpring(const EffectSettings& effect, const AnchorSpringSettings& spring
   const double duration = effect.output.durationSeconds();
   std::function<double(double)> perStep;
   std::string verb, change, extra;
+  const std::string added = " (k = " + quantity(k) + " N/m and c = " + quantity(c) +
+                            " N·s/m added up: each pulls on every particle)";
   if (integrator == "explicit_euler" && c < k / rate) {
     // |λ|² = det of the step matrix [[1, dt], [−ω²dt, 1 − (c/m)dt]].
     perStep = [=](double h) { return 1.0 + (k / h - c) / (mass * h); };
-    verb = "adds energy to this spring every step";
+    verb = one ? "adds energy to this spring every step"
+               : "adds energy to " + springs + " every step" + added;
     change = "gain";
-    extra = ", damping of at least " + rounded(k / rate, 4) + " N·s/m (k·dt)";
+    extra = ", damping of at least " + rounded(k / rate, 4) + " N·s/m (k·dt" +
+            (one ? "" : ", in all") + ")";
   } else if (integrator == "midpoint" && c == 0.0) {
     perStep = [=](double h) { return 1.0 - (omega * omega) / (2.0 * h * h); };
-    verb = "removes energy from this undamped spring every step";
+    verb = one ? "removes energy from this undamped spring every step"
+               : "removes energy from " + springs + ", undamped, every step" + added;
     change = "loss";
   } else {
     return;
@@ -209,13 +250,6 @@ void lintSpring(const EffectSettings& effect, const AnchorSpringSettings& spring
                         integrator + " " + verb + " (x" + factorText(perStep(rate)) +
                             " per step, x" + rounded(total, 3) + " over the " +
                             rounded(duration, 4) + " s of output) (" + fix + ")"));
-}
-
-// A stiffness or a rate to 4 significant digits, large ones as whole numbers ("20000", not
-// "2e+04").
-std::string quantity(double value) {
-  if (std::abs(value) >= 1e4 && std::abs(value) < 1e15) return std::to_string(std::llround(value));
-  return rounded(value, 4);
 }
 
 // 1 + the explicit-Euler energy factor's excess, written so that huge factors stay readable.
@@ -357,9 +391,6 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet*
     const std::string path = "forces." + std::to_string(i);
     if (const auto* wind = std::get_if<WindSettings>(&effect.forces[i]))
       lintWind(effect, *wind, path, out);
-    if (const auto* spring = std::get_if<AnchorSpringSettings>(&effect.forces[i])) {
-      lintSpring(effect, *spring, path, out);
-    }
     if (const auto* field = std::get_if<VectorFieldSettings>(&effect.forces[i])) {
       // The builder's module when there is one: a field sequence is not loaded twice.
       const VectorField* module = built != nullptr && i < built->size()
@@ -368,6 +399,7 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet*
       lintVectorField(effect, *field, path, module, out);
     }
   }
+  lintAnchorSprings(effect, out);
   lintStructures(effect, out);
   lintTickCap(effect, out);
   sortDiagnostics(out);

@@ -54,10 +54,13 @@ StructureStiffness structureStiffness(const StructureSettings& structure);
 ///   - a wind whose frequency f is at or above half the step rate aliases (the seed's 16 Hz wind
 ///     at 20 Hz is sampled as a 4 Hz wind that pushes the wrong way): a step_rate of at least
 ///     ⌊2f⌋ + 1 Hz;
-///   - an anchor spring (ω = √(k/m), m the lightest emitter mass, dt = 1/step_rate) with ω·dt at
-///     or past springStabilityLimit(): a step_rate of at least ⌊ω / limit⌋ + 1 Hz;
-///   - an anchor spring under explicit_euler while damping < k·dt (it gains energy every step,
-///     ×(1 + (k·dt − c)·dt/m)), or undamped under midpoint (it loses energy every step,
+///   - the anchor springs (ω = √(k/m), m the lightest emitter mass, dt = 1/step_rate) with ω·dt
+///     at or past springStabilityLimit(): a step_rate of at least ⌊ω / limit⌋ + 1 Hz. Every
+///     anchor spring pulls on every particle, so k and c are the stiffnesses and dampings of all
+///     of them added up (two springs each under the limit can be past it together); the warning
+///     is shown at the first one's stiffness and names the others;
+///   - those springs under explicit_euler while damping < k·dt (they gain energy every step,
+///     ×(1 + (k·dt − c)·dt/m)), or undamped under midpoint (they lose energy every step,
 ///     ×(1 − ω²dt²/2)): the step_rate that keeps the drift over the output's duration under 1 %,
 ///     and for explicit_euler the damping that stops the gain.
 ///   - the stiffest structure (largest ω, see structureStiffness, with every anchor spring's k

@@ -18,6 +18,7 @@
 #include "integrators/Integrator.h"
 #include "io/CsvCache.h"
 #include "io/EditDistance.h"
+#include "io/EffectBuilder.h"
 #include "io/SettingOverrides.h"
 #include "io/VdbPointCache.h"
 #include "io/VectorFieldSource.h"
@@ -213,6 +214,17 @@ class Context {
   std::vector<Diagnostic> diagnostics_;
   SourceMap sources_;
 };
+
+// What the core type that owns an entry's settings refuses in them (its validate()), shown where
+// each key was written, or at the entry's header for a default. Only for an entry read without
+// errors: every value is then the file's or a documented default, never a default standing in
+// for a value already refused, and no condition the reader words itself is reported twice.
+void reportProblems(Context& cx, const std::string& entryPath, const SettingProblems& problems) {
+  for (const SettingProblem& p : problems) {
+    const std::string path = entryPath + "." + p.key;
+    cx.error(cx.sources().find(path), path, p.message + " (expected " + p.expected + ")");
+  }
+}
 
 // ---- single values -------------------------------------------------------------------------
 // Each check reports what is wrong with `node` (at `path`) and returns nothing, or returns the
@@ -731,8 +743,6 @@ void readFileEmitter(Context& cx, const toml::table& table, std::size_t index,
 
 // The bound on springs one structure may make (a cloth of 10⁶ particles has about 6·10⁶).
 constexpr double kMaxSprings = 1e7;
-// Below this |û × v̂| a cloth's axes count as parallel (the core's own threshold).
-constexpr double kParallelSine = 1e-6;
 
 // Keys a particle emitter does not have, with the structure types that do.
 std::map<std::string, std::string> notForStructureKeys() {
@@ -827,8 +837,7 @@ void readCloth(Context& cx, TableReader& r, std::int64_t maxParticles, ClothShap
   const bool vOk = r.vec3("axis_v", cloth.axisV, kDirectionText, any, /*nonZero=*/true);
   const toml::node* uNode = r.table().get("axis_u");
   const toml::node* vNode = r.table().get("axis_v");
-  if ((uOk || uNode == nullptr) && (vOk || vNode == nullptr) &&
-      cloth.axisU.normalized().cross(cloth.axisV.normalized()).norm() <= kParallelSine) {
+  if ((uOk || uNode == nullptr) && (vOk || vNode == nullptr) && clothAxesParallel(cloth)) {
     // Shown at the later-written axis (the one a default cannot be blamed for).
     const bool atV = vNode != nullptr;
     const std::string other = atV ? "axis_u" : "axis_v";
@@ -938,6 +947,8 @@ void readStructure(Context& cx, const toml::table& table, std::size_t index,
 void readEmitterEntry(Context& cx, const toml::table& table, std::size_t index,
                       std::int64_t maxParticles, EffectSettings& effect,
                       std::map<std::string, std::size_t>& names) {
+  const std::size_t errorsBefore = cx.diagnostics().size();
+  const std::string path = childPath("emitters", index);
   std::string type = "particles";
   if (const toml::node* node = table.get("type")) {
     const std::optional<std::string> known =
@@ -964,11 +975,13 @@ void readEmitterEntry(Context& cx, const toml::table& table, std::size_t index,
     } else {
       readEmitter(cx, table, index, maxParticles, e);
     }
+    if (cx.diagnostics().size() == errorsBefore) reportProblems(cx, path, e.validate());
     name = e.name;
     effect.emitters.push_back(std::move(e));
   } else {
     StructureSettings s;
     readStructure(cx, table, index, type, maxParticles, s);
+    if (cx.diagnostics().size() == errorsBefore) reportProblems(cx, path, s.validate());
     name = s.name;
     effect.structures.push_back(std::move(s));
     effect.structureEntries.push_back(index);
@@ -1555,7 +1568,11 @@ EffectSettings readCurrentVersion(Context& cx, const toml::table& document) {
   });
   std::vector<std::size_t> forceEntries;
   readEntries(cx, top, "forces", /*required=*/false, [&](const toml::table& table, std::size_t i) {
+    const std::size_t errorsBefore = cx.diagnostics().size();
     if (auto force = readForce(cx, table, i)) {
+      if (cx.diagnostics().size() == errorsBefore) {
+        reportProblems(cx, childPath("forces", i), forceProblems(*force));
+      }
       effect.forces.push_back(*force);
       forceEntries.push_back(i);
     }

@@ -40,6 +40,20 @@ AnalyticField analyticField(const FieldBakeSettings& bake) {
                                   bake.evolution);
 }
 
+SettingProblems analyticFieldProblems(const FieldBakeSettings& bake) {
+  switch (bake.kind) {
+    case FieldBakeSettings::Kind::Uniform:
+      return {};
+    case FieldBakeSettings::Kind::Vortex:
+      return AnalyticField::validateVortex(bake.axis);
+    case FieldBakeSettings::Kind::Shear:
+      return AnalyticField::validateShear(bake.direction, bake.gradient);
+    case FieldBakeSettings::Kind::CurlNoise:
+      break;
+  }
+  return AnalyticField::validateCurlNoise(bake.frequency, bake.octaves);
+}
+
 BakeSettings bakeSettings(const FieldBakeSettings& bake, const std::string& gridName) {
   BakeSettings s;
   s.gridName = gridName;

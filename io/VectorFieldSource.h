@@ -42,8 +42,13 @@ struct BakeSize {
 BakeSize measureBake(const FieldBakeSettings& bake, std::int64_t frames);
 
 /// The analytic field `bake` describes (its kind's parameters). Throws std::invalid_argument as
-/// AnalyticField does (a zero axis or direction): settings from parseEffect() never are.
+/// AnalyticField does (analyticFieldProblems): settings from parseEffect() never are.
 AnalyticField analyticField(const FieldBakeSettings& bake);
+
+/// What the analytic field `bake` describes refuses (AnalyticField::validateVortex and the
+/// others, for its kind's parameters), keyed within the bake table ("axis", "gradient"): empty
+/// when analyticField(bake) accepts it.
+SettingProblems analyticFieldProblems(const FieldBakeSettings& bake);
 
 /// Where and how `bake` is baked, under grid name `gridName` (values rounded to float once).
 BakeSettings bakeSettings(const FieldBakeSettings& bake, const std::string& gridName = "vel");

@@ -23,51 +23,86 @@ void basis(const Eigen::Vector3d& n, Eigen::Vector3d& b1, Eigen::Vector3d& b2) {
   b2 = Eigen::Vector3d(b, sign + n.y() * n.y() * a, -n.y());
 }
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument(what);
-}
-
 }  // namespace
+
+SettingProblems EmitterSettings::validate() const {
+  SettingProblems out;
+  const auto check = [&](bool ok, const std::string& key, double value,
+                         const std::string& expected) {
+    if (!ok) out.push_back({key, settingNumber(value) + " is out of range", expected});
+  };
+  check(std::isfinite(rate) && rate >= 0.0 && rate <= 1.0e9, "rate", rate,
+        "particles per second, a number from 0 to 1e9");
+  check(std::isfinite(start) && start >= 0.0 && start <= 1.0e9, "start", start,
+        "seconds, a number from 0 to 1e9");
+  if (std::isfinite(stop) && stop > 1.0e9) {
+    out.push_back({"stop", settingNumber(stop) + " is out of range",
+                   "seconds, a number from start to 1e9"});
+  } else if (!(stop >= start)) {  // infinity: never stops
+    out.push_back({"stop",
+                   std::isnan(stop)
+                       ? "nan is not a time"
+                       : settingNumber(stop) + " is before start = " + settingNumber(start),
+                   "seconds, a number from start on"});
+  }
+  checkDirection(direction, "direction", out);
+  check(std::isfinite(speed) && speed >= 0.0, "speed", speed,
+        "metres per second, a finite number >= 0");
+  check(speedJitter >= 0.0 && speedJitter <= 1.0, "speed_jitter", speedJitter,
+        "a fraction from 0 to 1");
+  check(spreadDegrees >= 0.0 && spreadDegrees <= 180.0, "spread", spreadDegrees,
+        "degrees, a number from 0 to 180");
+  check(lifetime > 0.0, "lifetime", lifetime, "seconds, a number > 0");
+  check(lifetimeJitter >= 0.0 && lifetimeJitter < 1.0, "lifetime_jitter", lifetimeJitter,
+        "a fraction >= 0 and < 1");
+  check(mass > 0.0, "mass", mass, "kilograms, a number > 0");
+  if (!position.allFinite()) {
+    out.push_back({"position", "is not finite", "[x, y, z] in metres, finite numbers"});
+  }
+  if (const auto* disc = std::get_if<DiscShape>(&shape))
+    checkDirection(disc->normal, "normal", out);
+  if (const auto* list = std::get_if<PointListShape>(&shape)) {
+    const auto bad = [&](const std::string& what, const std::string& expected) {
+      out.push_back({"file", what, expected});
+    };
+    if (list->positions.empty()) bad("holds no points", "at least one point");
+    if (!list->velocities.empty() && list->velocities.size() != list->positions.size()) {
+      bad("has " + std::to_string(list->velocities.size()) + " velocities for " +
+              std::to_string(list->positions.size()) + " points",
+          "one velocity per point, or none");
+    }
+    for (const Eigen::Vector3f& p : list->positions) {
+      if (!p.allFinite()) {
+        bad("has a point that is not finite", "points of finite coordinates");
+        break;
+      }
+    }
+    for (const Eigen::Vector3f& v : list->velocities) {
+      if (!v.allFinite()) {
+        bad("has a velocity that is not finite", "velocities of finite coordinates");
+        break;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < bursts.size(); ++i) {
+    check(std::isfinite(bursts[i].time) && bursts[i].time >= 0.0 && bursts[i].time <= 1.0e9,
+          "bursts." + std::to_string(i) + ".time", bursts[i].time,
+          "seconds, a number from 0 to 1e9");
+  }
+  return out;
+}
 
 Emitter::Emitter(EmitterSettings settings, std::uint32_t index, std::int64_t stepRateHz)
     : s_(std::move(settings)), index_(index), stepRate_(stepRateHz) {
-  require(stepRateHz > 0, "step rate must be positive");
-  require(std::isfinite(s_.rate) && s_.rate >= 0.0 && s_.rate <= 1.0e9,
-          "emitter rate must be in [0, 1e9] particles per second");
-  require(std::isfinite(s_.start) && s_.start >= 0.0, "emitter start must be a time >= 0");
-  require(!std::isnan(s_.stop) && s_.stop >= s_.start, "emitter stop must not be before start");
-  require(s_.direction.allFinite() && s_.direction.norm() > 0.0,
-          "emitter direction must not be zero");
-  require(std::isfinite(s_.speed) && s_.speed >= 0.0, "emitter speed must be >= 0");
-  require(s_.speedJitter >= 0.0 && s_.speedJitter <= 1.0, "speed jitter must be in [0, 1]");
-  require(s_.spreadDegrees >= 0.0 && s_.spreadDegrees <= 180.0,
-          "spread must be in [0, 180] degrees");
-  require(s_.lifetime > 0.0, "lifetime must be > 0");
-  require(s_.lifetimeJitter >= 0.0 && s_.lifetimeJitter < 1.0, "lifetime jitter must be in [0, 1)");
-  require(s_.mass > 0.0, "mass must be > 0");
-  require(s_.position.allFinite(), "emitter position must be finite");
+  if (stepRateHz <= 0) throw std::invalid_argument("step rate must be positive");
+  throwIfAny("emitter", s_.validate());
+  // Both normalise in double: validate() made sure they can.
   s_.direction.normalize();
-  if (auto* disc = std::get_if<DiscShape>(&s_.shape)) {
-    require(disc->normal.allFinite() && disc->normal.norm() > 0.0, "disc normal must not be zero");
-    disc->normal.normalize();
-  }
-  if (const auto* list = std::get_if<PointListShape>(&s_.shape)) {
-    require(!list->positions.empty(), "a point list needs at least one point");
-    require(list->velocities.empty() || list->velocities.size() == list->positions.size(),
-            "a point list has one velocity per point or none");
-    for (const Eigen::Vector3f& p : list->positions)
-      require(p.allFinite(), "point list positions must be finite");
-    for (const Eigen::Vector3f& v : list->velocities)
-      require(v.allFinite(), "point list velocities must be finite");
-  }
-  require(s_.start <= 1.0e9 && (std::isinf(s_.stop) || s_.stop <= 1.0e9),
-          "emitter start and stop must be at most 1e9 s");
+  if (auto* disc = std::get_if<DiscShape>(&s_.shape)) disc->normal.normalize();
   rate_ = EmissionRate(std::llround(s_.rate * static_cast<double>(kMicros)), s_.start, s_.stop,
                        stepRate_);
-  for (const Burst& b : s_.bursts) {
-    require(std::isfinite(b.time) && b.time >= 0.0, "burst time must be >= 0");
+  for (const Burst& b : s_.bursts)
     burstTicks_.emplace_back(exact::tickAtOrAfter(b.time, stepRate_), b.count);
-  }
   std::stable_sort(burstTicks_.begin(), burstTicks_.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
 }

@@ -10,6 +10,7 @@
 
 #include "particles/EmissionRate.h"
 #include "particles/ParticlePool.h"
+#include "particles/SettingProblem.h"
 
 namespace tickfx {
 
@@ -65,6 +66,12 @@ struct EmitterSettings {
   double lifetime = std::numeric_limits<double>::infinity();  // seconds
   double lifetimeJitter = 0.0;                                // fraction: lifetime · (1 ± jitter)
   double mass = 1.0;                                          // kilograms
+
+  /// What an Emitter refuses in these settings (empty: it accepts them), each problem keyed as
+  /// effect files write it: "rate", "stop", "direction", "normal", "bursts.<i>.time", and "file"
+  /// for a point list. Numbers must be finite and in range, and `direction` (and a disc's
+  /// `normal`) long enough to normalise in double precision (see normalisable()).
+  SettingProblems validate() const;
 };
 
 /// Spawns particles for one emitter. Emission is a pure function of the tick: rate emission as
@@ -75,7 +82,7 @@ struct EmitterSettings {
 class Emitter {
  public:
   /// `index` is the emitter's place in the effect (part of its random keys); throws
-  /// std::invalid_argument for settings out of range.
+  /// std::invalid_argument with the first of settings.validate(), or for a step rate <= 0.
   Emitter(EmitterSettings settings, std::uint32_t index, std::int64_t stepRateHz);
 
   /// Particles this emitter starts before tick `tick` (its serial counter at that tick).

@@ -64,10 +64,12 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     springs_ = static_cast<SpringNetwork*>(&forces_.add(std::make_unique<SpringNetwork>()));
   }
   for (std::size_t i = 0; i < structures.size(); ++i) {
-    // Validate now, not at the structure's birth tick: bad settings fail the construction.
-    buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
+    // Built now, not at the structure's birth tick: bad settings fail the construction, and the
+    // build is kept for the birth.
+    StructureBuild build =
+        buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
     const std::int64_t tick = exact::tickAtOrAfter(structures[i].time, settings.stepRateHz);
-    structures_.push_back(PendingStructure{structures[i], tick, static_cast<std::uint32_t>(i)});
+    structures_.push_back(PendingStructure{std::move(build), tick});
   }
 }
 
@@ -104,8 +106,9 @@ void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
 
 void ParticleSystem::runTick(bool keepVelocities) {
   for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, tick_);
-  for (const PendingStructure& p : structures_) {
-    if (p.tick == tick_) spawnStructure(p);
+  for (PendingStructure& p : structures_) {
+    if (p.tick == tick_) spawnStructure(p.build);
+    if (p.tick <= tick_) p.build = {};  // born (or before a restored tick): not needed again
   }
   if (keepVelocities) {
     const auto n = static_cast<Eigen::Index>(pool_.size());
@@ -134,8 +137,7 @@ void ParticleSystem::restoreClock(std::int64_t tick, const Vec3Column* tickStart
   if (tickStartVelocities != nullptr) previousVelocity_ = *tickStartVelocities;
 }
 
-void ParticleSystem::spawnStructure(const PendingStructure& p) {
-  const StructureBuild build = buildStructure(p.settings, settings_.seed, p.index);
+void ParticleSystem::spawnStructure(const StructureBuild& build) {
   std::vector<std::uint64_t> ids(build.particles.size());
   std::vector<bool> spawned(build.particles.size(), false);
   for (std::size_t i = 0; i < build.particles.size(); ++i) {

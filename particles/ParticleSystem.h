@@ -113,7 +113,7 @@ class ParticleSystem {
   struct PendingStructure;
   void runTicks(std::int64_t ticks, bool keepVelocities);
   void runTick(bool keepVelocities);
-  void spawnStructure(const PendingStructure& p);
+  void spawnStructure(const StructureBuild& build);
 
   SystemSettings settings_;
   ParticlePool pool_;
@@ -121,9 +121,8 @@ class ParticleSystem {
   ForceSet forces_;
   std::unique_ptr<Integrator> integrator_;
   struct PendingStructure {
-    StructureSettings settings;  // born at `tick`; its index keys its random numbers
+    StructureBuild build;  // built (so validated) once, by the constructor; born at `tick`
     std::int64_t tick;
-    std::uint32_t index;
   };
   std::vector<PendingStructure> structures_;
   SpringNetwork* springs_ = nullptr;  // owned by forces_

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <cstdio>
+#include <limits>
 #include <stdexcept>
-#include <tuple>
+#include <utility>
 
 #include "particles/DetMath.h"
+#include "particles/NeighbourPairs.h"
 #include "particles/Random.h"
 
 namespace tickfx {
@@ -14,10 +16,6 @@ namespace {
 
 // Structures draw random numbers in their own emitter-index space, apart from the emitters'.
 constexpr std::uint32_t kStructureKeySpace = 0x80000000u;
-
-void require(bool ok, const char* what) {
-  if (!ok) throw std::invalid_argument(what);
-}
 
 struct Builder {
   const StructureSettings& s;
@@ -41,9 +39,6 @@ struct Builder {
 };
 
 void buildRope(Builder& b, const RopeShape& rope) {
-  require(rope.count >= 2 && rope.count <= 1'000'000, "rope count must be in [2, 1000000]");
-  require(rope.start.allFinite() && rope.end.allFinite() && (rope.end - rope.start).norm() > 0.0,
-          "rope start and end must be distinct finite points");
   std::vector<Eigen::Vector3d> at;
   for (int i = 0; i < rope.count; ++i) {
     at.push_back(rope.start +
@@ -54,14 +49,7 @@ void buildRope(Builder& b, const RopeShape& rope) {
 }
 
 void buildCloth(Builder& b, const ClothShape& c) {
-  require(c.width >= 2 && c.height >= 2 && static_cast<long long>(c.width) * c.height <= 1'000'000,
-          "cloth width and height must be >= 2 with at most 1000000 particles");
-  require(c.spacing > 0.0 && std::isfinite(c.spacing), "cloth spacing must be > 0");
-  require(
-      c.axisU.allFinite() && c.axisV.allFinite() && c.axisU.norm() > 0.0 && c.axisV.norm() > 0.0,
-      "cloth axes must not be zero");
   const Eigen::Vector3d u = c.axisU.normalized(), v = c.axisV.normalized();
-  require(u.cross(v).norm() > 1e-6, "cloth axes must not be parallel");
   const int w = c.width, h = c.height;
   auto index = [w](int col, int row) { return static_cast<std::size_t>(row) * w + col; };
   std::vector<Eigen::Vector3d> at;
@@ -109,10 +97,6 @@ void buildCloth(Builder& b, const ClothShape& c) {
 }
 
 void buildCluster(Builder& b, const ClusterShape& c, std::uint64_t seed, std::uint32_t index) {
-  require(c.count >= 1 && c.count <= 1'000'000, "cluster count must be in [1, 1000000]");
-  require(c.radius > 0.0 && std::isfinite(c.radius), "cluster radius must be > 0");
-  require(c.linkRadius > 0.0 && std::isfinite(c.linkRadius), "cluster link radius must be > 0");
-  require(c.center.allFinite(), "cluster center must be finite");
   std::vector<Eigen::Vector3d> at;
   for (int i = 0; i < c.count; ++i) {
     auto uniform = [&](RandomPurpose purpose) {
@@ -127,49 +111,117 @@ void buildCluster(Builder& b, const ClusterShape& c, std::uint64_t seed, std::ui
     at.push_back(c.center + r * Eigen::Vector3d(rxy * det::cos(phi), rxy * det::sin(phi), z));
     b.particle(at.back(), false);
   }
-  // Neighbours through a grid of cells one link radius wide; pairs are sorted so the springs'
-  // order does not depend on the map's.
-  using Cell = std::tuple<long long, long long, long long>;
-  std::map<Cell, std::vector<int>> cells;
-  auto cellOf = [&](const Eigen::Vector3d& q) {
-    const Eigen::Vector3d t = (q - c.center) / c.linkRadius;
-    return Cell{static_cast<long long>(std::floor(t.x())),
-                static_cast<long long>(std::floor(t.y())),
-                static_cast<long long>(std::floor(t.z()))};
-  };
-  for (int i = 0; i < c.count; ++i) cells[cellOf(at[i])].push_back(i);
-  std::vector<std::pair<int, int>> pairs;
-  for (int i = 0; i < c.count; ++i) {
-    const auto [cx, cy, cz] = cellOf(at[i]);
-    for (long long dx = -1; dx <= 1; ++dx) {
-      for (long long dy = -1; dy <= 1; ++dy) {
-        for (long long dz = -1; dz <= 1; ++dz) {
-          const auto it = cells.find(Cell{cx + dx, cy + dy, cz + dz});
-          if (it == cells.end()) continue;
-          for (int j : it->second) {
-            if (j > i && (at[j] - at[i]).norm() <= c.linkRadius) pairs.emplace_back(i, j);
-          }
-        }
-      }
+  // Every pair born within the link radius, in (i, j) order: the order of the springs is part
+  // of the sum each particle forms.
+  const std::vector<std::pair<int, int>> pairs = neighbourPairs(at, c.linkRadius);
+  for (const auto& [i, j] : pairs) b.spring(i, j, b.s.stiffness, at[i], at[j]);
+}
+
+// The problems of each shape, keyed as effect files write them.
+void validateShape(const RopeShape& rope, SettingProblems& out) {
+  if (rope.count < 2 || rope.count > 1'000'000) {
+    out.push_back({"count", std::to_string(rope.count) + " is out of range",
+                   "particles, an integer from 2 to 1000000"});
+  }
+  if (!rope.start.allFinite()) out.push_back({"start", "is not finite", "[x, y, z] in metres"});
+  if (!rope.end.allFinite()) {
+    out.push_back({"end", "is not finite", "[x, y, z] in metres"});
+  } else if (rope.start.allFinite() &&
+             (rope.end - rope.start).squaredNorm() < std::numeric_limits<double>::min()) {
+    // The positions along the rope are start + (end − start)·t: a length whose square is
+    // subnormal in double is no length to build on.
+    char length[32];
+    std::snprintf(length, sizeof length, "%.3g", (rope.end - rope.start).stableNorm());
+    out.push_back(
+        {"end",
+         "is " + std::string(length) +
+             " m from start, too close to give the rope a length in double precision",
+         "[x, y, z] in metres, at least " + shortestNormalisable<double>() + " m from start"});
+  }
+}
+
+void validateShape(const ClothShape& c, SettingProblems& out) {
+  for (const auto& [key, side] : {std::pair{"width", c.width}, std::pair{"height", c.height}}) {
+    if (side < 2) {
+      out.push_back(
+          {key, std::to_string(side) + " is out of range", "particles, an integer of at least 2"});
     }
   }
-  std::sort(pairs.begin(), pairs.end());
-  for (const auto& [i, j] : pairs) b.spring(i, j, b.s.stiffness, at[i], at[j]);
+  if (c.width >= 2 && c.height >= 2 && static_cast<long long>(c.width) * c.height > 1'000'000) {
+    out.push_back({"height",
+                   std::to_string(c.width) + " x " + std::to_string(c.height) + " = " +
+                       std::to_string(static_cast<long long>(c.width) * c.height) +
+                       " particles are too many",
+                   "width x height at most 1000000"});
+  }
+  if (!(c.spacing > 0.0 && std::isfinite(c.spacing))) {
+    out.push_back(
+        {"spacing", settingNumber(c.spacing) + " is out of range", "metres, a finite number > 0"});
+  }
+  if (!c.origin.allFinite()) out.push_back({"origin", "is not finite", "[x, y, z] in metres"});
+  checkDirection(c.axisU, "axis_u", out);
+  checkDirection(c.axisV, "axis_v", out);
+  if (clothAxesParallel(c)) {
+    out.push_back(
+        {"axis_v", "is parallel to axis_u", "a direction [x, y, z] not parallel to axis_u"});
+  }
+}
+
+void validateShape(const ClusterShape& c, SettingProblems& out) {
+  if (c.count < 1 || c.count > 1'000'000) {
+    out.push_back({"count", std::to_string(c.count) + " is out of range",
+                   "particles, an integer from 1 to 1000000"});
+  }
+  if (!(c.radius > 0.0 && std::isfinite(c.radius))) {
+    out.push_back(
+        {"radius", settingNumber(c.radius) + " is out of range", "metres, a finite number > 0"});
+  }
+  if (!(c.linkRadius > 0.0 && std::isfinite(c.linkRadius))) {
+    out.push_back({"link_radius", settingNumber(c.linkRadius) + " is out of range",
+                   "metres, a finite number > 0"});
+  }
+  if (!c.center.allFinite()) out.push_back({"center", "is not finite", "[x, y, z] in metres"});
+}
+
+}  // namespace
+
+bool clothAxesParallel(const ClothShape& cloth) {
+  return normalisable(cloth.axisU) && normalisable(cloth.axisV) &&
+         cloth.axisU.normalized().cross(cloth.axisV.normalized()).norm() <= 1e-6;
+}
+
+SettingProblems StructureSettings::validate() const {
+  SettingProblems out;
+  const auto check = [&](bool ok, const char* key, double value, const char* expected) {
+    if (!ok) out.push_back({key, settingNumber(value) + " is out of range", expected});
+  };
+  check(std::isfinite(time) && time >= 0.0, "time", time, "seconds, a finite number >= 0");
+  check(mass > 0.0 && std::isfinite(mass), "mass", mass,
+        "kilograms per particle, a finite number > 0");
+  check(stiffness >= 0.0 && std::isfinite(stiffness), "stiffness", stiffness,
+        "N/m, a finite number >= 0");
+  check(damping >= 0.0 && std::isfinite(damping), "damping", damping,
+        "N·s/m, a finite number >= 0");
+  check(breakRatio == 0.0 || breakRatio > 1.0, "break_ratio", breakRatio,
+        "0 (never breaks) or a ratio of the rest length > 1");
+  check(lifetime > 0.0, "lifetime", lifetime, "seconds, a number > 0");
+  if (!velocity.allFinite()) out.push_back({"velocity", "is not finite", "[x, y, z] in m/s"});
+  std::visit([&](const auto& s) { validateShape(s, out); }, shape);
+  return out;
+}
+
+namespace {
+
+const char* shapeName(const StructureShape& shape) {
+  if (std::holds_alternative<RopeShape>(shape)) return "rope";
+  return std::holds_alternative<ClothShape>(shape) ? "cloth" : "cluster";
 }
 
 }  // namespace
 
 StructureBuild buildStructure(const StructureSettings& settings, std::uint64_t seed,
                               std::uint32_t index) {
-  require(settings.mass > 0.0 && std::isfinite(settings.mass), "structure mass must be > 0");
-  require(settings.stiffness >= 0.0 && std::isfinite(settings.stiffness),
-          "structure stiffness must be >= 0");
-  require(settings.damping >= 0.0 && std::isfinite(settings.damping),
-          "structure damping must be >= 0");
-  require(settings.breakRatio == 0.0 || settings.breakRatio > 1.0,
-          "break ratio must be 0 (never) or > 1");
-  require(settings.lifetime > 0.0, "structure lifetime must be > 0");
-  require(settings.velocity.allFinite(), "structure velocity must be finite");
+  throwIfAny(shapeName(settings.shape), settings.validate());
   Builder b{settings, {}};
   if (const auto* rope = std::get_if<RopeShape>(&settings.shape)) buildRope(b, *rope);
   if (const auto* cloth = std::get_if<ClothShape>(&settings.shape)) buildCloth(b, *cloth);

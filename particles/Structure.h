@@ -11,6 +11,7 @@
 
 #include "fields/SpringNetwork.h"
 #include "particles/ParticlePool.h"
+#include "particles/SettingProblem.h"
 
 namespace tickfx {
 
@@ -63,7 +64,18 @@ struct StructureSettings {
   double breakRatio = 0.0;   // springs break past breakRatio · rest length; 0: never
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();         // initial, of every free particle
   double lifetime = std::numeric_limits<double>::infinity();  // seconds
+
+  /// What buildStructure() refuses in these settings (empty: it accepts them), each problem keyed
+  /// as effect files write it ("stiffness", "count", "end", "axis_v", "link_radius", ...).
+  /// Numbers must be finite and in range; a rope's end at least shortestNormalisable<double>()
+  /// from its start (it has a length); a cloth's axes long enough to normalise in double and not
+  /// parallel (clothAxesParallel).
+  SettingProblems validate() const;
 };
+
+/// True when both axes of `cloth` normalise (normalisable()) and are parallel: |û × v̂| <= 1e-6,
+/// where the cloth would have no area. validate() refuses such a cloth at "axis_v".
+bool clothAxesParallel(const ClothShape& cloth);
 
 /// The particles of a structure and its springs, with spring ends as indices into `particles`.
 struct StructureBuild {
@@ -72,7 +84,8 @@ struct StructureBuild {
 };
 
 /// Builds `settings` (a pure function of the settings, the effect seed and the structure's index,
-/// which keys its random numbers). Throws std::invalid_argument for settings out of range.
+/// which keys its random numbers). Throws std::invalid_argument with the first of
+/// settings.validate().
 StructureBuild buildStructure(const StructureSettings& settings, std::uint64_t seed,
                               std::uint32_t index);
 

@@ -498,6 +498,46 @@ const BadEffect kBadEffects[] = {
      "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nrate = "
      "10.0\n[[forces]]\ntype = \"wind\"\namplitude = 1.0\n",
      ":6:1: error: forces.0.frequency: missing (expected hertz, a number from 0 to 1000000)"},
+    // What only the core types refused (run exited 1 with no position, check passed): each
+    // type's validate() is asked at load.
+    {"tiny_direction",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\ndirection = [1e-200, "
+     "1e-200, 0]\nbursts = [{ time = 0.0, count = 1 }]\n",
+     ":5:13: error: emitters.0.direction: is too short to normalise in double precision (expected "
+     "a direction [x, y, z] at least 1.5e-154 long)"},
+    {"tiny_disc_normal",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nshape = \"disc\"\nnormal "
+     "= [1e-200, 0, 0]\nbursts = [{ time = 0.0, count = 1 }]\n",
+     ":6:10: error: emitters.0.normal: is too short to normalise in double precision (expected a "
+     "direction [x, y, z] at least 1.5e-154 long)"},
+    {"tiny_wind_direction",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nbursts = [{ time = 0.0, "
+     "count = 1 }]\n[[forces]]\ntype = \"wind\"\ndirection = [1e-50, 0, 0]\namplitude = "
+     "1.0\nfrequency = 1.0\n",
+     ":8:13: error: forces.0.direction: is too short to normalise in float precision (expected a "
+     "direction [x, y, z] at least 1.1e-19 long)"},
+    {"tiny_rope",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\ntype = \"rope\"\nend = "
+     "[1e-200, 0, 0]\ncount = 3\nstiffness = 1\n",
+     ":6:7: error: emitters.0.end: is 1e-200 m from start, too close to give the rope a length in "
+     "double precision (expected [x, y, z] in metres, at least 1.5e-154 m from start)"},
+    {"tiny_cloth_axis",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\ntype = \"cloth\"\naxis_u "
+     "= [1e-200, 0, 0]\nwidth = 2\nheight = 2\nspacing = 1\nstiffness = 1\n",
+     ":6:10: error: emitters.0.axis_u: is too short to normalise in double precision (expected a "
+     "direction [x, y, z] at least 1.5e-154 long)"},
+    {"tiny_vortex_axis",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nbursts = [{ time = 0.0, "
+     "count = 1 }]\n[[forces]]\ntype = \"vector_field\"\nmode = \"drag\"\nbake = { kind = "
+     "\"vortex\", axis = [0, 1e-200, 0] }\n",
+     ":9:34: error: forces.0.bake.axis: is too short to normalise in double precision (expected a "
+     "direction [x, y, z] at least 1.5e-154 long)"},
+    {"tiny_shear_gradient",
+     "format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\nbursts = [{ time = 0.0, "
+     "count = 1 }]\n[[forces]]\ntype = \"vector_field\"\nbake = { kind = \"shear\", gradient = "
+     "[0, 1e-170, 0] }\n",
+     ":8:37: error: forces.0.bake.gradient: is too short to normalise in double precision "
+     "(expected a direction [x, y, z] at least 1.5e-154 long)"},
 };
 
 class CliBadEffect : public Cli, public ::testing::WithParamInterface<BadEffect> {};

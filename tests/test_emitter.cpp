@@ -330,6 +330,41 @@ TEST(EmitterSettingsCheck, RejectsSettingsOutOfRange) {
   EXPECT_NO_THROW(bad([](EmitterSettings&) {})());
 }
 
+TEST(EmitterSettingsCheck, ValidateNamesEachProblemByItsKeyAndTheConstructorThrowsTheFirst) {
+  EmitterSettings s;
+  EXPECT_TRUE(s.validate().empty());
+  // Directions are normalised in double: a squared length below the smallest normal double
+  // (|v| < 1.49e-154) is refused, zero included; 1.5e-154 passes.
+  s.direction = Eigen::Vector3d(1e-200, 1e-200, 0.0);
+  s.shape = DiscShape{1.0, Eigen::Vector3d(0.0, -1e-160, 0.0)};
+  s.rate = -1.0;
+  s.bursts = {{0.5, 1}, {-2.0, 1}};
+  const SettingProblems problems = s.validate();
+  std::vector<std::string> texts;
+  for (const SettingProblem& p : problems) texts.push_back(p.text());
+  EXPECT_EQ(texts,
+            (std::vector<std::string>{
+                "rate: -1 is out of range (expected particles per second, a number from 0 to 1e9)",
+                "direction: is too short to normalise in double precision (expected a direction "
+                "[x, y, z] at least 1.5e-154 long)",
+                "normal: is too short to normalise in double precision (expected a direction [x, "
+                "y, z] at least 1.5e-154 long)",
+                "bursts.1.time: -2 is out of range (expected seconds, a number from 0 to 1e9)"}));
+  try {
+    const Emitter e(s, 0, 60);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "emitter " + problems.front().text());
+  }
+  s = EmitterSettings{};
+  s.direction = Eigen::Vector3d(0.0, 0.0, -1.5e-154);
+  s.shape = DiscShape{1.0, Eigen::Vector3d(1.5e-154, 0.0, 0.0)};
+  EXPECT_TRUE(s.validate().empty());
+  // Normalised to exactly unit vectors: the emitter shoots straight down.
+  s.speed = 2.0;
+  EXPECT_EQ(Emitter(s, 0, 60).sample(1, 0).velocity, Eigen::Vector3f(0.0f, 0.0f, -2.0f));
+}
+
 // ---- point lists (PointListShape): particles born at given points ----------------------------
 
 std::uint32_t floatBits(float x) { return std::bit_cast<std::uint32_t>(x); }

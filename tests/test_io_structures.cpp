@@ -522,6 +522,56 @@ stiffness = 1
              "in metres, each from -1e9 to 1e9, apart from start: a rope has a length)"}));
 }
 
+TEST(ioStructures, ShapesTooSmallForDoublePrecisionCannotBeBuilt) {
+  // What only the core refused, reported at load (run used to stop with exit 1 and no
+  // position): a rope whose end is 1e-200 m from its start has a length of 0 in double, and a
+  // cloth axis of 1e-200 cannot be normalised (it used to be called parallel to the other).
+  EXPECT_EQ(messages(head() + R"([[emitters]]
+type = "rope"
+start = [1e-200, 0, 0]
+end = [0, 1e-200, 0]
+count = 3
+stiffness = 1
+[[emitters]]
+type = "cloth"
+axis_u = [1e-200, 0, 0]
+width = 2
+height = 2
+spacing = 1
+stiffness = 1
+[[emitters]]
+type = "cloth"
+axis_u = [1, 0, 0]
+axis_v = [0, 0, 1e-160]
+width = 2
+height = 2
+spacing = 1
+stiffness = 1
+)"),
+            (Lines{"bad.toml:8:7: error: emitters.0.end: is 1.41e-200 m from start, "
+                   "too close to give the rope a length in double precision (expected [x, y, z] "
+                   "in metres, at least 1.5e-154 m from start)",
+                   "bad.toml:13:10: error: emitters.1.axis_u: is too short to normalise in double "
+                   "precision (expected a direction [x, y, z] at least 1.5e-154 long)",
+                   "bad.toml:21:10: error: emitters.2.axis_v: is too short to normalise in double "
+                   "precision (expected a direction [x, y, z] at least 1.5e-154 long)"}));
+  // The shortest the messages allow builds.
+  EXPECT_TRUE(messages(head() + R"([[emitters]]
+type = "rope"
+end = [0, 0, 1.5e-154]
+count = 3
+stiffness = 1
+[[emitters]]
+type = "cloth"
+axis_u = [1.5e-154, 0, 0]
+width = 2
+height = 2
+spacing = 1
+stiffness = 1
+)")
+                  .empty());
+}
+
 TEST(ioStructures, UnknownKeysGetSuggestions) {
   EXPECT_EQ(messages(head() + R"([[emitters]]
 type = "rope"

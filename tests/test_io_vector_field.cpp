@@ -306,6 +306,28 @@ TEST(ioVectorFieldParse, SequenceErrors) {
              "(expected frame_padding only with a file pattern)"}));
 }
 
+TEST(ioVectorFieldParse, BakeDirectionsMustNormaliseInDouble) {
+  // AnalyticField normalises a vortex's axis and a shear's direction and gradient in double;
+  // vectors too short for that used to pass check (which then failed, exit 1, loading the field
+  // for its lint) and stop run with exit 1 and no position.
+  EXPECT_EQ(messages(fieldEffect("mode = \"drag\"\nbake = { kind = \"vortex\", axis = [0, "
+                                 "1e-200, 0] }\n")),
+            (Lines{"fx.toml:9:34: error: forces.0.bake.axis: is too short to normalise in double "
+                   "precision (expected a direction [x, y, z] at least 1.5e-154 long)"}));
+  EXPECT_EQ(messages(fieldEffect("bake = { kind = \"shear\", direction = [1e-200, 0, 0], "
+                                 "gradient = [0, 1e-170, 0] }\n")),
+            (Lines{"fx.toml:8:38: error: forces.0.bake.direction: is too short to normalise in "
+                   "double precision (expected a direction [x, y, z] at least 1.5e-154 long)",
+                   "fx.toml:8:65: error: forces.0.bake.gradient: is too short to normalise in "
+                   "double precision (expected a direction [x, y, z] at least 1.5e-154 long)"}));
+  // Through an override, the message names it.
+  EXPECT_EQ(messages(fieldEffect("bake = { kind = \"vortex\" }\n"), {"forces.0.bake.axis=[0, 0, "
+                                                                     "1e-300]"}),
+            (Lines{"--set forces.0.bake.axis: error: forces.0.bake.axis: is too short to "
+                   "normalise in double precision (expected a direction [x, y, z] at least "
+                   "1.5e-154 long)"}));
+}
+
 TEST(ioVectorFieldParse, BakeErrors) {
   EXPECT_EQ(messages(fieldEffect("bake = { omega = 1 }\n")),
             (Lines{"fx.toml:8:8: error: forces.0.bake.kind: missing (expected field kind, one of: "

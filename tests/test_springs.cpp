@@ -18,6 +18,7 @@
 #include <memory>
 #include <numbers>
 #include <ostream>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -25,7 +26,9 @@
 
 #include "CoreTestSupport.h"
 #include "fields/SpringNetwork.h"
+#include "particles/NeighbourPairs.h"
 #include "particles/ParallelFor.h"
+#include "particles/Random.h"
 #include "particles/StateHash.h"
 #include "particles/Structure.h"
 
@@ -166,6 +169,176 @@ TEST(BuildStructure, RopeIsEvenlySpacedJoinedNeighbourToNeighbourAndPinnedAtItsS
   rope.count = 1;
   s.shape = rope;
   EXPECT_THROW(buildStructure(s, kSeed, 0), std::invalid_argument);
+}
+
+TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
+  StructureSettings s;
+  RopeShape rope;
+  rope.start = Eigen::Vector3d(1e-200, 0.0, 0.0);
+  rope.end = Eigen::Vector3d(0.0, 1e-200, 0.0);  // 1.41e-200 m apart: no length in double
+  s.shape = rope;
+  s.breakRatio = 0.5;
+  const SettingProblems problems = s.validate();
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].text(),
+            "break_ratio: 0.5 is out of range (expected 0 (never breaks) or a ratio of the rest "
+            "length > 1)");
+  EXPECT_EQ(problems[1].text(),
+            "end: is 1.41e-200 m from start, too close to give the rope a length in double "
+            "precision (expected [x, y, z] in metres, at least 1.5e-154 m from start)");
+  try {
+    buildStructure(s, kSeed, 0);
+    ADD_FAILURE() << "built";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "rope " + problems[0].text());
+  }
+  // Cloth axes: each must normalise, and then not be parallel.
+  ClothShape cloth;
+  cloth.axisU = Eigen::Vector3d(1e-200, 0.0, 0.0);
+  s = StructureSettings{};
+  s.shape = cloth;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].key, "axis_u");
+  EXPECT_FALSE(clothAxesParallel(cloth));  // too short to have a direction at all
+  cloth.axisU = Eigen::Vector3d(0.0, 3.0, 0.0);
+  s.shape = cloth;
+  EXPECT_TRUE(clothAxesParallel(cloth));
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(
+      s.validate()[0].text(),
+      "axis_v: is parallel to axis_u (expected a direction [x, y, z] not parallel to axis_u)");
+  // A structure's birth time is its own to check (the system turns it into a tick).
+  s = StructureSettings{};
+  s.time = -1.0;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].key, "time");
+}
+
+// ---- clusters: the pairs within the link radius (NeighbourPairs) ----------------------------
+
+// `n` points uniform in a ball of `radius` about `center`, from the counter-based generator.
+std::vector<Eigen::Vector3d> pointsInBall(int n, double radius,
+                                          const Eigen::Vector3d& center = Eigen::Vector3d::Zero()) {
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) {
+    const auto u = [&](std::uint32_t purpose) {
+      return randomUniform(RandomKey{kSeed, 7, static_cast<std::uint64_t>(i), purpose});
+    };
+    const double z = 1.0 - 2.0 * u(1), rxy = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = 2.0 * kPi * u(2), r = radius * std::cbrt(u(3));
+    points.push_back(center + r * Eigen::Vector3d(rxy * std::cos(phi), rxy * std::sin(phi), z));
+  }
+  return points;
+}
+
+// Every pair, compared as neighbourPairs promises: (points[j] − points[i]).norm() <= distance.
+std::vector<std::pair<int, int>> bruteForcePairs(const std::vector<Eigen::Vector3d>& points,
+                                                 double distance) {
+  std::vector<std::pair<int, int>> pairs;
+  const auto n = static_cast<int>(points.size());
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      if ((points[j] - points[i]).norm() <= distance) pairs.emplace_back(i, j);
+    }
+  }
+  return pairs;
+}
+
+TEST(NeighbourPairs, SameListAsComparingEveryPair) {
+  const std::vector<Eigen::Vector3d> ball = pointsInBall(400, 1.0, Eigen::Vector3d(3.0, -2.0, 1.0));
+  // From chance pairs to every pair joined, and a distance far below any gap.
+  for (const double distance : {1e-30, 0.05, 0.17, 0.5, 1.3, 2.5}) {
+    const std::vector<std::pair<int, int>> expected = bruteForcePairs(ball, distance);
+    EXPECT_EQ(neighbourPairs(ball, distance), expected) << distance;
+    if (distance == 0.17) {
+      // 399 · (x³ − 9x⁴/16 + x⁶/32) = 1.77 neighbours a point at x = 0.17 (clusterNeighbours):
+      // about 355 pairs.
+      EXPECT_GT(expected.size(), 300u);
+    }
+    if (distance == 2.5) {
+      EXPECT_EQ(expected.size(), 400u * 399u / 2u);
+    }
+  }
+  // Pairs exactly `distance` apart along the axes, where a cell a hair too narrow would part
+  // them, on a lattice shifted off the cell grid's origin; and points that coincide, found even
+  // with a link radius of 1e-30.
+  std::vector<Eigen::Vector3d> lattice;
+  for (int x = 0; x < 7; ++x) {
+    for (int y = 0; y < 6; ++y) {
+      for (int z = 0; z < 5; ++z) lattice.push_back(Eigen::Vector3d(x, y, z) * 0.1 + ball[x]);
+    }
+  }
+  for (const double distance : {0.1, 0.1 * std::sqrt(2.0), 0.2, 0.3}) {
+    EXPECT_EQ(neighbourPairs(lattice, distance), bruteForcePairs(lattice, distance)) << distance;
+  }
+  std::vector<Eigen::Vector3d> repeated(ball.begin(), ball.begin() + 100);
+  repeated.insert(repeated.end(), ball.begin() + 50, ball.begin() + 150);
+  const std::vector<std::pair<int, int>> twins = neighbourPairs(repeated, 1e-30);
+  EXPECT_EQ(twins, bruteForcePairs(repeated, 1e-30));
+  EXPECT_EQ(twins.size(), 50u);  // ball[50..99] twice
+  // Degenerate boxes: one point, every point in one place, points along a line.
+  EXPECT_TRUE(neighbourPairs({ball[0]}, 1.0).empty());
+  const std::vector<Eigen::Vector3d> same(30, ball[3]);
+  EXPECT_EQ(neighbourPairs(same, 1e-30).size(), 30u * 29u / 2u);
+  std::vector<Eigen::Vector3d> line;
+  for (int i = 0; i < 300; ++i) line.push_back(Eigen::Vector3d(0.01 * i, 0.0, 0.0));
+  EXPECT_EQ(neighbourPairs(line, 0.025), bruteForcePairs(line, 0.025));
+}
+
+TEST(NeighbourPairs, WorkStaysLinearForATinyDistance) {
+  // A link radius of 1e-30 in a ball of 1 m: the cells widen to about ∛N per axis instead of
+  // 1e30 per metre. 40 000 points fill ∛40000 → 35³ cells, of which the ball covers π/6, so
+  // about 1.8 points a cell; each point is compared with the later points of 27 cells, about
+  // 27 · 1.8 / 2 ≈ 24 a point, where comparing every pair would be 20 000 a point.
+  const std::vector<Eigen::Vector3d> ball = pointsInBall(40'000, 1.0);
+  std::uint64_t compared = 0;
+  EXPECT_TRUE(neighbourPairs(ball, 1e-30, &compared).empty());
+  EXPECT_GT(compared, 0u);
+  EXPECT_LT(compared, 40u * 40'000u);
+  // At a link radius the cells can be as wide as, the work is a bounded multiple of the pairs
+  // found: a point's 27 cells hold 27 / (4π/3) ≈ 6.4 times its neighbours' ball.
+  std::uint64_t comparedNear = 0;
+  const std::vector<std::pair<int, int>> near = neighbourPairs(ball, 0.1, &comparedNear);
+  EXPECT_GT(near.size(), 40'000u);
+  EXPECT_LT(comparedNear, 8u * near.size());
+}
+
+TEST(BuildStructure, ClusterJoinsThePairsBornWithinTheLinkRadius) {
+  StructureSettings s;
+  const Eigen::Vector3d center(0.5, 4.0, -1.0);
+  s.shape = ClusterShape{center, 0.3, 300, 0.08};
+  const StructureBuild b = buildStructure(s, kSeed, 2);
+  ASSERT_EQ(b.particles.size(), 300u);
+  // The particles are the double positions rounded to float; pairs whose float distance is
+  // within a rounding of the link radius could go either way, every other pair is decided.
+  const double rounding = 4e-7;
+  std::set<std::pair<std::uint64_t, std::uint64_t>> joined;
+  for (const Spring& sp : b.springs) {
+    EXPECT_LT(sp.a, sp.b);
+    joined.emplace(sp.a, sp.b);
+  }
+  EXPECT_EQ(joined.size(), b.springs.size());  // no pair twice
+  EXPECT_TRUE(std::is_sorted(
+      b.springs.begin(), b.springs.end(),
+      [](const Spring& x, const Spring& y) { return std::pair(x.a, x.b) < std::pair(y.a, y.b); }));
+  std::size_t decided = 0;
+  for (std::uint64_t i = 0; i < 300; ++i) {
+    for (std::uint64_t j = i + 1; j < 300; ++j) {
+      const double d =
+          (b.particles[j].position.cast<double>() - b.particles[i].position.cast<double>()).norm();
+      if (std::abs(d - 0.08) <= rounding) continue;
+      ++decided;
+      EXPECT_EQ(joined.count({i, j}) == 1, d < 0.08) << i << "-" << j << " at " << d;
+    }
+  }
+  EXPECT_GT(decided, 44'000u);
+  EXPECT_GT(b.springs.size(), 300u);
+  // A link radius of 1e-30 (valid: > 0) joins nothing, and builds without a cell index beyond
+  // the range of an integer (the sanitizer build's float-cast-overflow check guards this).
+  s.shape = ClusterShape{center, 0.3, 2000, 1e-30};
+  const StructureBuild tiny = buildStructure(s, kSeed, 2);
+  EXPECT_EQ(tiny.particles.size(), 2000u);
+  EXPECT_TRUE(tiny.springs.empty());
 }
 
 TEST(BuildStructure, ClothHasStructuralShearAndBendSpringsWithTheirScales) {

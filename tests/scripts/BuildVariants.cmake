@@ -109,8 +109,8 @@ function(append_cell out text width)
 endfunction()
 
 # The hash `tickfx` gives for `sample`, or a word saying why there is none. 60 fps frames take the
-# driver's path, as a user's run does, where the golden test takes stepTicks. A tick dropped by the
-# cap would give the hash of an earlier tick, so a drop is a failure of its own.
+# driver's path, as a user's run does, where the golden test takes stepTicks. The run must have run
+# exactly 2 s of ticks (`run` never drops one): any other count is a failure of its own.
 function(hash_of out tickfx sample)
   if(NOT tickfx)
     set(${out} "no-build" PARENT_SCOPE)
@@ -127,11 +127,18 @@ function(hash_of out tickfx sample)
   if(NOT rc EQUAL 0 OR NOT hash)
     message("${tickfx} run samples/${sample} failed (${rc}):\n${stdout}\n${stderr}")
     set(${out} "run-failed" PARENT_SCOPE)
-  elseif(NOT stdout MATCHES "ticks dropped by the cap \\([^)]*\\): 0\n")
-    message("${tickfx} run samples/${sample}: the cap dropped ticks at 60 fps:\n${stdout}")
-    set(${out} "dropped-ticks" PARENT_SCOPE)
+  elseif(NOT stdout MATCHES "\\(([0-9]+) ticks at ([0-9]+) Hz")
+    message("${tickfx} run samples/${sample}: no tick count in the summary:\n${stdout}")
+    set(${out} "no-tick-count" PARENT_SCOPE)
   else()
-    set(${out} ${hash} PARENT_SCOPE)
+    set(ran ${CMAKE_MATCH_1})
+    math(EXPR twoSeconds "2 * ${CMAKE_MATCH_2}")
+    if(NOT ran EQUAL twoSeconds)
+      message("${tickfx} run samples/${sample}: ran ${ran} ticks, not 2 s:\n${stdout}")
+      set(${out} "wrong-ticks" PARENT_SCOPE)
+    else()
+      set(${out} ${hash} PARENT_SCOPE)
+    endif()
   endif()
 endfunction()
 
