@@ -36,8 +36,8 @@ SettingProblems EmitterSettings::validate() const {
   check(std::isfinite(start) && start >= 0.0 && start <= 1.0e9, "start", start,
         "seconds, a number from 0 to 1e9");
   if (std::isfinite(stop) && stop > 1.0e9) {
-    out.push_back({"stop", settingNumber(stop) + " is out of range",
-                   "seconds, a number from start to 1e9"});
+    out.push_back(
+        {"stop", settingNumber(stop) + " is out of range", "seconds, a number from start to 1e9"});
   } else if (!(stop >= start)) {  // infinity: never stops
     out.push_back({"stop",
                    std::isnan(stop)

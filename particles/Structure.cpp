@@ -29,10 +29,14 @@ struct Builder {
     init.lifetime = static_cast<float>(s.lifetime);
     out.particles.push_back(init);
   }
-  // Rest length from the positions as built (in double), so a structure starts unstressed.
-  void spring(std::size_t a, std::size_t b, double stiffness, const Eigen::Vector3d& pa,
-              const Eigen::Vector3d& pb) {
-    out.springs.push_back(Spring{a, b, static_cast<float>((pb - pa).norm()),
+  // Rest length from the particles' stored float positions, by the float arithmetic the spring
+  // network measures lengths with, so a structure starts unstressed to the bit wherever it is
+  // (from the double positions, a cloth far from the origin started under stress).
+  void spring(std::size_t a, std::size_t b, double stiffness) {
+    const Eigen::Vector3f& pa = out.particles[a].position;
+    const Eigen::Vector3f& pb = out.particles[b].position;
+    const float dx = pb.x() - pa.x(), dy = pb.y() - pa.y(), dz = pb.z() - pa.z();
+    out.springs.push_back(Spring{a, b, std::sqrt(dx * dx + dy * dy + dz * dz),
                                  static_cast<float>(stiffness), static_cast<float>(s.damping),
                                  static_cast<float>(s.breakRatio)});
   }
@@ -45,7 +49,7 @@ void buildRope(Builder& b, const RopeShape& rope) {
                  (rope.end - rope.start) * (static_cast<double>(i) / (rope.count - 1)));
     b.particle(at.back(), (i == 0 && rope.pinStart) || (i == rope.count - 1 && rope.pinEnd));
   }
-  for (int i = 0; i + 1 < rope.count; ++i) b.spring(i, i + 1, b.s.stiffness, at[i], at[i + 1]);
+  for (int i = 0; i + 1 < rope.count; ++i) b.spring(i, i + 1, b.s.stiffness);
 }
 
 void buildCloth(Builder& b, const ClothShape& c) {
@@ -72,7 +76,7 @@ void buildCloth(Builder& b, const ClothShape& c) {
     const bool inside =
         c0 >= 0 && c0 < w && r0 >= 0 && r0 < h && c1 >= 0 && c1 < w && r1 >= 0 && r1 < h;
     if (!inside || stiffness <= 0.0) return;
-    b.spring(index(c0, r0), index(c1, r1), stiffness, at[index(c0, r0)], at[index(c1, r1)]);
+    b.spring(index(c0, r0), index(c1, r1), stiffness);
   };
   // Structural, then shear, then bend, each row by row: the order of the springs is part of the
   // sum each particle forms, so it is fixed here.
@@ -114,7 +118,7 @@ void buildCluster(Builder& b, const ClusterShape& c, std::uint64_t seed, std::ui
   // Every pair born within the link radius, in (i, j) order: the order of the springs is part
   // of the sum each particle forms.
   const std::vector<std::pair<int, int>> pairs = neighbourPairs(at, c.linkRadius);
-  for (const auto& [i, j] : pairs) b.spring(i, j, b.s.stiffness, at[i], at[j]);
+  for (const auto& [i, j] : pairs) b.spring(i, j, b.s.stiffness);
 }
 
 // The problems of each shape, keyed as effect files write them.

@@ -244,6 +244,34 @@ std::vector<std::pair<int, int>> bruteForcePairs(const std::vector<Eigen::Vector
   return pairs;
 }
 
+// Regression (issue 10, item 16): rest lengths came from the double positions while particles
+// are float, so a cloth far from the origin started under stress and moved on its own. From the
+// stored floats, a structure at rest under no force stays exactly at rest, wherever it is.
+TEST(BuildStructure, AStructureFarFromTheOriginStartsUnstressed) {
+  for (const Eigen::Vector3d& origin :
+       {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(1.0e4, -3.0e3, 7.7e3),
+        Eigen::Vector3d(123.456, 0.1, -987.6)}) {
+    StructureSettings cloth;
+    ClothShape shape;
+    shape.origin = origin;
+    shape.width = 12;
+    shape.height = 9;
+    shape.spacing = 0.1;
+    shape.pins = ClothPins::None;
+    cloth.shape = shape;
+    cloth.stiffness = 1000.0;
+    cloth.mass = 0.01;
+    ParticleSystem system(test::referenceSettings(), {}, ForceSet{}, {cloth});
+    system.stepTicks(30);
+    const ParticlePool& pool = system.pool();
+    ASSERT_EQ(pool.size(), 108u);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE((pool.velocity()[c].head(108) == 0.0f).all())
+          << "a cloth at " << origin.transpose() << " moved by itself";
+    }
+  }
+}
+
 TEST(NeighbourPairs, SameListAsComparingEveryPair) {
   const std::vector<Eigen::Vector3d> ball = pointsInBall(400, 1.0, Eigen::Vector3d(3.0, -2.0, 1.0));
   // From chance pairs to every pair joined, and a distance far below any gap.
