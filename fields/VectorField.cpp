@@ -172,9 +172,9 @@ struct ImplT final : VectorField::Impl {
   };
 
   template <class Sampler>
-  void add(const VectorField::Settings& s, const Frames& frames, const ForceInput& in,
+  void add(const VectorField::Settings& s, const Frames& between, const ForceInput& in,
            RowRange rows, Vec3Rows& out) const {
-    Blend<Sampler> field(*this, s, frames);
+    Blend<Sampler> field(*this, s, between);
     const bool drag = s.mode == VectorField::Mode::Drag;
     const ConstVec3Rows p = in.position.rows(rows);
     const ConstVec3Rows v = in.velocity.rows(rows);
@@ -204,22 +204,22 @@ struct ImplT final : VectorField::Impl {
     return quadratic ? f(vt::QuadraticSampler{}) : f(LeafBoxSampler{});
   }
 
-  void accumulate(const VectorField::Settings& s, const Frames& frames, const ForceInput& in,
+  void accumulate(const VectorField::Settings& s, const Frames& between, const ForceInput& in,
                   RowRange rows, Vec3Rows& out) const override {
-    withSampler(s, [&](auto sampler) { add<decltype(sampler)>(s, frames, in, rows, out); });
+    withSampler(s, [&](auto sampler) { add<decltype(sampler)>(s, between, in, rows, out); });
   }
 
-  Eigen::Vector3f sample(const VectorField::Settings& s, const Frames& frames,
+  Eigen::Vector3f sample(const VectorField::Settings& s, const Frames& between,
                          const Eigen::Vector3d& world) const override {
     return withSampler(s, [&](auto sampler) {
-      Blend<decltype(sampler)> field(*this, s, frames);
+      Blend<decltype(sampler)> field(*this, s, between);
       return field(openvdb::Vec3d(world.x(), world.y(), world.z()));
     });
   }
 
-  void flagOutside(const Frames& frames, const ForceInput& in, RowRange rows,
+  void flagOutside(const Frames& between, const ForceInput& in, RowRange rows,
                    std::uint8_t* dead) const override {
-    Frame first(*grids[frames.first]);
+    Frame first(*grids[between.first]);
     const ConstVec3Rows p = in.position.rows(rows);
     for (Eigen::Index j = 0; j < rows.count(); ++j) {
       const openvdb::Vec3d index = first.toIndex(openvdb::Vec3d(p.x[j], p.y[j], p.z[j]));
