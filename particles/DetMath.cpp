@@ -1,13 +1,15 @@
 #include "particles/DetMath.h"
 
+#include <boost/multiprecision/cpp_int.hpp>
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 namespace tickfx::det {
 namespace {
 
 // π/2 split into three parts whose products with a small integer are exact (Cody–Waite), so the
-// reduced argument keeps full precision for |x| up to about 1e5.
+// reduced argument keeps full precision while k · kPio2Hi is exact (below kCodyWaiteLimit).
 constexpr double kPio2Hi = 1.57079632673412561417e+00;
 constexpr double kPio2Mid = 6.07710050630396597660e-11;
 constexpr double kPio2Lo = 2.02226624879595063154e-21;
@@ -45,7 +47,48 @@ struct Reduced {
   std::int64_t quadrant;
 };
 
+// ⌊2/π · 2^1216⌋ in hexadecimal. For any double x = m · 2^e (m < 2^53, e <= 971) the product with
+// it keeps at least 245 bits below the binary point, and the bits of 2/π it leaves out move
+// x · 2/π by less than 2^-192: far below the 2^-61 that the closest double comes to a multiple
+// of π/2, so the quadrant and the leading bits of the remainder are exact.
+constexpr const char* kTwoOverPiHex =
+    "a2f9836e4e441529fc2757d1f534ddc0db6295993c439041fe5163abdebbc561"
+    "b7246e3a424dd2e006492eea09d1921cfe1deb1cb129a73ee88235f52ebb4484"
+    "e99c7026b45f7e413991d639835339f49c845f8bbdf9283b1ff897ffde05980f"
+    "ef2f118b5a0a6d1f6d367ecf27cb09b74f463f669e5fea2d7527bac7ebe5f17b"
+    "3d0739f78a5292ea6bfb5fb11f8d5d0856033046fc7b6bab";
+
+// Cody–Waite is exact while k · kPio2Hi is (kPio2Hi has 33 bits: k < 2^20); past 2^19 the
+// reduction multiplies by 2/π in exact integers instead (Payne–Hanek).
+constexpr double kCodyWaiteLimit = 524288.0;  // 2^19
+
+Reduced reduceLarge(double x) {
+  using Big = boost::multiprecision::cpp_int;
+  static const Big twoOverPi(std::string("0x") + kTwoOverPiHex);
+  constexpr int kBits = 1216;
+  int e = 0;
+  const double m = std::frexp(std::fabs(x), &e);
+  const auto mantissa = static_cast<std::uint64_t>(std::ldexp(m, 53));
+  const int shift = kBits - (e - 53);  // |x| · 2/π = product / 2^shift
+  const Big product = Big(mantissa) * twoOverPi;
+  const Big whole = product >> shift;
+  std::int64_t quadrant = static_cast<std::int64_t>(static_cast<unsigned>(whole & 3));
+  // The fraction's leading 128 bits, as f / 2^128 in [0, 1); past one half, the next quadrant.
+  const Big fraction = (product - (whole << shift)) >> (shift - 128);
+  const Big half = Big(1) << 127;
+  double f = 0.0;
+  if (fraction >= half) {
+    quadrant += 1;
+    f = -std::ldexp(((Big(1) << 128) - fraction).convert_to<double>(), -128);
+  } else {
+    f = std::ldexp(fraction.convert_to<double>(), -128);
+  }
+  const double r = f * (0.5 * kPi);
+  return x < 0.0 ? Reduced{-r, -quadrant} : Reduced{r, quadrant};
+}
+
 Reduced reduce(double x) {
+  if (std::fabs(x) >= kCodyWaiteLimit) return reduceLarge(x);
   // nearbyint under the default rounding mode is exact and the same everywhere.
   const double k = std::nearbyint(x * kTwoOverPi);
   const double r = ((x - k * kPio2Hi) - k * kPio2Mid) - k * kPio2Lo;

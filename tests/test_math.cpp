@@ -5,7 +5,9 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <vector>
 
 #include "particles/DetMath.h"
 #include "particles/Random.h"
@@ -49,6 +51,50 @@ TEST(DetMath, SinAndCosStayAccurateNearTheirZeros) {
     const double y = (k + 0.5) * det::kPi;
     EXPECT_NEAR(det::cos(y), std::cos(y), 4.0 * ulpOf(std::cos(y))) << "cos(" << k + 0.5 << "π)";
   }
+}
+
+// Regression (issue 10, item 14): past about 1e5 the reduction lost its precision and past ~1e15
+// the result left [−1, 1] (curl noise at 1e9 rad/m over 1e8 m stored |u| ≈ 9e5); past ~1.4e19
+// the quadrant's cast to int64 was undefined. Now the reduction is exact for every double:
+// checked against long double (glibc reduces sinl exactly) from 2^19 to 1e300.
+TEST(DetMath, SinAndCosAreAccurateForEveryFiniteArgument) {
+  std::vector<double> xs;
+  for (double x = 524288.0; x < 1e300; x *= 1.37) xs.push_back(x);
+  for (int e = 19; e < 1024; e += 7) xs.push_back(std::ldexp(1.0, e));
+  for (double k : {1e6, 3.0e8, 7.7e12, 1e17, 1e22}) {
+    xs.push_back(k * det::kPi / 2.0);  // near a multiple of π/2: a tiny remainder
+    xs.push_back(std::nextafter(k * det::kPi, 0.0));
+  }
+  xs.push_back(std::numeric_limits<double>::max());
+  xs.push_back(6381956970095103.0 * std::ldexp(1.0, 797));  // the double nearest a multiple of π/2
+  int checked = 0;
+  for (double x : xs) {
+    for (double sx : {x, -x}) {
+      const long double s = sinl(static_cast<long double>(sx));
+      const long double c = cosl(static_cast<long double>(sx));
+      ASSERT_LE(std::fabs(det::sin(sx)), 1.0) << sx;
+      ASSERT_LE(std::fabs(det::cos(sx)), 1.0) << sx;
+      ASSERT_NEAR(det::sin(sx), static_cast<double>(s), 5e-14) << sx;
+      ASSERT_NEAR(det::cos(sx), static_cast<double>(c), 5e-14) << sx;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 2000);
+}
+
+// Below 2^19 the reduction is the Cody–Waite one it always was: the same bits as before (the
+// golden hashes of the wind and of the emitters' directions depend on them).
+TEST(DetMath, SmallArgumentsKeepTheirBits) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (int i = -20000; i <= 20000; ++i) {
+    const double x = i * 26.2143;  // to ±524286
+    for (double v : {det::sin(x), det::cos(x)}) {
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &v, sizeof bits);
+      h = (h ^ bits) * 0x100000001b3ULL;
+    }
+  }
+  EXPECT_EQ(h, 0xe57d4ee2f35d3009ULL) << std::hex << h;  // the value before the change
 }
 
 TEST(DetMath, CbrtCubesBackToItsArgument) {
