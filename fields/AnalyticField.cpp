@@ -1,11 +1,15 @@
 #include "fields/AnalyticField.h"
 
 #include <openvdb/openvdb.h>
+#include <unistd.h>
 #include <Eigen/Geometry>
 
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "fields/VectorFieldGrids.h"
@@ -236,7 +240,11 @@ void bakeField(const AnalyticField& field, const BakeSettings& s, const std::str
                double time) {
   const openvdb::Vec3fGrid::Ptr grid = bakeGrid(field, s, time);
   // Written beside the target and renamed over it: a failed bake leaves no half-written file.
-  const std::string partial = path + ".partial";
+  // The temporary's name is the process's and the call's own, so bakes of one file at once (two
+  // processes, or two threads) never write into each other's.
+  static std::atomic<std::uint64_t> calls{0};
+  const std::string partial =
+      path + ".partial" + std::to_string(::getpid()) + "-" + std::to_string(calls.fetch_add(1));
   try {
     openvdb::io::File file(partial);
     file.write(openvdb::GridCPtrVec{grid});

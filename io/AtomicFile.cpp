@@ -1,7 +1,9 @@
 #include "io/AtomicFile.h"
 
 #include <unistd.h>
+#include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -24,9 +26,11 @@ void writeFileAtomically(const std::filesystem::path& path,
 
 void writeFileAtomicallyByName(const std::filesystem::path& path,
                                const std::function<void(const std::filesystem::path&)>& write) {
-  // The pid keeps two processes writing the same cache folder from sharing a temporary.
+  // The pid keeps two processes writing the same cache folder from sharing a temporary, and the
+  // call count two threads of one process writing the same path.
+  static std::atomic<std::uint64_t> calls{0};
   std::filesystem::path temp = path;
-  temp += ".tmp" + std::to_string(::getpid());
+  temp += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(calls.fetch_add(1));
   try {
     write(temp);
     std::filesystem::rename(temp, path);

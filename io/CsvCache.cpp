@@ -58,8 +58,14 @@ FrameData readCsvCache(const std::filesystem::path& path) {
     throw std::runtime_error(path.string() + ":" + std::to_string(line) + ": " + what);
   };
   std::string line;
-  if (!std::getline(in, line) || line.rfind(kFixedHeader, 0) != 0)
-    fail(1, "not a tickfx CSV cache header");
+  // Lines may end in CRLF (a cache that went through a Windows tool): the CR is not part of the
+  // last field.
+  const auto next = [&] {
+    if (!std::getline(in, line)) return false;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  if (!next() || line.rfind(kFixedHeader, 0) != 0) fail(1, "not a tickfx CSV cache header");
   FrameData frame;
   const std::vector<std::string> header = splitCommas(line);
   frame.attributeNames.assign(header.begin() + 1 + kFixedFloatColumns, header.end());
@@ -67,7 +73,7 @@ FrameData readCsvCache(const std::filesystem::path& path) {
 
   std::vector<std::vector<float>> values(columns - 1);
   std::size_t lineNumber = 1;
-  while (std::getline(in, line)) {
+  while (next()) {
     ++lineNumber;
     const std::vector<std::string> fields = splitCommas(line);
     if (fields.size() != columns)

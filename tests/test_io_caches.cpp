@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <numeric>
 
@@ -80,6 +81,19 @@ TEST_F(Caches, CsvRoundTripIsBitExact) {
   std::string header;
   std::getline(in, header);
   EXPECT_EQ(header, "id,px,py,pz,vx,vy,vz,age,life,mass,heat");
+}
+
+// Regression (issue 10, item 12): a CSV cache with CRLF line ends (one that went through a
+// Windows tool) failed with "bad number '0.002...\r'". It reads back the same bits.
+TEST_F(Caches, CsvWithCrlfLineEndsReadsBackTheSameBits) {
+  const FrameData frame = sampleFrame();
+  writeCsvCache(frame, dir_ / "f.csv");
+  std::ifstream in(dir_ / "f.csv", std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string crlf;
+  for (char ch : text) crlf += ch == '\n' ? std::string("\r\n") : std::string(1, ch);
+  std::ofstream(dir_ / "crlf.csv", std::ios::binary) << crlf;
+  expectSameBits(readCsvCache(dir_ / "crlf.csv"), frame);
 }
 
 TEST_F(Caches, PlyRoundTripIsBitExactWithHeaderAndMetadata) {

@@ -7,11 +7,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fields/AnalyticField.h"
@@ -501,6 +503,37 @@ TEST(ioVectorFieldParse, OverridesReachEveryKeyOfAField) {
   EXPECT_EQ(messages(text, {"forces.0.bake.kind=uniform"}),
             (Lines{"--set forces.0.bake.kind: error: forces.0.bake: given together with file "
                    "(expected either file or bake)"}));
+}
+
+// Regression (issue 10, item 12): every bake of a file went through the one temporary
+// PATH.partial, so two bakes of one file at once wrote into each other's. Eight at once now all
+// succeed and leave one whole file and no temporary.
+TEST_F(ioVectorField, BakesOfOneFileAtOnceDoNotShareATemporary) {
+  fs::create_directories(path("fields"));
+  std::vector<std::thread> bakes;
+  std::atomic<int> failed{0};
+  for (int i = 0; i < 8; ++i) {
+    bakes.emplace_back([&, i] {
+      try {
+        bakeField(AnalyticField::uniform({1.0 + i, 0.0, 0.0}), BakeSettings{},
+                  path("fields/same.vdb"));
+      } catch (const std::exception&) {
+        ++failed;
+      }
+    });
+  }
+  for (std::thread& t : bakes) t.join();
+  EXPECT_EQ(failed.load(), 0);
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(path("fields"))) {
+    ++files;
+    EXPECT_EQ(entry.path().filename(), "same.vdb") << "a temporary was left behind";
+  }
+  EXPECT_EQ(files, 1);
+  VectorField::Settings s;
+  s.file = path("fields/same.vdb");
+  const float x = VectorField(s).sample(Eigen::Vector3f::Zero()).x();
+  EXPECT_TRUE(x >= 1.0f && x <= 8.0f && x == std::floor(x)) << "one whole bake: " << x;
 }
 
 // ---- lint -------------------------------------------------------------------------------------
