@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -14,11 +15,13 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
 #include "fields/VdbGridFile.h"
 #include "io/AtomicFile.h"
+#include "io/Checkpoint.h"
 
 namespace tickfx::io {
 namespace {
@@ -209,6 +212,35 @@ bool isIdentity(const openvdb::math::Transform& transform) {
   return true;
 }
 
+// OpenVDB stamps every file with a random UUID (36 characters after the header's version fields),
+// so two identical runs would write different bytes. A cache's UUID is made from what the file
+// holds instead: the effect's fingerprint, its seed and the frame (an RFC 9562 version-8 UUID).
+// The header layout is checked first; a layout this build does not know is left as written.
+void stampUuid(const std::filesystem::path& file, const VdbCacheMetadata& meta,
+               std::int64_t frame) {
+  constexpr std::streamoff kUuidAt = 21;
+  constexpr std::size_t kUuidLength = 36;
+  std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+  char head[kUuidAt + kUuidLength] = {};
+  if (!io.read(head, sizeof head)) return;
+  const std::string_view uuid(head + kUuidAt, kUuidLength);
+  if (std::string_view(head, 4) != " BDV" || uuid[8] != '-' || uuid[13] != '-' || uuid[18] != '-' ||
+      uuid[23] != '-') {
+    return;
+  }
+  const std::string key =
+      meta.effectHash + '/' + std::to_string(meta.seed) + '/' + std::to_string(frame);
+  const std::uint64_t hi = fingerprint(key + "/hi"), lo = fingerprint(key + "/lo");
+  char text[kUuidLength + 1];
+  std::snprintf(text, sizeof text, "%08x-%04x-8%03x-%04x-%012llx", static_cast<unsigned>(hi >> 32),
+                static_cast<unsigned>((hi >> 16) & 0xffff), static_cast<unsigned>(hi & 0xfff),
+                static_cast<unsigned>(0x8000 | ((lo >> 48) & 0x3fff)),
+                static_cast<unsigned long long>(lo & 0xffffffffffffULL));
+  io.seekp(kUuidAt);
+  io.write(text, static_cast<std::streamsize>(kUuidLength));
+  if (!io.flush()) throw std::runtime_error(file.string() + ": cannot stamp the file's UUID");
+}
+
 }  // namespace
 
 void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
@@ -220,6 +252,7 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
       openvdb::io::File file(temp.string());
       file.write(grids);
       file.close();
+      stampUuid(temp, meta, frame.frame);
     } catch (const std::exception& e) {
       throw std::runtime_error(path.string() + ": cannot write the VDB points cache (" + e.what() +
                                ")");
