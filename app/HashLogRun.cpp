@@ -27,7 +27,10 @@ std::string cpuModel() {
 
 std::string compilerName() {
 #if defined(__clang__)
-  return "clang++ " __clang_version__;
+  // __clang_version__ ends in a space ("14.0.6 ").
+  std::string name = "clang++ " __clang_version__;
+  name.erase(name.find_last_not_of(' ') + 1);
+  return name;
 #elif defined(__GNUC__)
   return "g++ " __VERSION__;
 #else
