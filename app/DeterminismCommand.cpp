@@ -1,11 +1,17 @@
 // tickfx determinism: one effect under every frame schedule and thread count of the guarantee,
-// a table of state hashes, and a verdict a user's own CI can act on.
+// a table of state hashes, and a verdict a user's own CI can act on; or one run recorded as a hash
+// log, or compared with a log recorded on another machine.
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 
 #include "app/Commands.h"
 #include "app/DeterminismCheck.h"
+#include "app/HashLogRun.h"
+#include "io/AtomicFile.h"
+#include "io/Checkpoint.h"
 #include "io/EffectBuilder.h"
 #include "io/EffectParser.h"
 #include "io/FrameTimes.h"
@@ -24,7 +30,23 @@ constexpr const char* kHelp =
     "(default 1,2,3,8). The cap on ticks per frame is lifted. It hashes the state after every "
     "tick\n"
     "and prints the hashes at 1 s, 2 s and S. Exit code 0 when every run agrees at every tick,\n"
-    "1 otherwise (naming the first tick where they part), 2 for usage or effect errors.\n";
+    "1 otherwise (naming the first tick where they part), 2 for usage or effect errors.\n"
+    "\n"
+    "usage: tickfx determinism EFFECT.toml --record FILE [--seconds S] [--fps F]\n"
+    "                          [--snapshot-at TICKS] [--set key.path=value]...\n"
+    "       tickfx determinism EFFECT.toml --compare FILE [--set key.path=value]...\n"
+    "\n"
+    "--record runs EFFECT.toml once for S seconds (default 5) in frames of 1/F s (default: the\n"
+    "effect's output fps) and writes FILE, a hash log: a header naming this machine, CPU,\n"
+    "compiler, build and tickfx version and the effect (its fingerprint: the file's bytes and\n"
+    "every --set; its seed and step rate), then after every tick the state hash and one hash per\n"
+    "column (counters, id, birth_tick, position.x, ...), and after every frame the hash of what\n"
+    "it shows. --snapshot-at 120,121 also stores the whole state after those ticks.\n"
+    "--compare runs the same effect with the same --set, length and frames on this machine and\n"
+    "prints 'identical through tick N' (exit 0), or the first tick where the runs part with the\n"
+    "columns that differ there (exit 1); when the log holds a snapshot of that tick, also the\n"
+    "first particle id and column that differ with both values in hex. A log of another step\n"
+    "rate, seed or effect, or one truncated or garbled, is refused (exit 2).\n";
 
 std::vector<int> parseThreadList(const std::string& text) {
   std::vector<int> threads;
@@ -35,6 +57,182 @@ std::vector<int> parseThreadList(const std::string& text) {
   }
   if (threads.empty()) throw UsageError("determinism: --threads: empty list");
   return threads;
+}
+
+std::vector<std::int64_t> parseTickList(const std::string& text) {
+  std::vector<std::int64_t> ticks;
+  std::stringstream list(text);
+  std::string item;
+  while (std::getline(list, item, ','))
+    ticks.push_back(parseInteger(item, "determinism: --snapshot-at", 1, INT64_MAX));
+  if (ticks.empty()) throw UsageError("determinism: --snapshot-at: empty list");
+  std::sort(ticks.begin(), ticks.end());
+  return ticks;
+}
+
+// "0x3f800000 (1)" for a float column's bits, "0x000000000000002a" for id and birth_tick.
+std::string describeBits(const std::string& column, std::uint64_t bits) {
+  char text[64];
+  if (column == "id" || column == "birth_tick") {
+    std::snprintf(text, sizeof text, "0x%016" PRIx64, bits);
+  } else {
+    const auto b = static_cast<std::uint32_t>(bits);
+    float value = 0.0f;
+    std::memcpy(&value, &b, sizeof value);
+    std::snprintf(text, sizeof text, "0x%08" PRIx32 " (%.9g)", b, static_cast<double>(value));
+  }
+  return text;
+}
+
+std::string describeBuild(const io::HashLogHeader& h) {
+  return "tickfx " + h.version + ", " + h.compiler + ", " + h.build + ", " + h.machine + ", " +
+         h.cpu;
+}
+
+// What --record and --compare were given besides the effect.
+struct LogOptions {
+  std::string logPath;
+  double seconds = 5.0;
+  std::optional<FrameRate> fps;
+  std::vector<std::int64_t> snapshots;
+};
+
+int recordCommand(const io::EffectSettings& effect, const std::string& effectPath,
+                  const std::vector<std::string>& overrides, const LogOptions& options) {
+  const std::string& logPath = options.logPath;
+  const FrameRate fps = options.fps.value_or(effect.output.fps);
+  const double seconds = options.seconds;
+  const std::vector<std::int64_t>& snapshots = options.snapshots;
+
+  io::HashLogHeader header = describeThisBuild();
+  header.effect = effectPath;
+  header.fingerprint = io::effectFingerprint(effectPath, overrides);
+  header.seed = effect.simulation.seed;
+  header.stepRateHz = effect.simulation.stepRateHz;
+  header.length = flicksFromSeconds(seconds);
+  header.fps = fps;
+  try {
+    io::requireWritable(logPath);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitUsage;
+  }
+  io::HashLog log;
+  try {
+    log = recordHashLog(effect, header, snapshots);
+  } catch (const io::BuildError& e) {  // a vector field's file that does not load: bad input
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitUsage;
+  }
+  io::writeHashLog(logPath, log);
+  std::printf("recorded %s: %" PRId64 " ticks at %" PRId64 " Hz, %" PRId64
+              " frames, state-hash %s, %zu snapshot(s)\n",
+              logPath.c_str(), log.header.ticks, log.header.stepRateHz, log.header.frames,
+              log.ticks.empty() ? "-" : hashToHex(log.ticks.back().state).c_str(),
+              log.snapshots.size());
+  std::printf("this build: %s\n", describeBuild(log.header).c_str());
+  return kExitOk;
+}
+
+int compareCommand(const io::EffectSettings& effect, const std::string& effectPath,
+                   const std::vector<std::string>& overrides, const std::string& logPath) {
+  LogComparison c;
+  io::HashLog log;
+  try {
+    log = io::readHashLog(logPath);
+    c = compareWithHashLog(effect, io::effectFingerprint(effectPath, overrides), logPath, log);
+  } catch (const io::BuildError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitUsage;
+  } catch (const std::runtime_error& e) {  // the log is unreadable, or of another effect
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitUsage;
+  }
+  std::printf("log:       %s\n", describeBuild(log.header).c_str());
+  std::printf("this run:  %s\n", describeBuild(describeThisBuild()).c_str());
+  if (c.partTick >= 0) {
+    std::printf(
+        "the runs part at tick %" PRId64 " (t = %.9g s): state-hash %s here, %s in the log\n",
+        c.partTick, static_cast<double>(c.partTick) / static_cast<double>(log.header.stepRateHz),
+        hashToHex(c.runHash).c_str(), hashToHex(c.logHash).c_str());
+    std::string columns;
+    for (const std::string& name : c.columns) columns += " " + name;
+    std::printf("columns that differ:%s\n", columns.empty() ? " -" : columns.c_str());
+    if (c.row && c.row->column == "counters") {
+      std::printf("first difference: particle id %" PRIu64 ": %" PRIu64 " particles here, %" PRIu64
+                  " in the log\n",
+                  c.row->id, c.row->runBits, c.row->logBits);
+    } else if (c.row) {
+      std::printf("first difference: particle id %" PRIu64 ", %s: %s here, %s in the log\n",
+                  c.row->id, c.row->column.c_str(),
+                  describeBits(c.row->column, c.row->runBits).c_str(),
+                  describeBits(c.row->column, c.row->logBits).c_str());
+    } else if (!c.logHasState) {
+      std::printf("the log holds no state of tick %" PRId64
+                  ": record it again with --snapshot-at %" PRId64
+                  " to name the particle and both values\n",
+                  c.partTick, c.partTick);
+    }
+    return kExitFailure;
+  }
+  if (c.partFrame >= 0) {
+    std::printf("every tick agrees, but frame %" PRId64
+                " shows other bits here than in the log (the interpolation between ticks)\n",
+                c.partFrame);
+    return kExitFailure;
+  }
+  std::printf("identical through tick %" PRId64 " and frame %" PRId64 " (state-hash %s)\n", c.ticks,
+              c.frames, hashToHex(c.lastHash).c_str());
+  return kExitOk;
+}
+
+// --record FILE or --compare FILE: every option is read before the effect file (Arguments wants
+// the positional last), and the effect is loaded as for the table.
+int logCommand(Arguments& args, const std::vector<std::string>& overrides,
+               const std::optional<std::string>& record,
+               const std::optional<std::string>& compare) {
+  if (record && compare) throw UsageError("determinism: give --record or --compare, not both");
+  for (const char* option : {"--threads", "--frame-times"}) {
+    if (args.value(option)) {
+      throw UsageError(std::string("determinism: ") + option +
+                       " does not go with --record or --compare");
+    }
+  }
+  LogOptions options;
+  const auto seconds = args.value("--seconds");
+  const auto fps = args.value("--fps");
+  const auto snapshotAt = args.value("--snapshot-at");
+  if (compare) {
+    // The log fixes the run: comparing another length or other frames would prove nothing.
+    for (const auto& [given, option] : {std::pair{seconds, "--seconds"}, std::pair{fps, "--fps"},
+                                        std::pair{snapshotAt, "--snapshot-at"}}) {
+      if (given) {
+        throw UsageError(std::string("determinism: --compare takes the length and frames from "
+                                     "the log; drop ") +
+                         option);
+      }
+    }
+    options.logPath = *compare;
+  } else {
+    options.logPath = *record;
+    if (seconds) options.seconds = parseNumber(*seconds, "determinism: --seconds", 0.001, 3600.0);
+    if (fps) {
+      try {
+        options.fps = io::parseFrameRate(*fps);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string("determinism: --fps: ") + e.what());
+      }
+    }
+    if (snapshotAt) options.snapshots = parseTickList(*snapshotAt);
+  }
+  const std::string path =
+      args.positionals(1, std::string("one effect file: tickfx determinism EFFECT.toml ") +
+                              (compare ? "--compare FILE" : "--record FILE"))[0];
+  const io::LoadResult load = io::loadEffectFile(path, overrides);
+  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
+  if (!load.ok()) return kExitUsage;
+  return compare ? compareCommand(*load.effect, path, overrides, options.logPath)
+                 : recordCommand(*load.effect, path, overrides, options);
 }
 
 std::string hashAt(const DriveTrace& t, std::int64_t tick) {
@@ -52,6 +250,9 @@ int determinismCommand(Arguments& args) {
     return kExitOk;
   }
   const std::vector<std::string> overrides = args.values("--set");
+  const auto record = args.value("--record");
+  const auto compare = args.value("--compare");
+  if (record || compare) return logCommand(args, overrides, record, compare);
   const double seconds =
       parseNumber(args.value("--seconds").value_or("5"), "determinism: --seconds", 0.001, 3600.0);
   const std::vector<int> threads = parseThreadList(args.value("--threads").value_or("1,2,3,8"));

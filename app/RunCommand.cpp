@@ -141,15 +141,6 @@ std::filesystem::path checkpointPath(const std::filesystem::path& dir, std::int6
   return dir / name;
 }
 
-// The effect as a checkpoint knows it: the file's bytes and every override, in order.
-std::uint64_t effectFingerprint(const std::string& path,
-                                const std::vector<std::string>& overrides) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const std::string& o : overrides) bytes += '\0' + o;
-  return io::fingerprint(bytes);
-}
-
 }  // namespace
 
 int runCommand(Arguments& args) {
@@ -205,7 +196,7 @@ int runCommand(Arguments& args) {
     throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
   const std::filesystem::path checkpoints =
       checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
-  const std::uint64_t effectHash = effectFingerprint(effectPath, overrides);
+  const std::uint64_t effectHash = io::effectFingerprint(effectPath, overrides);
   // What a VDB cache records of the run, for the pipeline that reads it.
   const io::VdbCacheMetadata vdbMeta{hashToHex(effectHash), effect.simulation.seed,
                                      effect.simulation.stepRateHz, effect.simulation.integrator,

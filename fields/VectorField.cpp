@@ -101,7 +101,7 @@ struct VectorField::Impl {
                            std::uint8_t* dead) const = 0;
   std::string valueType;
   bool staggered = false;
-  int frames = 1;
+  int frameCount = 1;
   double voxelSize = 0.0;
   double maxMagnitude = 0.0;
 };
@@ -250,7 +250,7 @@ std::unique_ptr<VectorField::Impl> load(const VectorField::Settings& s,
     }
     impl->grids.push_back(grid);
   }
-  impl->frames = static_cast<int>(raw.size());
+  impl->frameCount = static_cast<int>(raw.size());
   const openvdb::Vec3d voxel = impl->grids.front()->voxelSize();
   impl->voxelSize = std::min({voxel.x(), voxel.y(), voxel.z()});
   for (const auto& grid : impl->grids) {
@@ -399,7 +399,7 @@ void VectorField::flagOutside(const ForceInput& in, RowRange rows, std::uint8_t*
 
 const std::string& VectorField::valueType() const { return impl_->valueType; }
 bool VectorField::staggered() const { return impl_->staggered; }
-int VectorField::frameCount() const { return impl_->frames; }
+int VectorField::frameCount() const { return impl_->frameCount; }
 double VectorField::voxelSize() const { return impl_->voxelSize; }
 double VectorField::maxMagnitude() const { return impl_->maxMagnitude; }
 

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -365,6 +366,14 @@ std::uint64_t fingerprint(std::string_view bytes) {
   }
   // Without the length, inputs that differ only by trailing zero bytes would collide.
   return mix(h, bytes.size());
+}
+
+std::uint64_t effectFingerprint(const std::filesystem::path& effectFile,
+                                const std::vector<std::string>& overrides) {
+  std::ifstream in(effectFile, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const std::string& o : overrides) bytes += '\0' + o;
+  return fingerprint(bytes);
 }
 
 void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,

@@ -4,7 +4,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "particles/Clock.h"
 #include "particles/ParticleSystem.h"
@@ -80,5 +82,10 @@ CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem&
 /// h *= 0xbf58476d1ce4e5b9, h ^= h >> 32; then the byte count is mixed in the same way. Every
 /// step is a bijection of h, so any change confined to one word always changes the result.
 std::uint64_t fingerprint(std::string_view bytes);
+
+/// The effect as a checkpoint, a VDB cache and a hash log know it: fingerprint() of the file's
+/// bytes and every override, in order, each after a zero byte.
+std::uint64_t effectFingerprint(const std::filesystem::path& effectFile,
+                                const std::vector<std::string>& overrides);
 
 }  // namespace tickfx::io

@@ -1,5 +1,6 @@
 #include "io/FrameData.h"
 
+#include "io/Checkpoint.h"
 #include "particles/ParticleSystem.h"
 
 namespace tickfx::io {
@@ -33,6 +34,26 @@ FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double 
     data.attributes.emplace_back(pool.attribute(a).head(n));
   }
   return data;
+}
+
+std::uint64_t frameHash(const FrameData& data) {
+  const std::size_t n = data.size();
+  std::string bytes;
+  auto append = [&](const void* p, std::size_t size) {
+    bytes.append(static_cast<const char*>(p), size);
+  };
+  auto appendFloats = [&](const FloatColumn& c) { append(c.data(), n * sizeof(float)); };
+  append(&n, sizeof n);
+  append(data.id.data(), n * sizeof(std::uint64_t));
+  for (const Vec3Column* v : {&data.position, &data.velocity}) {
+    for (int k = 0; k < 3; ++k) appendFloats((*v)[k]);
+  }
+  for (const FloatColumn* c : {&data.age, &data.life, &data.mass}) appendFloats(*c);
+  for (std::size_t a = 0; a < data.attributes.size(); ++a) {
+    bytes += data.attributeNames[a] + '\0';
+    appendFloats(data.attributes[a]);
+  }
+  return fingerprint(bytes);
 }
 
 }  // namespace tickfx::io

@@ -37,4 +37,9 @@ struct FrameData {
 /// positions, velocities and ages at that time; mass, lifetime and attributes of the newest tick.
 FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double timeSeconds);
 
+/// A 64-bit hash of what `data` shows: the row count, then the bits of every id, position,
+/// velocity, age, lifetime, mass and attribute (names included), not the frame number or time.
+/// Two caches of equal frames hold the same bits exactly when (barring collisions) this agrees.
+std::uint64_t frameHash(const FrameData& data);
+
 }  // namespace tickfx::io

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 namespace tickfx {
 namespace {
@@ -48,6 +49,72 @@ std::uint64_t stateHash(const ParticlePool& pool) {
   }
   for (std::size_t a = 0; a < pool.attributeCount(); ++a) h.addFloats(pool.attribute(a), n);
   return h.value();
+}
+
+namespace {
+
+// The float columns in stateHash()'s order, with their names.
+std::vector<std::pair<std::string, const FloatColumn*>> floatColumns(const ParticlePool& pool) {
+  std::vector<std::pair<std::string, const FloatColumn*>> columns;
+  const std::pair<const char*, const Vec3Column*> vectors[] = {
+      {"position", &pool.position()},
+      {"velocity", &pool.velocity()},
+      {"previous_position", &pool.previousPosition()},
+      {"acceleration", &pool.acceleration()}};
+  for (const auto& [name, column] : vectors) {
+    for (int k = 0; k < 3; ++k)
+      columns.emplace_back(std::string(name) + "." + "xyz"[k], &(*column)[k]);
+  }
+  columns.emplace_back("age", &pool.age());
+  columns.emplace_back("lifetime", &pool.lifetime());
+  columns.emplace_back("mass", &pool.mass());
+  columns.emplace_back("inverse_mass", &pool.inverseMass());
+  for (std::size_t a = 0; a < pool.attributeCount(); ++a)
+    columns.emplace_back("attribute." + pool.attributeName(a), &pool.attribute(a));
+  return columns;
+}
+
+}  // namespace
+
+std::vector<std::string> stateColumnNames(const ParticlePool& pool) {
+  std::vector<std::string> names = {"counters", "id", "birth_tick"};
+  for (const auto& column : floatColumns(pool)) names.push_back(column.first);
+  return names;
+}
+
+std::vector<std::uint64_t> stateColumnHashes(const ParticlePool& pool) {
+  const std::size_t n = pool.size();
+  std::vector<std::uint64_t> hashes;
+  Hasher counters;
+  counters.add(n);
+  counters.add(pool.nextId());
+  counters.add(pool.droppedSpawns());
+  hashes.push_back(counters.value());
+  Hasher ids, births;
+  ids.add(n);
+  births.add(n);
+  for (std::size_t i = 0; i < n; ++i) ids.add(pool.id()[i]);
+  for (std::size_t i = 0; i < n; ++i) births.add(static_cast<std::uint64_t>(pool.birthTick()[i]));
+  hashes.push_back(ids.value());
+  hashes.push_back(births.value());
+  for (const auto& column : floatColumns(pool)) {
+    Hasher h;
+    h.add(n);
+    h.addFloats(*column.second, n);
+    hashes.push_back(h.value());
+  }
+  return hashes;
+}
+
+std::vector<std::uint64_t> stateRowBits(const ParticlePool& pool, std::size_t row) {
+  std::vector<std::uint64_t> bits = {pool.id()[row],
+                                     static_cast<std::uint64_t>(pool.birthTick()[row])};
+  for (const auto& column : floatColumns(pool)) {
+    std::uint32_t b = 0;
+    std::memcpy(&b, &(*column.second)[static_cast<Eigen::Index>(row)], sizeof b);
+    bits.push_back(b);
+  }
+  return bits;
 }
 
 std::string hashToHex(std::uint64_t hash) {

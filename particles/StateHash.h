@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "particles/ParticlePool.h"
 
@@ -12,6 +13,19 @@ namespace tickfx {
 /// order), plus the row count, the next id and the dropped-spawn count. Two states hash equal
 /// only if (barring collisions) every float is bitwise equal; −0 and +0 differ, as they should.
 std::uint64_t stateHash(const ParticlePool& pool);
+
+/// The columns stateHash() covers, in its order, so a difference can be named: "counters" (row
+/// count, next id, dropped spawns), "id", "birth_tick", "position.x" ... "acceleration.z", "age",
+/// "lifetime", "mass", "inverse_mass", then "attribute.NAME" for each custom attribute.
+std::vector<std::string> stateColumnNames(const ParticlePool& pool);
+
+/// One hash per column of stateColumnNames(), each over the row count and that column's bits
+/// alone: two states whose stateHash() differs differ in the columns whose hashes differ.
+std::vector<std::uint64_t> stateColumnHashes(const ParticlePool& pool);
+
+/// The bits of row `row` in every column but "counters" (the first of stateColumnNames()): the
+/// id, the birth tick as two's complement, and each float's 32 bits.
+std::vector<std::uint64_t> stateRowBits(const ParticlePool& pool, std::size_t row);
 
 /// `hash` as 16 lowercase hex digits.
 std::string hashToHex(std::uint64_t hash);

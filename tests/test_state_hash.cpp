@@ -77,6 +77,37 @@ TEST(StateHash, OneFlippedBitOfOneParticleChangesIt) {
   EXPECT_EQ(stateHash(pool), original);
 }
 
+// What a hash log uses to name a difference: a flipped bit changes its own column's hash and no
+// other, and the row's bits show the value that changed.
+TEST(StateHash, ColumnHashesNameTheColumnThatChanged) {
+  const auto system = test::referenceSystem(test::referenceSettings("velocity_verlet"));
+  system->stepTicks(90);
+  ParticlePool& pool = system->pool();
+  const std::vector<std::string> names = stateColumnNames(pool);
+  ASSERT_EQ(names.size(), 3u + 12u + 4u + pool.attributeCount());
+  EXPECT_EQ(names[0], "counters");
+  EXPECT_EQ(names[4], "position.y");
+  EXPECT_EQ(names[14], "acceleration.z");
+  EXPECT_EQ(names[18], "inverse_mass");
+  const std::vector<std::uint64_t> original = stateColumnHashes(pool);
+  ASSERT_EQ(original.size(), names.size());
+  const std::vector<std::uint64_t> row = stateRowBits(pool, 3);
+  ASSERT_EQ(row.size(), names.size() - 1);
+  EXPECT_EQ(row[0], pool.id()[3]);
+  EXPECT_EQ(row[3], test::bitsOf(pool.position().y[3]));
+
+  pool.position().y[3] = test::withBits(test::bitsOf(pool.position().y[3]) ^ 1u);
+  const std::vector<std::uint64_t> changed = stateColumnHashes(pool);
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    if (names[c] == "position.y") {
+      EXPECT_NE(changed[c], original[c]);
+    } else {
+      EXPECT_EQ(changed[c], original[c]) << names[c];
+    }
+  }
+  EXPECT_EQ(stateRowBits(pool, 3)[3], row[3] ^ 1u);
+}
+
 TEST(StateHash, HexIsSixteenLowercaseDigits) {
   EXPECT_EQ(hashToHex(0), "0000000000000000");
   EXPECT_EQ(hashToHex(0x0123456789abcdefULL), "0123456789abcdef");

@@ -1,5 +1,5 @@
 # The determinism promise across builds: `tickfx run` built with clang++ (Release, Debug) and g++
-# (Debug) must reach the same golden state hashes as this build. See
+# (Debug), and with both at -O3 -march=native, must reach the same golden state hashes as this build. See
 # tests/scripts/BuildVariants.cmake.
 #
 # Not in a sanitizer build: the variants are unsanitised, so scripts/test's second pass would only
@@ -14,9 +14,10 @@ if(TARGET tickfx_cli AND NOT TICKFX_SANITIZE)
       -DMAIN_NAME=main-${CMAKE_CXX_COMPILER_ID}-${CMAKE_BUILD_TYPE}
       -DGOLDEN_FILE=${CMAKE_CURRENT_SOURCE_DIR}/data/golden_hashes.txt
       -P ${CMAKE_CURRENT_SOURCE_DIR}/scripts/BuildVariants.cmake)
-  # It builds the CLI three times on every core: beside other tests it would slow them into their
-  # timeouts. From scratch it took 70 to 140 s on 2 shared cores (the runs themselves about 1 s);
-  # the timeout leaves room for a slow CI machine.
+  # It builds the CLI five times on every core: beside other tests it would slow them into their
+  # timeouts. With three variants it took 70 to 140 s from scratch on 2 shared cores (the runs
+  # themselves about 1 s); the two native variants are Release builds, about as long each. The
+  # timeout leaves room for a slow CI machine.
   set_tests_properties(determinism.compilers PROPERTIES
     TIMEOUT 1500
     RUN_SERIAL TRUE

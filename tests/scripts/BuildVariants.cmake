@@ -1,8 +1,9 @@
 # cmake -P script behind the determinism.compilers test.
 #
-# Builds only the tickfx CLI in three more variants (clang++ Release, clang++ Debug, g++ Debug),
-# runs every sample of GOLDEN_FILE through each of them and through the main build's MAIN_TICKFX,
-# and fails with a table unless every state hash is the golden one.
+# Builds only the tickfx CLI in five more variants (clang++ Release, clang++ Debug, g++ Debug, and
+# clang++ and g++ at -O3 -march=native, as a host that builds tickfx for its own CPU would), runs
+# every sample of GOLDEN_FILE through each of them and through the main build's MAIN_TICKFX, and
+# fails with a table unless every state hash is the golden one.
 #
 # Inputs: SOURCE_DIR, WORK_DIR (variants are built in WORK_DIR/<name>), GENERATOR, MAIN_TICKFX,
 # MAIN_NAME (a label for the main build), GOLDEN_FILE.
@@ -26,13 +27,22 @@ foreach(compiler CLANGXX GXX)
   endif()
 endforeach()
 
-set(variants clang-release clang-debug gcc-debug)
+set(variants clang-release clang-debug gcc-debug clang-native gcc-native)
 set(clang-release_compiler ${CLANGXX})
 set(clang-release_type Release)
 set(clang-debug_compiler ${CLANGXX})
 set(clang-debug_type Debug)
 set(gcc-debug_compiler ${GXX})
 set(gcc-debug_type Debug)
+# The native variants replace the Release flags only: -ffp-contract=off and the rest of the
+# project's floating-point flags are compile options of every target, so they still hold. -march=native lets the
+# vectorisers use this CPU's widest units (AVX2, AVX-512), the case the rules must survive.
+set(clang-native_compiler ${CLANGXX})
+set(clang-native_type Release)
+set(clang-native_flags "-O3 -march=native -DNDEBUG")
+set(gcc-native_compiler ${GXX})
+set(gcc-native_type Release)
+set(gcc-native_flags "-O3 -march=native -DNDEBUG")
 
 cmake_host_system_information(RESULT jobs QUERY NUMBER_OF_LOGICAL_CORES)
 
@@ -64,18 +74,26 @@ foreach(v ${variants})
   set(step_ok TRUE)
   # -Werror stays off: a warning of the other compiler is not what this test is about, and an
   # error that remains is a real one.
+  # A variant without its own flags keeps CMake's defaults of its build type.
+  string(TOUPPER ${${v}_type} type_upper)
+  set(flags_option "")
+  set(label "${${v}_compiler}, ${${v}_type}")
+  if(DEFINED ${v}_flags)
+    set(flags_option "-DCMAKE_CXX_FLAGS_${type_upper}=${${v}_flags}")
+    set(label "${label} ${${v}_flags}")
+  endif()
   run_step("configuring ${v}" ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${dir} -G ${GENERATOR}
-      -DCMAKE_CXX_COMPILER=${${v}_compiler} -DCMAKE_BUILD_TYPE=${${v}_type}
+      -DCMAKE_CXX_COMPILER=${${v}_compiler} -DCMAKE_BUILD_TYPE=${${v}_type} ${flags_option}
       -DTICKFX_BUILD_TESTS=OFF -DTICKFX_BUILD_BENCH=OFF -DTICKFX_BUILD_SAMPLES=OFF
       -DTICKFX_BUILD_CLI=ON -DTICKFX_WERROR=OFF -DTICKFX_SANITIZE=OFF)
   if(step_ok)
-    run_step("building ${v} (${${v}_compiler}, ${${v}_type})"
+    run_step("building ${v} (${label})"
              ${CMAKE_COMMAND} --build ${dir} --target tickfx_cli -j ${jobs})
   endif()
   string(TIMESTAMP stop "%s")
   math(EXPR seconds "${stop} - ${start}")
   if(step_ok)
-    message("built ${v} (${${v}_compiler}, ${${v}_type}) in ${seconds} s")
+    message("built ${v} (${label}) in ${seconds} s")
     set(${v}_tickfx ${dir}/bin/tickfx)
   else()
     math(EXPR failures "${failures} + 1")
@@ -168,6 +186,6 @@ message("state hashes of `tickfx run samples/<sample> --seconds 2 --fps 60 --for
 if(failures GREATER 0)
   message(FATAL_ERROR "determinism.compilers: ${failures} build(s) or run(s) did not give the "
                       "golden hash of ${GOLDEN_FILE}. The promise is that the state after tick k "
-                      "is the same bits with g++ or clang++, Release or Debug.")
+                      "is the same bits with g++ or clang++, Release, Debug or -O3 -march=native.")
 endif()
 message("determinism.compilers: every build gives every golden hash")
