@@ -241,6 +241,29 @@ void stampUuid(const std::filesystem::path& file, const VdbCacheMetadata& meta,
   if (!io.flush()) throw std::runtime_error(file.string() + ": cannot stamp the file's UUID");
 }
 
+// What OpenVDB reads without comparing (readVdbGrid has checked every size it trusts): a leaf's
+// voxel offsets must rise to its point count, and every attribute array must hold that many
+// points, or the handles below would read past the arrays.
+void checkLeaf(const vdbp::PointDataTree::LeafNodeType& leaf, const std::string& file) {
+  openvdb::Index32 count = 0;
+  for (openvdb::Index n = 0; n < vdbp::PointDataTree::LeafNodeType::SIZE; ++n) {
+    const openvdb::Index32 end = leaf.getValue(n);
+    if (end < count) {
+      throw std::runtime_error(where(file) +
+                               ": a leaf's point offsets decrease (the file is corrupt)");
+    }
+    count = end;
+  }
+  const vdbp::AttributeSet& set = leaf.attributeSet();
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    const vdbp::AttributeArray* a = set.getConst(i);
+    if (a == nullptr || a->size() != count || (!a->isUniform() && a->dataSize() < a->size())) {
+      throw std::runtime_error(where(file) + ": a leaf's attributes do not hold its " +
+                               std::to_string(count) + " points (the file is corrupt)");
+    }
+  }
+}
+
 }  // namespace
 
 void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
@@ -281,6 +304,7 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
   std::vector<std::vector<float>> custom;
   bool first = true;
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+    checkLeaf(*leaf, file);
     const vdbp::AttributeSet::Descriptor& d = leaf->attributeSet().descriptor();
     // Every leaf of a PointDataGrid shares one descriptor: positions and names are the first
     // leaf's.

@@ -66,9 +66,9 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
 /// and time come from tickfx_frame and tickfx_time (absent: 0). `contents`, when given, receives
 /// the metadata and which attributes were present.
 /// Throws std::runtime_error naming the file and the grid ("PATH: grid 'points': ...") when the
-/// file is missing, is not an OpenVDB file, is truncated, has no grid "points", the grid is not a
-/// PointDataGrid, or it has no P. A file cut inside its grid data is caught before OpenVDB reads
-/// it (OpenVDB 10 may hang on one).
+/// file is missing, is not an OpenVDB file, is truncated or corrupt, has no grid "points", the grid
+/// is not a PointDataGrid, or it has no P. Every byte is checked before OpenVDB reads it (see
+/// readVdbGrid): a damaged file is an exception, never an abort inside OpenVDB.
 FrameData readVdbPointCache(const std::filesystem::path& path,
                             VdbCacheContents* contents = nullptr);
 

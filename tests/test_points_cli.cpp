@@ -150,4 +150,40 @@ TEST_F(CliPoints, AnEffectSeededFromACacheChecksAndRuns) {
   EXPECT_FALSE(fs::exists(path("o")));
 }
 
+TEST_F(CliPoints, ACorruptPointsFileIsAnEffectErrorNotACrash) {
+  // A one-point cache whose first attribute array (P) says it holds 13 bytes, one too many: the
+  // paged stream of OpenVDB 10 asserted on it, so `check` and `run` died of SIGABRT (exit 134).
+  tickfx::io::FrameData one;
+  one.resize(1, {});
+  one.id = {7};
+  for (int c = 0; c < 3; ++c) {
+    one.position[c][0] = 0.5f + static_cast<float>(c);
+    one.velocity[c][0] = 1.0f;
+  }
+  one.age[0] = 0.0f;
+  one.life[0] = 5.0f;
+  one.mass[0] = 1.0f;
+  tickfx::io::writeVdbPointCache(one, tickfx::io::VdbCacheMetadata{}, path("pts.vdb"));
+  std::string bytes = readAll(path("pts.vdb"));
+  const std::string count{"\x12\0\0\0\0\0\0\0", 8};  // 6 + 12 bytes, a uint64
+  const std::size_t at = bytes.find(count);
+  ASSERT_NE(at, std::string::npos);
+  bytes[at] = '\x13';
+  std::ofstream(path("pts.vdb"), std::ios::binary) << bytes;
+  std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"
+                                    "[[emitters]]\ntype = \"file\"\nfile = \"pts.vdb\"\n";
+  const std::string message =
+      path("fx.toml") + ":6:8: error: emitters.0.file: \"" + path("pts.vdb") +
+      "\" cannot be read: " + path("pts.vdb") +
+      ": grid 'points': cannot read the grid (the file is corrupt at byte " + std::to_string(at) +
+      ": an attribute array of 13 bytes where 12 are expected)";
+  const Result check = tickfx("check " + path("fx.toml"));
+  EXPECT_EQ(check.exit, 2) << check.err;
+  EXPECT_NE(check.err.find(message), std::string::npos) << check.err;
+  const Result r = tickfx("run " + path("fx.toml") + " --frames 2 --out " + path("o"));
+  EXPECT_EQ(r.exit, 2) << r.err;
+  EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("o")));
+}
+
 }  // namespace

@@ -7,6 +7,7 @@
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointCount.h>
 #include <openvdb/points/PointDataGrid.h>
+#include <openvdb/points/PointGroup.h>
 #include <openvdb/tools/PointIndexGrid.h>
 #include <unistd.h>
 
@@ -307,6 +308,44 @@ TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
   EXPECT_EQ(matched, std::vector<bool>(3, true));
 }
 
+TEST_F(ioVdbPoints, PointsFilesInEveryLayoutOpenVdbWritesRead) {
+  // Checking every byte before OpenVDB reads it must not refuse a valid file: paged blosc arrays
+  // over many leaves, raw arrays (no blosc: no compression, or zip, which points do not use), a
+  // strided array, a uniform one, a string attribute and a group.
+  openvdb::initialize();
+  std::vector<openvdb::Vec3R> positions;
+  for (int i = 0; i < 300; ++i) positions.emplace_back(0.1 * i, 0.05 * i, -0.07 * i);
+  const vdbp::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
+  const auto transform = openvdb::math::Transform::createLinearTransform(0.5);
+  const auto index =
+      openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
+  auto grid =
+      vdbp::createPointDataGrid<vdbp::NullCodec, vdbp::PointDataGrid>(*index, wrapper, *transform);
+  vdbp::appendAttribute<float>(grid->tree(), "density", 2.5f);
+  vdbp::appendAttribute<float>(grid->tree(), "triple", 1.0f, /*stride=*/3);
+  vdbp::appendAttribute<openvdb::Name>(grid->tree(), "label");
+  vdbp::appendGroup(grid->tree(), "chosen");
+  vdbp::appendAttribute<openvdb::Vec3f>(grid->tree(), "v", openvdb::Vec3f(1.0f, 2.0f, 3.0f));
+  grid->setName("points");
+  ASSERT_GT(grid->tree().leafCount(), 5u);
+  for (const std::uint32_t compression :
+       {std::uint32_t{openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK},
+        std::uint32_t{openvdb::io::COMPRESS_NONE}, std::uint32_t{openvdb::io::COMPRESS_ZIP}}) {
+    SCOPED_TRACE(compression);
+    openvdb::io::File out(path("p.vdb").string());
+    out.setCompression(compression);
+    out.write({grid});
+    const FrameData back = readVdbPointCache(path("p.vdb"));
+    ASSERT_EQ(back.size(), positions.size());
+    EXPECT_EQ(back.attributeNames, (std::vector<std::string>{"density", "triple"}));
+    for (Eigen::Index r = 0; r < 300; ++r) {
+      EXPECT_EQ(back.attributes[0][r], 2.5f);
+      EXPECT_EQ(back.attributes[1][r], 1.0f);
+      EXPECT_EQ(back.velocity.y[r], 2.0f);
+    }
+  }
+}
+
 // ---- errors ------------------------------------------------------------------------------------
 
 std::string errorOf(const fs::path& file) {
@@ -357,6 +396,93 @@ TEST_F(ioVdbPoints, MissingTruncatedAndForeignFilesNameTheFileAndGrid) {
   EXPECT_EQ(errorOf(path("float.vdb")), path("float.vdb").string() +
                                             ": grid 'points': is a grid of type Tree_float_5_4_3 "
                                             "(expected a PointDataGrid)");
+}
+
+std::string fileBytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
+  // A small cache: 12 points over 4 leaves (so pages span leaves), every attribute, a custom one.
+  FrameData frame;
+  const Eigen::Index n = 12;
+  frame.position.resize(n);
+  frame.velocity.resize(n);
+  frame.age = FloatColumn::Constant(n, 0.5f);
+  frame.life = FloatColumn::Constant(n, 5.0f);
+  frame.mass = FloatColumn::Ones(n);
+  frame.attributeNames = {"heat"};
+  frame.attributes.assign(1, FloatColumn::Zero(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    frame.id.push_back(static_cast<std::uint64_t>(3 * i + 1));
+    for (int c = 0; c < 3; ++c) {
+      frame.position[c][i] = 0.75f * static_cast<float>(i) + static_cast<float>(c);
+      frame.velocity[c][i] = 0.5f * static_cast<float>(c - i);
+    }
+    frame.attributes[0][i] = static_cast<float>(i);
+  }
+  writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
+  const std::string bytes = fileBytes(path("f.vdb"));
+  ASSERT_GT(bytes.size(), 10000u);  // the root's child alone has two 4 KB masks
+
+  // Bit i mod 8 of byte i flipped, each its own file. OpenVDB 10 trusts the sizes, counts and
+  // flags it reads: on hundreds of these files it aborted on an assertion (its paged streams,
+  // blosc pages), crashed, or allocated gigabytes. Each now reads, or is refused naming the file.
+  std::size_t read = 0, refused = 0, corrupt = 0;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    std::string flipped = bytes;
+    flipped[i] = static_cast<char>(flipped[i] ^ (1 << (i % 8)));
+    const fs::path file = path("flip" + std::to_string(i) + ".vdb");
+    std::ofstream(file, std::ios::binary) << flipped;
+    try {
+      const FrameData back = readVdbPointCache(file);
+      ++read;
+      // What was read is a frame of the cache's size, whatever values the flip changed.
+      EXPECT_EQ(back.size(), frame.size()) << "byte " << i;
+    } catch (const std::runtime_error& e) {
+      ++refused;
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(file.string() + ": grid 'points': ", 0), 0u)
+          << "byte " << i << ": " << what;
+      if (what.find("the file is corrupt at byte ") != std::string::npos) ++corrupt;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "byte " << i << ": not a runtime_error: " << e.what();
+    }
+    fs::remove(file);
+  }
+  EXPECT_EQ(read + refused, bytes.size());
+  // Values (positions, velocities, metadata values, unused bits) still read; most of the bytes are
+  // structure, and most refusals name the byte where the file stops making sense.
+  EXPECT_GT(read, 300u);
+  EXPECT_GT(refused, bytes.size() / 2);
+  EXPECT_GT(corrupt, refused / 2);
+
+  // The first attribute array's byte count (a uint64, 6 + 12 bytes for one point's P) one too
+  // many: OpenVDB's paged stream asserted (mByteIndex <= mUncompressedBytes).
+  FrameData one;
+  one.resize(1, {});
+  one.id = {7};
+  for (int c = 0; c < 3; ++c) {
+    one.position[c][0] = 0.5f + static_cast<float>(c);
+    one.velocity[c][0] = 1.0f;
+  }
+  one.age[0] = 0.0f;
+  one.life[0] = 5.0f;
+  one.mass[0] = 1.0f;
+  writeVdbPointCache(one, sampleMetadata(), path("one.vdb"));
+  std::string damaged = fileBytes(path("one.vdb"));
+  const std::string count{"\x12\0\0\0\0\0\0\0", 8};
+  const std::size_t at = damaged.find(count);
+  ASSERT_NE(at, std::string::npos);
+  damaged[at] = '\x13';
+  std::ofstream(path("one.vdb"), std::ios::binary) << damaged;
+  EXPECT_EQ(errorOf(path("one.vdb")), path("one.vdb").string() +
+                                          ": grid 'points': cannot read the grid (the file is "
+                                          "corrupt at byte " +
+                                          std::to_string(at) +
+                                          ": an attribute array of 13 bytes where 12 are "
+                                          "expected)");
 }
 
 TEST_F(ioVdbPoints, AFailedWriteLeavesNoFile) {
