@@ -1,36 +1,38 @@
 #include "particles/ParticleSystem.h"
 
-#include <tbb/global_control.h>
-#include <tbb/info.h>
 #include <tbb/task_arena.h>
 #include <stdexcept>
 
 #include "particles/Clock.h"
 #include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
+#include "particles/TaskExecutor.h"
 
 namespace tickfx {
 
 class ParticleSystem::ThreadArena {
  public:
-  explicit ThreadArena(int threads) : arena_(threads > 0 ? threads : tbb::task_arena::automatic) {
-    // TBB keeps its workers to the core count unless told otherwise; a determinism test that
-    // asks for 8 threads on 2 cores must really get 8. Only ever raised, never lowered: the
-    // smallest active limit wins process-wide, and lowering it would starve other systems.
-    if (threads > tbb::info::default_concurrency()) {
-      limit_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                     static_cast<std::size_t>(threads));
-    }
-  }
+  // TBB keeps its workers to the process-wide limit (the core count unless the host raised it
+  // with tbb::global_control, as `tickfx run --threads` does): a system never changes it.
+  explicit ThreadArena(int threads) : arena_(threads > 0 ? threads : tbb::task_arena::automatic) {}
   template <typename F>
   void execute(F&& f) {
     arena_.execute(std::forward<F>(f));
   }
 
  private:
-  std::unique_ptr<tbb::global_control> limit_;  // before the arena: it must outlive it
   tbb::task_arena arena_;
 };
+
+template <typename F>
+void ParticleSystem::runParallel(F&& f) const {
+  if (executor_ != nullptr) {
+    const ExecutorScope scope(executor_);
+    f();
+  } else {
+    arena_->execute(std::forward<F>(f));
+  }
+}
 
 namespace {
 
@@ -95,7 +97,7 @@ void ParticleSystem::stepTicks(std::int64_t ticks) {
 
 void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
   if (ticks <= 0) return;
-  arena_->execute([&] {
+  runParallel([&] {
     for (std::int64_t i = 0; i < ticks; ++i) {
       // Only the last tick of a frame needs its starting velocities, for interpolation.
       runTick(keepVelocities && i == ticks - 1);
@@ -156,24 +158,37 @@ void ParticleSystem::spawnStructure(const StructureBuild& build) {
 
 namespace {
 
+// Row i of a host buffer whose rows are `stride` bytes apart.
+template <typename T>
+T& rowOf(T* base, std::size_t stride, std::size_t i) {
+  return *reinterpret_cast<T*>(reinterpret_cast<unsigned char*>(base) + i * stride);
+}
+
 // previous + (current − previous) · α over rows [0, n), exactly `current` at α = 1 and
-// `previous` at α = 0 (the arithmetic would turn −0 into +0).
+// `previous` at α = 0 (the arithmetic would turn −0 into +0). Element by element in float, as an
+// Eigen expression would compute it: the bits do not depend on the destination's layout.
 void interpolate(const Vec3Column& previous, const Vec3Column& current, float alpha, std::size_t n,
-                 Vec3Column& out) {
-  out.resize(static_cast<Eigen::Index>(n));
+                 const Vec3Destination& out) {
+  float* const dst[3] = {out.x, out.y, out.z};
   parallelForRows(n, [&](std::size_t b, std::size_t e) {
-    const auto i = static_cast<Eigen::Index>(b), m = static_cast<Eigen::Index>(e - b);
     for (int c = 0; c < 3; ++c) {
+      const float* p = previous[c].data();
+      const float* q = current[c].data();
+      float* d = dst[c];
       if (alpha == 1.0f) {
-        out[c].segment(i, m) = current[c].segment(i, m);
+        for (std::size_t i = b; i < e; ++i) rowOf(d, out.rowStride, i) = q[i];
       } else if (alpha == 0.0f) {
-        out[c].segment(i, m) = previous[c].segment(i, m);
+        for (std::size_t i = b; i < e; ++i) rowOf(d, out.rowStride, i) = p[i];
       } else {
-        out[c].segment(i, m) = previous[c].segment(i, m) +
-                               (current[c].segment(i, m) - previous[c].segment(i, m)) * alpha;
+        for (std::size_t i = b; i < e; ++i) rowOf(d, out.rowStride, i) = p[i] + (q[i] - p[i]) * alpha;
       }
     }
   });
+}
+
+Vec3Destination columnsOf(Vec3Column& out, std::size_t n) {
+  out.resize(static_cast<Eigen::Index>(n));
+  return Vec3Destination::columns(out.x.data(), out.y.data(), out.z.data(), n);
 }
 
 }  // namespace
@@ -185,43 +200,91 @@ double ParticleSystem::shownSeconds() const {
 }
 
 void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
-  arena_->execute(
-      [&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, pool_.size(), out); });
+  const Vec3Destination to = columnsOf(out, pool_.size());
+  runParallel([&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, pool_.size(), to); });
 }
 
 void ParticleSystem::renderPositions(Vec3Column& out) const {
-  interpolatedPositions(frameOffset_ == kFlicksPerSecond ? 1.0f : alpha_, out);
+  copyRenderPositions(columnsOf(out, pool_.size()));
 }
 
 void ParticleSystem::renderVelocities(Vec3Column& out) const {
-  const bool onTick = frameOffset_ == kFlicksPerSecond || velocitiesTick_ != tick_;
-  const Vec3Column& previous = onTick ? pool_.velocity() : previousVelocity_;
-  arena_->execute(
-      [&] { interpolate(previous, pool_.velocity(), onTick ? 1.0f : alpha_, pool_.size(), out); });
+  copyRenderVelocities(columnsOf(out, pool_.size()));
 }
 
 void ParticleSystem::renderAges(FloatColumn& out) const {
+  out.resize(static_cast<Eigen::Index>(pool_.size()));
+  copyRenderAges(FloatDestination{out.data(), sizeof(float), pool_.size()});
+}
+
+CopyResult ParticleSystem::copyRenderPositions(const Vec3Destination& out) const {
   const std::size_t n = pool_.size();
+  if (out.capacity < n) return {n, false};
+  const float alpha = frameOffset_ == kFlicksPerSecond ? 1.0f : alpha_;
+  runParallel([&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, n, out); });
+  return {n, true};
+}
+
+CopyResult ParticleSystem::copyRenderVelocities(const Vec3Destination& out) const {
+  const std::size_t n = pool_.size();
+  if (out.capacity < n) return {n, false};
+  const bool onTick = frameOffset_ == kFlicksPerSecond || velocitiesTick_ != tick_;
+  const Vec3Column& previous = onTick ? pool_.velocity() : previousVelocity_;
+  runParallel([&] { interpolate(previous, pool_.velocity(), onTick ? 1.0f : alpha_, n, out); });
+  return {n, true};
+}
+
+CopyResult ParticleSystem::copyRenderAges(const FloatDestination& out) const {
+  const std::size_t n = pool_.size();
+  if (out.capacity < n) return {n, false};
+  const float* tickAge = pool_.age().data();
   if (frameOffset_ == kFlicksPerSecond) {
-    out = pool_.age().head(static_cast<Eigen::Index>(n));
-    return;
+    for (std::size_t i = 0; i < n; ++i) rowOf(out.data, out.rowStride, i) = tickAge[i];
+    return {n, true};
   }
   // age = ((tick − 1 − birth) · F + offset) / (F · H) seconds: an exact integer numerator, one
   // division in double, one rounding to float. No float time is read back.
-  out.resize(static_cast<Eigen::Index>(n));
   const std::int64_t* birth = pool_.birthTick().data();
   const double unitsPerSecond =
       static_cast<double>(kFlicksPerSecond) * static_cast<double>(settings_.stepRateHz);
   const std::int64_t last = tick_ - 1, offset = frameOffset_;
-  float* age = out.data();
-  arena_->execute([&] {
+  runParallel([&] {
     parallelForRows(n, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const __int128 units = static_cast<__int128>(last - birth[i]) * kFlicksPerSecond + offset;
-        age[i] = static_cast<float>(static_cast<double>(units) / unitsPerSecond);
+        rowOf(out.data, out.rowStride, i) =
+            static_cast<float>(static_cast<double>(units) / unitsPerSecond);
       }
     });
   });
+  return {n, true};
+}
+
+CopyResult ParticleSystem::copyIds(const IdDestination& out) const {
+  const std::size_t n = pool_.size();
+  if (out.capacity < n) return {n, false};
+  const std::uint64_t* id = pool_.id().data();
+  for (std::size_t i = 0; i < n; ++i) rowOf(out.data, out.rowStride, i) = id[i];
+  return {n, true};
+}
+
+std::optional<CopyResult> ParticleSystem::copyColumn(std::string_view name,
+                                                     const FloatDestination& out) const {
+  const FloatColumn* column = nullptr;
+  if (name == "lifetime") {
+    column = &pool_.lifetime();
+  } else if (name == "mass") {
+    column = &pool_.mass();
+  } else {
+    const std::size_t a = pool_.findAttribute(std::string(name));
+    if (a == ParticlePool::npos) return std::nullopt;
+    column = &pool_.attribute(a);
+  }
+  const std::size_t n = pool_.size();
+  if (out.capacity < n) return CopyResult{n, false};
+  const float* values = column->data();
+  for (std::size_t i = 0; i < n; ++i) rowOf(out.data, out.rowStride, i) = values[i];
+  return CopyResult{n, true};
 }
 
 }  // namespace tickfx

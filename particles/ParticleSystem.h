@@ -4,7 +4,9 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fields/ForceSet.h"
@@ -12,9 +14,12 @@
 #include "particles/Emitter.h"
 #include "particles/FixedStepDriver.h"
 #include "particles/ParticlePool.h"
+#include "particles/RenderDestination.h"
 #include "particles/Structure.h"
 
 namespace tickfx {
+
+class TaskExecutor;
 
 /// Settings of a whole simulation (the [simulation] table of an effect file).
 struct SystemSettings {
@@ -35,7 +40,9 @@ struct SystemSettings {
 /// the frame time, so the state after tick k is the same for any sequence of frames that reaches
 /// it.
 ///
-/// Not thread-safe: one thread drives a system; the system uses its own TBB arena inside a tick.
+/// Not thread-safe: one thread drives a system. Inside a tick the system runs its loops in its
+/// own TBB arena, or on the host's executor (setTaskExecutor()); it never changes TBB's
+/// process-wide limits.
 class ParticleSystem {
  public:
   /// Throws std::invalid_argument for invalid settings (unknown integrator, bad emitter, ...).
@@ -84,6 +91,25 @@ class ParticleSystem {
   /// previous + (current − previous) · α, exactly previous at 0 and current at 1.
   void interpolatedPositions(float alpha, Vec3Column& out) const;
 
+  /// The render copies above, written straight into a host's buffers (a vertex buffer, a
+  /// renderer's point arrays) in any layout: the same bits as renderPositions() and the others,
+  /// rows in id order. Nothing is written when the destination holds fewer rows than the pool
+  /// (see CopyResult).
+  CopyResult copyRenderPositions(const Vec3Destination& out) const;
+  CopyResult copyRenderVelocities(const Vec3Destination& out) const;
+  CopyResult copyRenderAges(const FloatDestination& out) const;
+  /// Particle ids (unique per system, in increasing order of birth).
+  CopyResult copyIds(const IdDestination& out) const;
+  /// A float column of the current tick by name: "lifetime" (seconds), "mass" (kg), or an
+  /// attribute of the pool (see ParticlePool::addAttribute). Empty for any other name.
+  std::optional<CopyResult> copyColumn(std::string_view name, const FloatDestination& out) const;
+
+  /// Runs this system's parallel loops on a host's job system from the next tick on, or on the
+  /// system's own TBB arena for nullptr (the default). Not owned: the executor must outlive the
+  /// system or be replaced first. The state's bits do not depend on it.
+  void setTaskExecutor(TaskExecutor* executor) { executor_ = executor; }
+  TaskExecutor* taskExecutor() const { return executor_; }
+
   const ParticlePool& pool() const { return pool_; }
   ParticlePool& pool() { return pool_; }
   const ForceSet& forces() const { return forces_; }
@@ -129,6 +155,9 @@ class ParticleSystem {
   FixedStepDriver driver_;
   class ThreadArena;  // the TBB arena, kept out of this header
   std::unique_ptr<ThreadArena> arena_;
+  TaskExecutor* executor_ = nullptr;  // the host's, when given: used instead of arena_
+  template <typename F>
+  void runParallel(F&& f) const;
   std::function<void(const ParticleSystem&)> tickObserver_;
   std::int64_t tick_ = 0;
   float alpha_ = 1.0f;

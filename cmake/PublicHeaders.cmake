@@ -1,0 +1,50 @@
+# The headers `cmake --install` puts under include/tickfx: what a host includes, and what those
+# include. tests/scripts/EmbedTest.cmake compiles each one alone against the install, so a
+# public header that includes an internal one fails the embed test.
+
+# Core (tickfx::tickfx): the system, its settings, the force modules and the integrator interface.
+set(TICKFX_CORE_PUBLIC_HEADERS
+  particles/Clock.h
+  particles/EmissionRate.h
+  particles/Emitter.h
+  particles/FixedStepDriver.h
+  particles/ParticlePool.h
+  particles/ParticleSystem.h
+  particles/Random.h
+  particles/RenderDestination.h
+  particles/SettingProblem.h
+  particles/StateHash.h
+  particles/Structure.h
+  particles/TaskExecutor.h
+  integrators/Advection.h
+  integrators/Integrator.h
+  integrators/StagePasses.h
+  fields/AnchorSpring.h
+  fields/ForceModule.h
+  fields/ForceSet.h
+  fields/Gravity.h
+  fields/LinearDrag.h
+  fields/PeriodicWind.h
+  fields/SpringNetwork.h
+)
+
+# COMPONENTS vdb (tickfx::vdb): vector fields from OpenVDB grids (their headers include none of
+# OpenVDB's).
+set(TICKFX_VDB_PUBLIC_HEADERS
+  fields/AnalyticField.h
+  fields/VectorField.h
+)
+
+# COMPONENTS effects (tickfx::effects): effect files, loadEffect(), caches.
+set(TICKFX_EFFECTS_PUBLIC_HEADERS
+  io/CsvCache.h
+  io/Diagnostics.h
+  io/EffectLint.h
+  io/EffectLoader.h
+  io/EffectParser.h
+  io/EffectSettings.h
+  io/FrameData.h
+  io/PlyCache.h
+  io/SourceMap.h
+  io/VdbPointCache.h
+)
