@@ -14,6 +14,8 @@
 #include "io/EffectBuilder.h"
 #include "io/EffectParser.h"
 #include "particles/StateHash.h"
+#include "particles/TaskExecutor.h"
+#include "tests/WorkerPool.h"
 
 namespace tickfx::io {
 namespace {
@@ -127,6 +129,27 @@ TEST_P(goldenHashes, StateAfterTwoSecondsOfTicks) {
       << kGoldenFile.string()
       << " with the new line, on purpose, and give the reason in the commit message. If not, a "
          "change has moved the bits of the state: find it.";
+}
+
+// A host that runs tickfx's loops on its own job system gets the same bits: on the calling thread
+// alone, and on four workers of its own that take the blocks in any order.
+TEST_P(goldenHashes, SameStateOnHostExecutors) {
+  const auto& entries = goldenList().entries;
+  const auto found = std::find_if(entries.begin(), entries.end(),
+                                  [&](const GoldenHash& g) { return g.file == GetParam(); });
+  ASSERT_NE(found, entries.end());
+  const LoadResult load = loadEffectFile(kSourceDir / "samples" / found->file);
+  ASSERT_TRUE(load.ok());
+  const std::int64_t ticks = 2 * load.effect->simulation.stepRateHz;
+  SerialExecutor serial;
+  WorkerPool workers(4);
+  for (TaskExecutor* executor : std::vector<TaskExecutor*>{&serial, &workers}) {
+    const std::unique_ptr<ParticleSystem> system = buildSystem(*load.effect);
+    system->setTaskExecutor(executor);
+    system->stepTicks(ticks);
+    EXPECT_EQ(hashToHex(stateHash(system->pool())), found->hash)
+        << (executor == &serial ? "serial executor" : "4 workers");
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Samples, goldenHashes, ::testing::ValuesIn(listedFiles()),
