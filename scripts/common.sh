@@ -10,6 +10,7 @@ TICKFX_PACKAGES=(
   libeigen3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenvdb-dev libopenvdb-tools libboost-dev libboost-iostreams-dev zlib1g-dev
+  python3-dev pybind11-dev python3-numpy python3-pytest
 )
 
 # Installs the packages that are missing. As root it runs apt-get itself (with one update first,
@@ -33,11 +34,15 @@ ensure_packages() {
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
-# configure_and_build BUILD_DIR [cmake args...]: configures (Release unless told) and builds on
-# every core.
-configure_and_build() {
+# configure BUILD_DIR [cmake args...]: configures (Release unless told).
+configure() {
   local dir=$1
   shift
   cmake -S "$TICKFX_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
-  cmake --build "$dir" -j "$(nproc)"
+}
+
+# configure_and_build BUILD_DIR [cmake args...]: configures and builds everything on every core.
+configure_and_build() {
+  configure "$@"
+  cmake --build "$1" -j "$(nproc)"
 }
