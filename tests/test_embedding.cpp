@@ -1,6 +1,7 @@
 // The embedding API as a host uses it: loadEffect() with errors as values, render copies into the
 // host's own buffers, and the host's job system running the parallel loops.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <unistd.h>
 
@@ -315,6 +316,20 @@ TEST_F(Embedding, HostExecutorsGiveTheArenasBits) {
   const std::size_t before = four.tasksRun();
   pooled.system->step();
   EXPECT_EQ(four.tasksRun(), before);
+}
+
+TEST_F(Embedding, ASystemLeavesTbbsProcessWideLimitAlone) {
+  // A host's own TBB limit is the host's: 64 threads asked of a 2-core machine do not raise it.
+  const std::size_t before =
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  LoadOptions many;
+  many.threads = 64;
+  const LoadedEffect fx = loadEffect(kSamples / "fountain.toml", {}, many);
+  ASSERT_TRUE(fx.ok()) << fx.text();
+  EXPECT_EQ(fx.system->settings().threads, 64);
+  fx.system->stepTicks(2);
+  EXPECT_EQ(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+            before);
 }
 
 }  // namespace

@@ -71,7 +71,7 @@ TEST_F(HashLog, ALogComparedWithItselfIsIdentical) {
   const std::vector<std::string> log = lines(readAll(path("a.log")));
   ASSERT_GT(log.size(), 16u);
   EXPECT_EQ(log[0], "tickfx hash log 1");
-  for (const char* key : {"machine: ", "cpu: ", "compiler: ", "build: ", "tickfx: 0.1.0"})
+  for (const char* key : {"machine: ", "cpu: ", "compiler: ", "build: ", "tickfx: 0.2.0"})
     EXPECT_GE(find(log, key), 0) << key;
   EXPECT_EQ(log[find(log, "seed: ")], "seed: 7");
   EXPECT_EQ(log[find(log, "step_rate: ")], "step_rate: 120");
