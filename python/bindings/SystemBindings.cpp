@@ -3,8 +3,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <cmath>
+#include <unistd.h>
+
 #include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <memory>
 #include <optional>
@@ -20,6 +22,17 @@
 
 namespace tickfx::python {
 namespace {
+
+// Bytes of one row of the pool's columns: position, velocity, previous position and acceleration
+// (12 floats), age, lifetime, mass and inverse mass (4 floats), id and birth tick (8 bytes each)
+// and the dead flag; a custom attribute adds a float.
+constexpr double kPoolBytesPerRow = 12 * 4 + 4 * 4 + 8 + 8 + 1;
+
+std::string gigabytes(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GB", bytes / 1e9);
+  return text;
+}
 
 /// What Python holds: the system, the effect it was built from and what a VDB cache records of it.
 class PySystem {
@@ -44,6 +57,22 @@ class PySystem {
   void pinStorage() {
     if (pinned_) return;
     ParticlePool& pool = system_->pool();
+    // Some of the columns are zero-filled as they grow: a reservation past the machine's memory
+    // would not fail as an exception but get the interpreter killed.
+    const double bytes = static_cast<double>(pool.maxParticles()) *
+                         (kPoolBytesPerRow + 4.0 * static_cast<double>(pool.attributeCount()));
+    const double physical =
+        static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+    if (physical > 0.0 && bytes > physical) {
+      const std::string message =
+          "the first view of a system reserves simulation.max_particles = " +
+          std::to_string(pool.maxParticles()) + " rows (" + gigabytes(bytes) +
+          "), more than this machine's " + gigabytes(physical) +
+          " of memory: load the effect with a smaller max_particles (overrides "
+          "{\"simulation.max_particles\": N})";
+      PyErr_SetString(PyExc_MemoryError, message.c_str());
+      throw py::error_already_set();
+    }
     pool.reserve(pool.maxParticles());
     pinned_ = true;
   }
