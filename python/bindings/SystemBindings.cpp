@@ -155,8 +155,9 @@ void bindSystemClass(py::module_& m) {
           },
           py::arg("ticks") = 1,
           "Runs `ticks` ticks (each 1/step_rate seconds) now, bypassing the frame clock of "
-          "advance(); the shown time is then the newest tick's (alpha = 1). Do not mix with "
-          "advance() on one system: advance() keeps its own clock.")
+          "advance(); the shown time is then the newest tick's (alpha = 1). advance() keeps a "
+          "frame clock that step() does not move: after mixing the two, advance() still runs "
+          "the ticks its own clock asks for.")
       .def_property_readonly(
           "tick", [](const PySystem& s) { return s.system().tickCount(); },
           "Ticks completed: the pool holds the state after tick `tick` - 1, at tick / step_rate "

@@ -227,6 +227,8 @@ def _advance(self, duration):
     return AdvanceResult(ticks, dropped)
 
 
+_advance.__name__ = "advance"
+_advance.__qualname__ = "System.advance"
 System.advance = _advance
 
 
