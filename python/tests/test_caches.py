@@ -1,0 +1,197 @@
+# read_cache / write_cache: every attribute back bit for bit, in every format, for caches the
+# command line wrote and caches the module wrote.
+import numpy as np
+import pytest
+import tickfx
+from conftest import run_cli
+
+FORMATS = ["csv", "ply", "vdb"]
+STANDARD = ["P", "v", "id", "age", "life", "mass"]
+
+
+def assert_same_bits(actual, expected):
+    assert list(actual) == list(expected)
+    for name in expected:
+        a, e = actual[name], expected[name]
+        assert a.dtype == e.dtype, name
+        assert a.shape == e.shape, name
+        assert a.tobytes() == e.tobytes(), name
+
+
+@pytest.fixture(scope="module")
+def cli_frames(cli, samples, tmp_path_factory):
+    """Frame 36 of the fountain (1.5 s) written by `tickfx run` in all three formats, and the
+    System that reached the same frame in Python."""
+    out = tmp_path_factory.mktemp("cli_caches")
+    run_cli(cli, "run", samples / "fountain.toml", "--frames", "36", "--format", "csv,ply,vdb",
+            "--out", out, "--quiet")
+    system = tickfx.load_effect(samples / "fountain.toml")
+    frame = 1 / system.output_fps
+    for _ in range(36):
+        system.advance(frame)
+    return out, system
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_cli_cache_reads_as_the_python_frame(cli_frames, fmt):
+    out, system = cli_frames
+    columns = tickfx.read_cache(out / f"frame_0036.{fmt}")
+    assert list(columns) == STANDARD
+    n = system.count
+    assert n > 2000
+    assert columns["P"].shape == (n, 3) and columns["P"].dtype == np.float32
+    assert columns["v"].shape == (n, 3) and columns["v"].dtype == np.float32
+    assert columns["id"].shape == (n,) and columns["id"].dtype == np.int64
+    for name in ("age", "life", "mass"):
+        assert columns[name].shape == (n,) and columns[name].dtype == np.float32
+    assert_same_bits(columns, system.capture())
+    assert np.all(columns["mass"] == 1.0)
+    assert columns["age"].max() <= 1.5
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_write_cache_matches_the_cli(cli_frames, tmp_path, fmt):
+    out, system = cli_frames
+    cli_file = out / f"frame_0036.{fmt}"
+    mine = tmp_path / f"mine.{fmt}"
+    tickfx.write_cache(mine, system.capture(), frame=36, time=system.time, system=system)
+    assert_same_bits(tickfx.read_cache(mine), tickfx.read_cache(cli_file))
+    # The same frame, frame number, time and effect: the same file, byte for byte (a .vdb's
+    # metadata included).
+    assert mine.read_bytes() == cli_file.read_bytes()
+    # Rewriting what was read gives the same frame again.
+    again = tmp_path / f"again.{fmt}"
+    tickfx.write_cache(again, tickfx.read_cache(cli_file), frame=36, time=system.time,
+                       system=system)
+    assert_same_bits(tickfx.read_cache(again), tickfx.read_cache(cli_file))
+
+
+def awkward_frame(fmt):
+    """Values that a careless reader or writer would change: signed zeros, infinities, NaN,
+    subnormals, the extremes of float32, large ids; plus two custom attributes."""
+    special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan, 1e-45, -1e-40, 3.4028235e38,
+                        -3.4028235e38, 0.1, 1.0 / 3.0, 2.0 ** -126, 1e30, -7.25], dtype=np.float32)
+    n = len(special)
+    rng = np.random.default_rng(11)
+    noise = rng.standard_normal((n, 3)).astype(np.float32) * np.float32(1e3)
+    big = 2**53 if fmt == "ply" else 2**62 + 12345  # PLY stores ids as doubles
+    ids = np.array([0, 1, 2, 3, 5, 8, 13, 1000, 10**6, 10**9, 2**31, 2**32 + 1, 2**40, big],
+                   dtype=np.int64)
+    return {
+        "P": np.stack([special, np.roll(special, 3), noise[:, 2]], axis=1),
+        "v": np.stack([noise[:, 0], special[::-1].copy(), noise[:, 1]], axis=1),
+        "id": ids,
+        "age": np.abs(noise[:, 0]),
+        "life": np.roll(special, 5),
+        "mass": np.roll(special, 7),
+        "temperature": -special,  # a NaN with its sign bit set, too
+        "Cd": rng.random(n, dtype=np.float32),
+    }
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_round_trip_every_bit(tmp_path, fmt):
+    columns = awkward_frame(fmt)
+    path = tmp_path / f"awkward.{fmt}"
+    tickfx.write_cache(path, columns, frame=7, time=0.25)
+    back = tickfx.read_cache(path)
+    assert_same_bits(back, columns)
+    # And once more through a second write.
+    path2 = tmp_path / f"awkward2.{fmt.upper()}"
+    tickfx.write_cache(path2, back)
+    assert_same_bits(tickfx.read_cache(path2), columns)
+
+
+@pytest.mark.parametrize("fmt", ["csv", "vdb"])
+def test_ids_past_2_63_keep_their_bits(tmp_path, fmt):
+    ids = np.array([1, 2**63 - 1], dtype=np.int64)
+    columns = {"P": np.zeros((2, 3), np.float32), "id": ids}
+    tickfx.write_cache(tmp_path / f"ids.{fmt}", columns)
+    assert tickfx.read_cache(tmp_path / f"ids.{fmt}")["id"].tobytes() == ids.tobytes()
+    # As uint64: the id 2^64 - 1 reads back as int64 -1.
+    tickfx.write_cache(tmp_path / f"u.{fmt}",
+                       {"P": np.zeros((1, 3), np.float32),
+                        "id": np.array([2**64 - 1], dtype=np.uint64)})
+    assert tickfx.read_cache(tmp_path / f"u.{fmt}")["id"].tolist() == [-1]
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_missing_columns_take_their_defaults(tmp_path, fmt):
+    P = np.arange(12, dtype=np.float32).reshape(4, 3)
+    tickfx.write_cache(tmp_path / f"min.{fmt}", {"P": P, "id": np.arange(4, dtype=np.uint32)})
+    back = tickfx.read_cache(tmp_path / f"min.{fmt}")
+    assert back["P"].tobytes() == P.tobytes()
+    assert back["id"].tolist() == [0, 1, 2, 3]
+    assert np.array_equal(back["v"], np.zeros((4, 3), np.float32))
+    assert np.array_equal(back["age"], np.zeros(4, np.float32))
+    assert np.array_equal(back["life"], np.full(4, np.inf, np.float32))
+    assert np.array_equal(back["mass"], np.ones(4, np.float32))
+
+
+def test_empty_frame(tmp_path):
+    for fmt in FORMATS:
+        tickfx.write_cache(tmp_path / f"empty.{fmt}",
+                           {"P": np.zeros((0, 3), np.float32), "id": np.zeros(0, np.int64)})
+        back = tickfx.read_cache(tmp_path / f"empty.{fmt}")
+        assert back["P"].shape == (0, 3) and back["id"].shape == (0,)
+
+
+def test_write_cache_validates(tmp_path):
+    P = np.zeros((3, 3), np.float32)
+    ids = np.arange(3)
+    good = {"P": P, "id": ids}
+    cases = [
+        ({"P": P.astype(np.float64), "id": ids}, "float64, which does not convert to float32"),
+        ({"P": P[:, :2], "id": ids}, r"'P' must have shape \(N, 3\)"),
+        ({"P": P, "id": ids.astype(np.float32)}, "'id' must be an integer array"),
+        ({"P": P, "id": ids[:2]}, r"'id' must have shape \(3,\)"),
+        ({"P": P}, "columns need 'id'"),
+        ({"id": ids}, "columns need 'P'"),
+        ({**good, "v": np.zeros((3,), np.float32)}, r"'v' must have shape \(3, 3\)"),
+        ({**good, "mass": np.ones(4, np.float32)}, r"'mass' must have shape \(3,\)"),
+        ({**good, "heat": [1.0, 2.0, 3.0]}, "'heat' is float64"),
+        ({**good, "heat": np.ones(3, np.int32)}, "'heat' is int32"),
+    ]
+    for columns, message in cases:
+        with pytest.raises(ValueError, match=message):
+            tickfx.write_cache(tmp_path / "x.csv", columns)
+    # Exact conversions are fine: float16 and small integers are float32 exactly.
+    tickfx.write_cache(tmp_path / "ok.csv", {**good, "heat": np.ones(3, np.int16),
+                                             "age": np.full(3, 0.5, np.float16)})
+    assert tickfx.read_cache(tmp_path / "ok.csv")["heat"].dtype == np.float32
+    with pytest.raises(ValueError, match="expected .csv, .ply or .vdb"):
+        tickfx.write_cache(tmp_path / "x.bgeo", good)
+    with pytest.raises(ValueError, match="no commas"):
+        tickfx.write_cache(tmp_path / "x.csv", {**good, "a,b": np.zeros(3, np.float32)})
+    with pytest.raises(ValueError, match="no spaces"):
+        tickfx.write_cache(tmp_path / "x.ply", {**good, "a b": np.zeros(3, np.float32)})
+    with pytest.raises(ValueError, match="not a valid OpenVDB attribute name"):
+        tickfx.write_cache(tmp_path / "x.vdb", {**good, "a b": np.zeros(3, np.float32)})
+    with pytest.raises(ValueError, match="past 2\\^53"):
+        tickfx.write_cache(tmp_path / "x.ply", {"P": P, "id": np.array([0, 1, 2**53 + 2])})
+    with pytest.raises(TypeError):
+        tickfx.write_cache(tmp_path / "x.csv", [P, ids])
+    assert not any(tmp_path.glob("x.*"))  # nothing half-written
+
+
+def test_unreadable_caches_raise_cache_error(tmp_path, cli_frames):
+    out, _ = cli_frames
+    with pytest.raises(ValueError, match="expected .csv, .ply or .vdb"):
+        tickfx.read_cache(tmp_path / "frame.bgeo")
+    for fmt in FORMATS:
+        missing = tmp_path / f"missing.{fmt}"
+        with pytest.raises(tickfx.CacheError, match="missing"):
+            tickfx.read_cache(missing)
+        whole = (out / f"frame_0036.{fmt}").read_bytes()
+        cut = tmp_path / f"cut.{fmt}"
+        cut.write_bytes(whole[: len(whole) // 2])
+        with pytest.raises(tickfx.CacheError, match="cut"):
+            tickfx.read_cache(cut)
+        junk = tmp_path / f"junk.{fmt}"
+        junk.write_bytes(b"\x00\x01garbage\xff" * 100)
+        with pytest.raises(tickfx.CacheError, match="junk"):
+            tickfx.read_cache(junk)
+    assert issubclass(tickfx.CacheError, OSError)
+    with pytest.raises(tickfx.CacheError):
+        tickfx.write_cache(tmp_path / "no" / "such" / "dir.csv",
+                           {"P": np.zeros((1, 3), np.float32), "id": np.zeros(1, np.int64)})
