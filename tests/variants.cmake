@@ -1,5 +1,5 @@
-# The determinism promise across builds: `tickfx run` built with clang++ (Release, Debug) and g++
-# (Debug), and with both at -O3 -march=native, must reach the same golden state hashes as this build. See
+# The determinism promise across builds: `tickfx run` built with clang++ (Release) and g++ (-O0),
+# and with both at -O3 -march=native, must reach the same golden state hashes as this build. See
 # tests/scripts/BuildVariants.cmake.
 #
 # Not in a sanitizer build: the variants are unsanitised, so scripts/test's second pass would only
@@ -14,7 +14,7 @@ if(TARGET tickfx_cli AND NOT TICKFX_SANITIZE)
       -DMAIN_NAME=main-${CMAKE_CXX_COMPILER_ID}-${CMAKE_BUILD_TYPE}
       -DGOLDEN_FILE=${CMAKE_CURRENT_SOURCE_DIR}/data/golden_hashes.txt
       -P ${CMAKE_CURRENT_SOURCE_DIR}/scripts/BuildVariants.cmake)
-  # It builds the CLI five times on every core: beside other tests it would slow them into their
+  # It builds the CLI four times on every core: beside other tests it would slow them into their
   # timeouts. With three variants it took 70 to 140 s from scratch on 2 shared cores (the runs
   # themselves about 1 s); the two native variants are Release builds, about as long each. The
   # timeout leaves room for a slow CI machine.
