@@ -118,7 +118,9 @@ TEST_F(Cli, OscillatorDumpAgreesWithMinusCosT) {
   }
 }
 
-TEST_F(Cli, JitteredAndRecordedFrameTimesReachTheSameTickState) {
+// A regression guard: every frame source runs the same ticks through the same code; this fails
+// only if the frames leak into a tick.
+TEST_F(Cli, JitteredAndRecordedFrameTimesReachTheSameTickStateRegressionGuard) {
   const std::string reference =
       hashOf(run("run samples/fountain.toml --seconds 2 --fps 60 --format none --hash"));
   EXPECT_EQ(hashOf(run("run samples/fountain.toml --seconds 2 --jitter 7 --format none --hash")),
@@ -354,7 +356,8 @@ TEST_F(Cli, DeterminismPrintsTheTableAndAVerdict) {
   EXPECT_EQ(run("determinism samples/fountain.toml --threads 0").exit, 2);
 }
 
-TEST_F(Cli, TracesOfTwoFrameRatesAreIdenticalTickForTick) {
+// A regression guard, as above, tick by tick; the trace's own format is checked for real.
+TEST_F(Cli, TracesOfTwoFrameRatesAreIdenticalTickForTickRegressionGuard) {
   ASSERT_EQ(
       run("run samples/burst.toml --seconds 2 --fps 24 --format none --trace " + path("a.csv"))
           .exit,

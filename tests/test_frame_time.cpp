@@ -216,8 +216,10 @@ TEST(FrameTime, BirthsAndDeathsBetweenTwoTicks) {
 }
 
 // Interpolated ages are computed from integers: the same bits for the same frame time however
-// the frames got there, like the state.
-TEST(FrameTime, SharedFramesAreBitwiseEqualAcrossFrameRates) {
+// the frames got there, like the state. A regression guard: both schedules render a shared frame
+// from the same two ticks through the same code, so this fails only if the frame history leaks
+// into what a frame shows (a float α or age accumulated frame by frame would).
+TEST(FrameTime, SharedFramesAreBitwiseEqualAcrossFrameRatesRegressionGuard) {
   const SystemSettings settings = test::referenceSettings();
   const auto a = test::referenceSystem(settings);
   const auto b = test::referenceSystem(settings);

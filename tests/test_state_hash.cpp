@@ -11,7 +11,10 @@
 namespace tickfx {
 namespace {
 
-TEST(StateHash, TwoIndependentRunsGiveTheSameHash) {
+// A regression guard: the same code path run twice in one process, so equal hashes show only that
+// nothing outside the effect (uninitialised memory, a static, the allocator) leaks into the state;
+// one more tick must change the hash. Frames, threads and builds are tested elsewhere.
+TEST(StateHash, SamePathTwiceGivesTheSameHashRegressionGuard) {
   for (const std::string& name : integratorNames()) {
     const auto a = test::referenceSystem(test::referenceSettings(name));
     const auto b = test::referenceSystem(test::referenceSettings(name));

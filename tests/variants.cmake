@@ -1,5 +1,6 @@
 # The determinism promise across builds: `tickfx run` built with clang++ (Release) and g++ (-O0),
-# and with both at -O3 -march=native, must reach the same golden state hashes as this build. See
+# and with both at -O3 -march=native, must reach the same golden state hashes as this build, for
+# the samples and for the golden effects of tests/data/golden/. See
 # tests/scripts/BuildVariants.cmake.
 #
 # Not in a sanitizer build: the variants are unsanitised, so scripts/test's second pass would only
@@ -13,6 +14,7 @@ if(TARGET tickfx_cli AND NOT TICKFX_SANITIZE)
       -DMAIN_TICKFX=$<TARGET_FILE:tickfx_cli>
       -DMAIN_NAME=main-${CMAKE_CXX_COMPILER_ID}-${CMAKE_BUILD_TYPE}
       -DGOLDEN_FILE=${CMAKE_CURRENT_SOURCE_DIR}/data/golden_hashes.txt
+      -DGOLDEN_EFFECTS_FILE=${CMAKE_CURRENT_SOURCE_DIR}/data/golden/hashes.txt
       -P ${CMAKE_CURRENT_SOURCE_DIR}/scripts/BuildVariants.cmake)
   # It builds the CLI four times on every core: beside other tests it would slow them into their
   # timeouts. With three variants it took 70 to 140 s from scratch on 2 shared cores (the runs
