@@ -60,7 +60,7 @@ LoadedEffect loadEffect(const std::filesystem::path& path,
                         const LoadOptions& options = {}) noexcept;
 
 /// `tickfx check` as a call: every error of the effect, or its lint warnings. Never throws.
-std::vector<io::Diagnostic> checkEffect(const std::filesystem::path& path,
-                                        const std::vector<SettingOverride>& overrides = {}) noexcept;
+std::vector<io::Diagnostic> checkEffect(
+    const std::filesystem::path& path, const std::vector<SettingOverride>& overrides = {}) noexcept;
 
 }  // namespace tickfx

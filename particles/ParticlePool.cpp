@@ -42,13 +42,6 @@ void Vec3Column::conservativeResize(Eigen::Index rows) {
   z.conservativeResize(rows);
 }
 
-void Vec3Column::assignRows(const Vec3Column& from, Eigen::Index begin, Eigen::Index end) {
-  const Eigen::Index n = end - begin;
-  x.segment(begin, n) = from.x.segment(begin, n);
-  y.segment(begin, n) = from.y.segment(begin, n);
-  z.segment(begin, n) = from.z.segment(begin, n);
-}
-
 ParticlePool::ParticlePool(std::size_t maxParticles) : maxParticles_(maxParticles) {
   if (maxParticles >= (std::size_t{1} << 32)) {
     // Row indices are 32-bit in the compaction and in the spring tables.

@@ -25,8 +25,6 @@ struct Vec3Column {
 
   void resize(Eigen::Index rows);
   void conservativeResize(Eigen::Index rows);
-  /// Copies rows [begin, end) of `from` (same row count semantics) into this column.
-  void assignRows(const Vec3Column& from, Eigen::Index begin, Eigen::Index end);
 };
 
 /// Everything a new particle starts with. Units: metres, metres per second, seconds, kilograms.

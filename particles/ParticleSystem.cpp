@@ -180,7 +180,8 @@ void interpolate(const Vec3Column& previous, const Vec3Column& current, float al
       } else if (alpha == 0.0f) {
         for (std::size_t i = b; i < e; ++i) rowOf(d, out.rowStride, i) = p[i];
       } else {
-        for (std::size_t i = b; i < e; ++i) rowOf(d, out.rowStride, i) = p[i] + (q[i] - p[i]) * alpha;
+        for (std::size_t i = b; i < e; ++i)
+          rowOf(d, out.rowStride, i) = p[i] + (q[i] - p[i]) * alpha;
       }
     }
   });
@@ -201,7 +202,8 @@ double ParticleSystem::shownSeconds() const {
 
 void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
   const Vec3Destination to = columnsOf(out, pool_.size());
-  runParallel([&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, pool_.size(), to); });
+  runParallel(
+      [&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, pool_.size(), to); });
 }
 
 void ParticleSystem::renderPositions(Vec3Column& out) const {

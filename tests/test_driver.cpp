@@ -343,6 +343,27 @@ TEST(SystemDriver, DropExcessRunsTheCapOnAOneSecondFrame) {
   EXPECT_EQ(stateHash(system->pool()), stateHash(reference->pool()));
 }
 
+// step() after a frame between ticks shows the new tick itself: α = 1, the shown time the tick's,
+// and the render copies the tick's own positions, not an interpolation left over from advance().
+TEST(SystemDriver, StepAfterAFrameBetweenTicksShowsTheNewTick) {
+  const auto system = test::referenceSystem(test::referenceSettings());
+  system->advance(kSecond / 60 * 10 + kSecond / 120);  // 10.5 ticks: shows tick 10.5
+  ASSERT_EQ(system->tickCount(), 11);
+  ASSERT_EQ(system->alpha(), 0.5f);
+  EXPECT_DOUBLE_EQ(system->shownSeconds(), 10.5 / 60.0);
+  system->step();
+  EXPECT_EQ(system->tickCount(), 12);
+  EXPECT_EQ(system->alpha(), 1.0f);
+  EXPECT_EQ(system->shownSeconds(), 12.0 / 60.0);
+  Vec3Column shown;
+  system->renderPositions(shown);
+  const Eigen::Index n = static_cast<Eigen::Index>(system->pool().size());
+  ASSERT_GT(n, 0);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_TRUE((shown[c] == system->pool().position()[c].head(n)).all()) << c;
+  }
+}
+
 TEST(SystemDriver, FallBehindCatchesUpOnLaterFrames) {
   SystemSettings settings = test::referenceSettings();
   settings.overrunPolicy = OverrunPolicy::FallBehind;

@@ -87,10 +87,10 @@ TEST_F(Embedding, LoadsASampleIntoARunningSystem) {
 }
 
 TEST_F(Embedding, OverridesAreAppliedAsTheCommandLineAppliesThem) {
-  const LoadedEffect fx = loadEffect(kSamples / "fountain.toml",
-                                     {{"simulation.step_rate", "240"},
-                                      {"simulation.integrator", "rk4"},
-                                      {"emitters.0.direction", "[1, 0, 0]"}});
+  const LoadedEffect fx =
+      loadEffect(kSamples / "fountain.toml", {{"simulation.step_rate", "240"},
+                                              {"simulation.integrator", "rk4"},
+                                              {"emitters.0.direction", "[1, 0, 0]"}});
   ASSERT_TRUE(fx.ok()) << fx.text();
   EXPECT_EQ(fx.system->settings().stepRateHz, 240);
   EXPECT_EQ(fx.system->settings().integrator, "rk4");
@@ -103,10 +103,10 @@ TEST_F(Embedding, ErrorsComeBackAsTheCheckCommandsLines) {
   EXPECT_EQ(fx.system, nullptr);
   EXPECT_FALSE(fx.effect.has_value());
   ASSERT_EQ(lines(fx).size(), 2u) << fx.text();
-  EXPECT_EQ(lines(fx)[0], file + ":1:1: error: unknown_key: unknown key \"unknown_key\" (expected "
-                                 "one of: format_version, simulation, emitters, forces, output)");
-  EXPECT_EQ(lines(fx)[1].rfind("--set simulation.step_rate: error: simulation.step_rate: ", 0),
-            0u)
+  EXPECT_EQ(lines(fx)[0], file +
+                              ":1:1: error: unknown_key: unknown key \"unknown_key\" (expected "
+                              "one of: format_version, simulation, emitters, forces, output)");
+  EXPECT_EQ(lines(fx)[1].rfind("--set simulation.step_rate: error: simulation.step_rate: ", 0), 0u)
       << lines(fx)[1];
   EXPECT_EQ(fx.text(), lines(fx)[0] + "\n" + lines(fx)[1] + "\n");
 }
@@ -126,15 +126,15 @@ TEST_F(Embedding, AMissingFileOrBrokenTomlIsAValueNotAnException) {
 }
 
 TEST_F(Embedding, AFieldFileThatCannotBeReadIsADiagnosticAtItsKey) {
-  const std::string file = write(
-      "field.toml", std::string(kBall) + "[[forces]]\ntype = \"vector_field\"\nfile = \"" +
-                        (dir_ / "none.vdb").string() + "\"\n");
+  const std::string file =
+      write("field.toml", std::string(kBall) + "[[forces]]\ntype = \"vector_field\"\nfile = \"" +
+                              (dir_ / "none.vdb").string() + "\"\n");
   const LoadedEffect fx = loadEffect(file);
   EXPECT_FALSE(fx.ok());
   EXPECT_TRUE(fx.effect.has_value());  // the file is valid; building it is what failed
-  EXPECT_EQ(lines(fx), std::vector<std::string>{file + ":12:8: error: forces.1.file: " +
-                                                (dir_ / "none.vdb").string() +
-                                                ": grid 'vel': no such file"});
+  EXPECT_EQ(lines(fx),
+            std::vector<std::string>{file + ":12:8: error: forces.1.file: " +
+                                     (dir_ / "none.vdb").string() + ": grid 'vel': no such file"});
   // checkEffect() reports it as `tickfx check` does: a warning naming the fix.
   const std::vector<io::Diagnostic> check = checkEffect(file);
   ASSERT_EQ(check.size(), 1u);
@@ -204,8 +204,8 @@ TEST_F(Embedding, RenderCopiesInEveryLayoutAreTheRenderColumnsBitForBit) {
   EXPECT_NE(bitsOf(position.y[5]), bitsOf(system->pool().position().y[5]));
 
   std::vector<float> interleaved(3 * n, -1.0f);
-  ASSERT_TRUE(system->copyRenderPositions(Vec3Destination::interleaved(interleaved.data(), n))
-                  .written);
+  ASSERT_TRUE(
+      system->copyRenderPositions(Vec3Destination::interleaved(interleaved.data(), n)).written);
   struct Vertex {
     float p[3];
     std::uint32_t colour;
@@ -213,11 +213,12 @@ TEST_F(Embedding, RenderCopiesInEveryLayoutAreTheRenderColumnsBitForBit) {
     float age;
   };
   std::vector<Vertex> vertices(n, Vertex{{0, 0, 0}, 0xdeadbeef, {0, 0, 0}, 0});
-  const CopyResult p = system->copyRenderPositions(
-      Vec3Destination::records(vertices[0].p, sizeof(Vertex), n));
+  const CopyResult p =
+      system->copyRenderPositions(Vec3Destination::records(vertices[0].p, sizeof(Vertex), n));
   const CopyResult v =
       system->copyRenderVelocities(Vec3Destination::records(vertices[0].v, sizeof(Vertex), n));
-  const CopyResult a = system->copyRenderAges(FloatDestination{&vertices[0].age, sizeof(Vertex), n});
+  const CopyResult a =
+      system->copyRenderAges(FloatDestination{&vertices[0].age, sizeof(Vertex), n});
   EXPECT_TRUE(p.written && v.written && a.written);
   EXPECT_EQ(p.rows, n);
   std::vector<float> x(n), y(n), z(n);
@@ -241,7 +242,8 @@ TEST_F(Embedding, ACopyIntoTooSmallABufferWritesNothingAndSaysHowManyRows) {
   const auto system = fountainBetweenTicks();
   const std::size_t n = system->pool().size();
   std::vector<float> small(3 * (n - 1), 7.0f);
-  const CopyResult r = system->copyRenderPositions(Vec3Destination::interleaved(small.data(), n - 1));
+  const CopyResult r =
+      system->copyRenderPositions(Vec3Destination::interleaved(small.data(), n - 1));
   EXPECT_FALSE(r.written);
   EXPECT_EQ(r.rows, n);
   for (float f : small) ASSERT_EQ(f, 7.0f);
@@ -268,7 +270,8 @@ TEST_F(Embedding, IdsAndNamedColumnsCopyTheCurrentTick) {
   EXPECT_FALSE(system->copyColumn("colour", {life.data(), sizeof(float), n}).has_value());
 }
 
-// ---- host executors ------------------------------------------------------------------------------
+// ---- host executors
+// ------------------------------------------------------------------------------
 
 class CountingSerial final : public TaskExecutor {
  public:

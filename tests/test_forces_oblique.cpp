@@ -601,3 +601,35 @@ INSTANTIATE_TEST_SUITE_P(EveryForce, ObliqueMotion, ::testing::ValuesIn(kForces)
 
 }  // namespace
 }  // namespace tickfx::oblique
+
+namespace tickfx {
+namespace {
+
+// ForceSet adds a leading run of uniform modules once per evaluation (uniformAcceleration) and
+// any later one per row (accumulate): gravity after drag takes the per-row path, which must add
+// the same vector on every axis.
+TEST(GravityPerRow, AddsTheUniformVectorOnEveryAxis) {
+  const Eigen::Vector3f g(1.5f, -9.81f, 2.25f);
+  const Gravity gravity(g);
+  ParticlePool pool(4);
+  for (int i = 0; i < 3; ++i) pool.spawn(ParticleInit{}, 0);
+  const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), {}};
+  Eigen::Vector3f uniform;
+  ASSERT_TRUE(gravity.uniformAcceleration(in, uniform));
+  EXPECT_EQ(uniform, g);
+  Vec3Column a;
+  a.resize(3);
+  a.x << 0.5f, 0.0f, -1.0f;
+  a.y << 0.0f, 1.0f, 0.0f;
+  a.z << -0.25f, 0.0f, 4.0f;
+  const Vec3Column before = a;
+  const RowRange rows{0, 3};
+  Vec3Rows out = Vec3Rows::of(a, rows);
+  gravity.accumulate(in, rows, out);
+  for (int c = 0; c < 3; ++c) {
+    for (Eigen::Index i = 0; i < 3; ++i) EXPECT_EQ(a[c][i], before[c][i] + g[c]) << c << ", " << i;
+  }
+}
+
+}  // namespace
+}  // namespace tickfx

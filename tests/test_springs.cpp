@@ -369,6 +369,33 @@ TEST(BuildStructure, ClusterJoinsThePairsBornWithinTheLinkRadius) {
   EXPECT_TRUE(tiny.springs.empty());
 }
 
+// Pinned particles have infinite mass (inverse mass 0): each pin setting pins exactly its grid
+// points, (col, row) with row 0 at the top.
+TEST(BuildStructure, ClothPinsExactlyItsCornersOrItsTopEdge) {
+  for (const ClothPins pins : {ClothPins::AllCorners, ClothPins::TopCorners, ClothPins::TopEdge}) {
+    StructureSettings s;
+    ClothShape cloth;
+    cloth.width = 5;
+    cloth.height = 4;
+    cloth.spacing = 0.25;
+    cloth.pins = pins;
+    s.shape = cloth;
+    const StructureBuild b = buildStructure(s, kSeed, 0);
+    ASSERT_EQ(b.particles.size(), 20u);
+    for (int row = 0; row < 4; ++row) {
+      for (int col = 0; col < 5; ++col) {
+        const bool sideCol = col == 0 || col == 4;
+        const bool expected = pins == ClothPins::TopEdge      ? row == 0
+                              : pins == ClothPins::TopCorners ? row == 0 && sideCol
+                                                              : sideCol && (row == 0 || row == 3);
+        const float mass = b.particles[static_cast<std::size_t>(row * 5 + col)].mass;
+        EXPECT_EQ(std::isinf(mass), expected)
+            << "pins " << static_cast<int>(pins) << " at (" << col << ", " << row << ")";
+      }
+    }
+  }
+}
+
 TEST(BuildStructure, ClothHasStructuralShearAndBendSpringsWithTheirScales) {
   StructureSettings s;
   ClothShape cloth;
