@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
+#include "fields/LinearDrag.h"
 
 namespace tickfx {
 namespace {
@@ -192,6 +193,43 @@ TEST(ConstantAcceleration, LateSpawnStartsCleanlyInEveryScheme) {
                 3e-5)
         << name << ", the early particle";
   }
+}
+
+// Regression (issue 10, item 16), the README's order table: position Verlet's velocity is the last
+// step's difference of positions, half a step behind, so a force that reads velocity makes it first
+// order: under linear drag (k = 2/s, from 10 m/s, 1 s) its position error halves when the step
+// halves, where velocity Verlet's quarters. The figures are the schemes' closed forms
+// (test_forces_oblique): position Verlet −0.04975 m at 60 Hz and −0.02481 m at 120 Hz.
+TEST(LinearDragOrder, PositionVerletIsFirstOrderWhenForcesReadVelocity) {
+  constexpr double kDrag = 2.0, kSpeed = 10.0, kSeconds = 1.0;
+  ForceSet forces;
+  forces.add(std::make_unique<LinearDrag>(static_cast<float>(kDrag), Eigen::Vector3f::Zero()));
+  ParticleInit init;
+  init.velocity = Eigen::Vector3f(static_cast<float>(kSpeed), 0.0f, 0.0f);
+  const double exact = kSpeed * (1.0 - std::exp(-kDrag * kSeconds)) / kDrag;
+  auto errorAt = [&](const std::string& integrator, std::int64_t rate) {
+    double p = 0.0;
+    test::runSingle(integrator, forces, init, rate, rate, 0,
+                    [&](const test::Sample& s) { p = s.p; });
+    return p - exact;
+  };
+  // Round-off bounds as for the fall (fallRoundOff): the distance is at most 5 m, and position
+  // Verlet's velocity keeps every rounding of its positions, so its bound grows as n².
+  auto roundOff = [&](const std::string& integrator, std::int64_t rate) {
+    const double n = static_cast<double>(rate) * kSeconds;
+    return ((integrator == "position_verlet" ? n * n / 6.0 : 2.0 / 3.0 * n) + 48.0) * kFloatU * 5.0;
+  };
+  const double verlet60 = errorAt("position_verlet", 60),
+               verlet120 = errorAt("position_verlet", 120);
+  EXPECT_NEAR(verlet60, -0.0497522, roundOff("position_verlet", 60));    // 1.8e-4
+  EXPECT_NEAR(verlet120, -0.0248127, roundOff("position_verlet", 120));  // 7.2e-4
+  EXPECT_GT(verlet60 / verlet120, 1.9) << "first order";
+  EXPECT_LT(verlet60 / verlet120, 2.1) << "first order";
+  const double velocity60 = errorAt("velocity_verlet", 60);
+  const double velocity120 = errorAt("velocity_verlet", 120);
+  EXPECT_NEAR(velocity60, 5.6182e-4, roundOff("velocity_verlet", 60));    // 2.6e-5
+  EXPECT_NEAR(velocity120, 1.4202e-4, roundOff("velocity_verlet", 120));  // 3.1e-5
+  EXPECT_GT(velocity60 / velocity120, 3.0) << "second order";
 }
 
 TEST(IntegratorRegistry, NamesMakeTheirSchemes) {

@@ -1128,6 +1128,48 @@ TEST(SpringLifecycle, OnlySpringsStretchedPastTheirRatioBreak) {
   EXPECT_GT(pool.velocity().x[1], 0.0f) << "particle 1 is pulled by 1–2 only";
 }
 
+// Regression (issue 10, item 16), the documented caveat: velocity Verlet keeps a(t) from the end of
+// the last tick, so a spring that breaks at the start of a tick still pulls in that tick's first
+// half-kick, by exactly h/2 times its last acceleration. Semi-implicit Euler, which evaluates
+// forces within the tick, sees no spring at all in that tick.
+TEST(SpringLifecycle, VelocityVerletsKeptAccelerationIncludesASpringThatBrokeAtTheTicksStart) {
+  constexpr std::int64_t kRate = 60;
+  const double h = floatDt(kRate);
+  for (const std::string integrator : {"velocity_verlet", "semi_implicit_euler"}) {
+    ForceSet forces;
+    SpringNetwork& network = addNetwork(forces);
+    ParticleSystem system(settingsFor(integrator, kRate), {}, std::move(forces));
+    ParticlePool& pool = system.pool();
+    // 2 m apart and flying apart at 20 m/s: whole at the first tick's start (2 < 2.1), broken at
+    // the second's (2.33 > 2.1).
+    for (float side : {-1.0f, 1.0f}) {
+      ParticleInit p;
+      p.position = Eigen::Vector3f(side, 0.0f, 0.0f);
+      p.velocity = Eigen::Vector3f(10.0f * side, 0.0f, 0.0f);
+      pool.spawn(p, 0);
+    }
+    constexpr double kStiffness = 5.0, kRest = 1.0;
+    network.add(
+        Spring{0, 1, static_cast<float>(kRest), static_cast<float>(kStiffness), 0.0f, 2.1f});
+    system.step();
+    ASSERT_EQ(network.brokenCount(), 0u) << integrator;
+    const double length = positionOf(pool, 1).x() - positionOf(pool, 0).x();
+    const Eigen::Vector3d v1 = velocityOf(pool, 0);
+    system.step();
+    ASSERT_EQ(network.brokenCount(), 1u) << integrator;
+    const double dv = velocityOf(pool, 0).x() - v1.x();
+    if (integrator == "velocity_verlet") {
+      // Particle 0's last acceleration: k·(L − rest)/m toward particle 1, at the length the first
+      // tick ended with (5.5e-2 m/s here).
+      const double halfKick = h / 2.0 * kStiffness * (length - kRest);
+      EXPECT_NEAR(dv, halfKick, 8.0 * kFloatU * std::abs(v1.x())) << "length " << length;
+      EXPECT_GT(dv, 0.05);
+    } else {
+      EXPECT_EQ(dv, 0.0) << "no spring, no force in the tick it broke";
+    }
+  }
+}
+
 // ---- the bits do not depend on the thread count ------------------------------------------------
 //
 // A 100 × 100 cloth (10 000 rows: two blocks of kParallelBlockRows, springs across the boundary)
