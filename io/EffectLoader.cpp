@@ -3,6 +3,7 @@
 #include <exception>
 #include <new>
 
+#include "io/Checkpoint.h"
 #include "io/EffectBuilder.h"
 #include "io/EffectLint.h"
 #include "io/EffectParser.h"
@@ -45,7 +46,8 @@ LoadedEffect loadEffect(const std::filesystem::path& path,
                         const LoadOptions& options) noexcept {
   LoadedEffect result;
   try {
-    io::LoadResult load = io::loadEffectFile(path, overrideTexts(overrides));
+    const std::vector<std::string> texts = overrideTexts(overrides);
+    io::LoadResult load = io::loadEffectFile(path, texts);
     result.diagnostics = std::move(load.diagnostics);
     if (!load.ok()) return result;
     result.effect = std::move(load.effect);
@@ -58,11 +60,14 @@ LoadedEffect loadEffect(const std::filesystem::path& path,
     }
     if (options.lint) appendLint(*result.effect, &result.system->forces(), result.diagnostics);
     io::sortDiagnostics(result.diagnostics);
+    result.fingerprint = io::effectFingerprint(path, texts);
   } catch (const std::bad_alloc&) {
     result.system.reset();
+    result.fingerprint = 0;
     result.diagnostics.push_back(fileError(path, "out of memory while loading the effect"));
   } catch (const std::exception& e) {
     result.system.reset();
+    result.fingerprint = 0;
     result.diagnostics.push_back(fileError(path, e.what()));
   }
   return result;

@@ -1,6 +1,7 @@
 // The embedding API: from an effect file to a running system in one call, errors as values.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -44,6 +45,9 @@ struct LoadedEffect {
   /// Every error (the reason `system` is null) and, with LoadOptions::lint, every warning, in
   /// file order, exactly as `tickfx check` prints them: FILE:LINE:COL: error: key.path: message.
   std::vector<io::Diagnostic> diagnostics;
+  /// io::effectFingerprint() of the file and the overrides, the effect's identity that
+  /// checkpoints, VDB caches and hash logs record; 0 when there is an error.
+  std::uint64_t fingerprint = 0;
 
   bool ok() const { return system != nullptr; }
   /// diagnostics, one format()ted line each, '\n'-terminated ("" when there are none).

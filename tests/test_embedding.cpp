@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "io/Checkpoint.h"
 #include "io/EffectLoader.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"
@@ -94,6 +95,13 @@ TEST_F(Embedding, OverridesAreAppliedAsTheCommandLineAppliesThem) {
   ASSERT_TRUE(fx.ok()) << fx.text();
   EXPECT_EQ(fx.system->settings().stepRateHz, 240);
   EXPECT_EQ(fx.system->settings().integrator, "rk4");
+  // The identity `tickfx run --set ...` records in caches and checkpoints: the file and each
+  // override as key=value, in order.
+  EXPECT_EQ(fx.fingerprint,
+            io::effectFingerprint(kSamples / "fountain.toml",
+                                  {"simulation.step_rate=240", "simulation.integrator=rk4",
+                                   "emitters.0.direction=[1, 0, 0]"}));
+  EXPECT_NE(fx.fingerprint, loadEffect(kSamples / "fountain.toml").fingerprint);
 }
 
 TEST_F(Embedding, ErrorsComeBackAsTheCheckCommandsLines) {
@@ -102,6 +110,7 @@ TEST_F(Embedding, ErrorsComeBackAsTheCheckCommandsLines) {
   EXPECT_FALSE(fx.ok());
   EXPECT_EQ(fx.system, nullptr);
   EXPECT_FALSE(fx.effect.has_value());
+  EXPECT_EQ(fx.fingerprint, 0u);
   ASSERT_EQ(lines(fx).size(), 2u) << fx.text();
   EXPECT_EQ(lines(fx)[0], file +
                               ":1:1: error: unknown_key: unknown key \"unknown_key\" (expected "

@@ -14,7 +14,6 @@
 #include <utility>
 #include <vector>
 
-#include "io/Checkpoint.h"
 #include "io/EffectLoader.h"
 #include "io/FrameData.h"
 #include "particles/StateHash.h"
@@ -93,17 +92,6 @@ std::vector<SettingOverride> toOverrides(
   return overrides;
 }
 
-// The fingerprint `tickfx run` records in VDB caches: the file's bytes and each "key=value".
-std::string effectHashOf(const std::string& path, const std::vector<SettingOverride>& overrides) {
-  std::vector<std::string> texts;
-  for (const SettingOverride& o : overrides) texts.push_back(o.key + "=" + o.value);
-  try {
-    return hashToHex(io::effectFingerprint(path, texts));
-  } catch (const std::exception&) {
-    return "";  // the file changed under us since it loaded: the cache records no hash
-  }
-}
-
 // The system's `owner` is the numpy base: the array keeps the System object (and its pool) alive.
 template <typename T>
 py::array readOnlyView(const T* data, std::size_t rows, py::handle owner) {
@@ -134,19 +122,42 @@ constexpr const char* kViewNote =
 
 std::string viewDoc(const std::string& what) { return what + kViewNote; }
 
+// A zero-copy view of one column of the pool: what the pool's `Column` accessor returns.
+template <typename Column>
+struct ColumnView {
+  const char* name;
+  const Column& (ParticlePool::*column)() const;
+  const char* doc;
+};
+
+template <typename Column>
+void bindColumnViews(py::class_<PySystem>& system,
+                     std::initializer_list<ColumnView<Column>> views) {
+  for (const ColumnView<Column>& v : views) {
+    system.def_property_readonly(
+        v.name,
+        [column = v.column](py::object self) {
+          const ParticlePool& pool = pinned(self).system().pool();
+          return readOnlyView((pool.*column)().data(), pool.size(), self);
+        },
+        viewDoc(v.doc).c_str());
+  }
+}
+
 void bindSystemClass(py::module_& m) {
-  py::class_<PySystem>(m, "System",
-                       "A running effect, made by tickfx.load_effect(). Advance it frame by frame "
-                       "with advance() (or tick by tick with step()), read its particles through "
-                       "the zero-copy views (positions, velocities, ids, ...) or as copies "
-                       "(interpolated_positions(), capture()). Not thread-safe: drive a system "
-                       "from one thread.")
-      .def("_advance_flicks",
-           [](PySystem& s, std::int64_t flicks) {
-             if (flicks < 0) throw py::value_error("a frame lasts 0 flicks or more");
-             const AdvanceResult r = s.system().advance(flicks);
-             return py::make_tuple(r.ticks, r.ticksDropped);
-           })
+  py::class_<PySystem> cls(
+      m, "System",
+      "A running effect, made by tickfx.load_effect(). Advance it frame by frame "
+      "with advance() (or tick by tick with step()), read its particles through "
+      "the zero-copy views (positions, velocities, ids, ...) or as copies "
+      "(interpolated_positions(), capture()). Not thread-safe: drive a system "
+      "from one thread.");
+  cls.def("_advance_flicks",
+          [](PySystem& s, std::int64_t flicks) {
+            if (flicks < 0) throw py::value_error("a frame lasts 0 flicks or more");
+            const AdvanceResult r = s.system().advance(flicks);
+            return py::make_tuple(r.ticks, r.ticksDropped);
+          })
       .def(
           "step",
           [](PySystem& s, std::int64_t ticks) {
@@ -225,36 +236,6 @@ void bindSystemClass(py::module_& m) {
           },
           viewDoc("Velocities in metres per second as (x, y, z), three 1-D float32 arrays.")
               .c_str())
-      .def_property_readonly(
-          "ids",
-          [](py::object self) {
-            const ParticlePool& pool = pinned(self).system().pool();
-            return readOnlyView(pool.id().data(), pool.size(), self);
-          },
-          viewDoc("Particle ids, uint64, unique per system and increasing with birth (rows are "
-                  "in id order).")
-              .c_str())
-      .def_property_readonly(
-          "ages",
-          [](py::object self) {
-            const ParticlePool& pool = pinned(self).system().pool();
-            return readOnlyView(pool.age().data(), pool.size(), self);
-          },
-          viewDoc("Ages in seconds at the newest tick, float32.").c_str())
-      .def_property_readonly(
-          "lifetimes",
-          [](py::object self) {
-            const ParticlePool& pool = pinned(self).system().pool();
-            return readOnlyView(pool.lifetime().data(), pool.size(), self);
-          },
-          viewDoc("Lifetimes in seconds, float32 (inf: never dies).").c_str())
-      .def_property_readonly(
-          "masses",
-          [](py::object self) {
-            const ParticlePool& pool = pinned(self).system().pool();
-            return readOnlyView(pool.mass().data(), pool.size(), self);
-          },
-          viewDoc("Masses in kilograms, float32 (inf: pinned).").c_str())
       .def(
           "attribute",
           [](py::object self, const std::string& name) {
@@ -312,6 +293,15 @@ void bindSystemClass(py::module_& m) {
         return "<tickfx.System " + s.path() + " tick=" + std::to_string(s.system().tickCount()) +
                " count=" + std::to_string(s.system().pool().size()) + ">";
       });
+  bindColumnViews<std::vector<std::uint64_t>>(
+      cls, {{"ids", &ParticlePool::id,
+             "Particle ids, uint64, unique per system and increasing with birth (rows are in "
+             "id order)."}});
+  bindColumnViews<FloatColumn>(
+      cls,
+      {{"ages", &ParticlePool::age, "Ages in seconds at the newest tick, float32."},
+       {"lifetimes", &ParticlePool::lifetime, "Lifetimes in seconds, float32 (inf: never dies)."},
+       {"masses", &ParticlePool::mass, "Masses in kilograms, float32 (inf: pinned)."}});
 }
 
 }  // namespace
@@ -333,7 +323,7 @@ void bindSystem(py::module_& m) {
           // Loading reads and may bake vector fields: other Python threads may run meanwhile.
           py::gil_scoped_release release;
           loaded = loadEffect(path, overrides, options);
-          if (loaded.ok()) hash = effectHashOf(path, overrides);
+          if (loaded.ok()) hash = hashToHex(loaded.fingerprint);
         }
         std::vector<std::string> lines;
         for (const io::Diagnostic& d : loaded.diagnostics) lines.push_back(d.format());
