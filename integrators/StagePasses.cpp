@@ -3,14 +3,27 @@
 #include <algorithm>
 #include <array>
 #include <stdexcept>
+#include <string>
 
 #include "particles/ParallelFor.h"
 
 namespace tickfx {
 
-StageScratch::StageScratch(int count) : count_(count), columns_(static_cast<std::size_t>(count)) {
-  if (count < 0 || count > kMaxColumns) throw std::invalid_argument("too many stage columns");
+namespace {
+
+// Checked before the columns are made: a negative count would first ask for 2^64 of them.
+int checkedColumnCount(int count) {
+  if (count < 0 || count > StageScratch::kMaxColumns) {
+    throw std::invalid_argument("a scheme takes 0 to " + std::to_string(StageScratch::kMaxColumns) +
+                                " stage columns");
+  }
+  return count;
 }
+
+}  // namespace
+
+StageScratch::StageScratch(int count)
+    : count_(checkedColumnCount(count)), columns_(static_cast<std::size_t>(count_)) {}
 
 void StageScratch::ensureRows(std::size_t rows) {
   for (Vec3Column& c : columns_) {

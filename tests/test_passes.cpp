@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <stdexcept>
 
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
+#include "integrators/StagePasses.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
 
@@ -62,6 +64,15 @@ TEST_P(PassScheduling, FusedSplitAndThreadCountsGiveTheSameBits) {
 
 INSTANTIATE_TEST_SUITE_P(AllIntegrators, PassScheduling, ::testing::ValuesIn(integratorNames()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// The fused passes keep every stage column of a tile in one stack buffer of kMaxColumns columns:
+// a scheme may ask for 0 to kMaxColumns of them, and no more.
+TEST(StageScratch, HoldsZeroToMaxColumnsAndRefusesMore) {
+  EXPECT_EQ(StageScratch(0).count(), 0);
+  EXPECT_EQ(StageScratch(StageScratch::kMaxColumns).count(), StageScratch::kMaxColumns);
+  EXPECT_THROW(StageScratch(StageScratch::kMaxColumns + 1), std::invalid_argument);
+  EXPECT_THROW(StageScratch(-1), std::invalid_argument);
+}
 
 }  // namespace
 }  // namespace tickfx

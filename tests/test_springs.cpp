@@ -313,6 +313,23 @@ TEST(NeighbourPairs, SameListAsComparingEveryPair) {
   EXPECT_EQ(neighbourPairs(line, 0.025), bruteForcePairs(line, 0.025));
 }
 
+// The cells' margin, at the one place it matters: two points exactly `distance` apart whose first
+// lies a hair below a cell boundary. With cells exactly `distance` wide they fall in adjacent cells
+// only by luck of rounding; with cells 2⁻³⁰ narrower (a margin of the wrong sign) the second lands
+// two cells on and the pair is missed. The box is 3 m with 27 points, so the cells are the
+// distance wide (1 m) and not widened.
+TEST(NeighbourPairs, APairExactlyTheDistanceApartAcrossACellBoundaryIsFound) {
+  const double below = 1.0 - 0x1p-30 - 0x1p-40;  // just under a cell 2⁻³⁰ narrower than 1 m
+  std::vector<Eigen::Vector3d> points = {Eigen::Vector3d(0.0, 0.0, 0.0),
+                                         Eigen::Vector3d(below, 0.0, 0.0),
+                                         Eigen::Vector3d(below + 1.0, 0.0, 0.0)};
+  ASSERT_EQ((points[2] - points[1]).norm(), 1.0) << "exactly the distance apart";
+  while (points.size() < 27) points.push_back(Eigen::Vector3d(3.0, 0.0, 0.0));
+  const std::vector<std::pair<int, int>> pairs = neighbourPairs(points, 1.0);
+  EXPECT_EQ(pairs, bruteForcePairs(points, 1.0));
+  EXPECT_NE(std::find(pairs.begin(), pairs.end(), std::pair<int, int>{1, 2}), pairs.end());
+}
+
 TEST(NeighbourPairs, WorkStaysLinearForATinyDistance) {
   // A link radius of 1e-30 in a ball of 1 m: the cells widen to about ∛N per axis instead of
   // 1e30 per metre. 40 000 points fill ∛40000 → 35³ cells, of which the ball covers π/6, so
