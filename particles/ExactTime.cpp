@@ -16,15 +16,15 @@ std::int64_t tickAtOrAfter(double seconds, std::int64_t stepRateHz) {
   const double fraction = std::frexp(seconds, &e);
   const auto m = static_cast<std::uint64_t>(std::ldexp(fraction, 53));
   const u128 scaled = static_cast<u128>(m) * static_cast<u128>(stepRateHz);
-  const int shift = e - 53;
+  // seconds <= 1e9 < 2^30, so e <= 30: the binary point is always right of m's last bit, and
+  // the power of two is a right shift by at least 23.
+  const int shift = 53 - e;
   u128 ceil = 0;
-  if (shift >= 0) {
-    ceil = scaled << shift;  // seconds <= 1e9, so the product is below 2^50
-  } else if (-shift < 128) {
-    const u128 whole = scaled >> -shift;
-    ceil = whole + ((whole << -shift) != scaled ? 1 : 0);
+  if (shift < 128) {
+    const u128 whole = scaled >> shift;
+    ceil = whole + ((whole << shift) != scaled ? 1 : 0);
   } else {
-    ceil = scaled != 0 ? 1 : 0;
+    ceil = scaled != 0 ? 1 : 0;  // below 2^-75 s: any positive time is after tick 0
   }
   const auto k = static_cast<std::int64_t>(ceil);
   // Tick k − 1 is before `seconds` exactly, but its double may be `seconds` itself: the time

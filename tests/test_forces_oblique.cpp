@@ -1,6 +1,7 @@
 // Every force module against its closed form on all three axes, with directions along no axis:
 // gravity, drag, periodic wind, the anchor spring, a spring between two particles, and vector
-// fields (uniform, in force and drag mode, and a linear shear), each under all six integrators.
+// fields (uniform, in force and drag mode, sampled from a baked grid and in closed form through
+// AnalyticForce, and a linear shear), each under all six integrators.
 //
 // Three checks, so that neither the library nor the test's own arithmetic is trusted alone:
 //  1. the float run follows the scheme's recurrence, every tick and coordinate, within the
@@ -323,15 +324,28 @@ std::unique_ptr<VectorField> bakedField(const AnalyticField& field, VectorField:
   return bakeVectorField(field, bake, s);
 }
 
+// A field's force module: sampled from a baked grid (what effects use) or evaluated in closed form
+// (AnalyticForce, the oracle the field tests compare grids with).
+enum class FieldSource { Baked, Analytic };
+
+std::unique_ptr<ForceModule> fieldForce(FieldSource source, const AnalyticField& field,
+                                        VectorField::Mode mode, float scale) {
+  if (source == FieldSource::Baked) return bakedField(field, mode, scale);
+  return std::make_unique<AnalyticForce>(
+      field,
+      mode == VectorField::Mode::Drag ? AnalyticForce::Mode::Drag : AnalyticForce::Mode::Force,
+      scale);
+}
+
 // A uniform field in force mode is a constant acceleration scale·u.
-ForceCase uniformFieldForceCase() {
+ForceCase uniformFieldForceCase(FieldSource source) {
   const Vec u = floats(0.75f, -1.5f, 1.25f);
   const double scale = 1.5f;
   ForceCase c;
-  c.forces = [u, scale] {
+  c.forces = [u, scale, source] {
     ForceSet f;
-    f.add(
-        bakedField(AnalyticField::uniform(u), VectorField::Mode::Force, static_cast<float>(scale)));
+    f.add(fieldForce(source, AnalyticField::uniform(u), VectorField::Mode::Force,
+                     static_cast<float>(scale)));
     return f;
   };
   const Vec a = scale * u;
@@ -351,13 +365,14 @@ ForceCase uniformFieldForceCase() {
 }
 
 // A uniform field in drag mode is drag toward u at rate k = scale.
-ForceCase uniformFieldDragCase() {
+ForceCase uniformFieldDragCase(FieldSource source) {
   const Vec u = floats(-1.25f, 0.5f, 1.75f);
   const double k = 1.25f;
   ForceCase c;
-  c.forces = [u, k] {
+  c.forces = [u, k, source] {
     ForceSet f;
-    f.add(bakedField(AnalyticField::uniform(u), VectorField::Mode::Drag, static_cast<float>(k)));
+    f.add(fieldForce(source, AnalyticField::uniform(u), VectorField::Mode::Drag,
+                     static_cast<float>(k)));
     return f;
   };
   c.accel = [u, k](const std::vector<Vec>&, const std::vector<Vec>& v, double) {
@@ -413,8 +428,10 @@ ForceCase forceCase(const std::string& name) {
   if (name == "wind") return windCase();
   if (name == "anchor_spring") return anchorCase();
   if (name == "spring_pair") return springPairCase();
-  if (name == "field_uniform_force") return uniformFieldForceCase();
-  if (name == "field_uniform_drag") return uniformFieldDragCase();
+  if (name == "field_uniform_force") return uniformFieldForceCase(FieldSource::Baked);
+  if (name == "field_uniform_drag") return uniformFieldDragCase(FieldSource::Baked);
+  if (name == "analytic_uniform_force") return uniformFieldForceCase(FieldSource::Analytic);
+  if (name == "analytic_uniform_drag") return uniformFieldDragCase(FieldSource::Analytic);
   if (name == "field_shear_force") return shearFieldCase();
   throw std::invalid_argument("no force case " + name);
 }
@@ -426,9 +443,15 @@ const std::vector<std::string> kForces{"gravity",
                                        "spring_pair",
                                        "field_uniform_force",
                                        "field_uniform_drag",
-                                       "field_shear_force"};
-const std::vector<std::string> kClosedFormForces{"gravity", "drag", "field_uniform_force",
-                                                 "field_uniform_drag"};
+                                       "field_shear_force",
+                                       "analytic_uniform_force",
+                                       "analytic_uniform_drag"};
+const std::vector<std::string> kClosedFormForces{"gravity",
+                                                 "drag",
+                                                 "field_uniform_force",
+                                                 "field_uniform_drag",
+                                                 "analytic_uniform_force",
+                                                 "analytic_uniform_drag"};
 
 // ---- 1 and 2: the float run on every axis ------------------------------------------------------
 
