@@ -216,6 +216,23 @@ TEST(FixedStepDriver, RejectsInvalidArguments) {
 }
 
 // NTSC: 1001 frames of 30000/1001 fps are 33.4 s exactly; every prefix issues the ceiling.
+// restore() takes only a state some run of advance() reaches: a remainder below one second of
+// flicks, and one tick issued ahead of the ticks due only when a frame between ticks needed it
+// (AtFrameTime with a remainder). Checkpoints are checked through it.
+TEST(FixedStepDriver, RestoreRefusesStatesNoRunReaches) {
+  FixedStepDriver driver(60, 16);
+  EXPECT_NO_THROW(driver.restore(5, 0, 4, 1));  // tick 5 shows a frame just after tick 4
+  EXPECT_EQ(driver.ticksDue(), 4);
+  EXPECT_NO_THROW(driver.restore(4, 0, 4, kFlicksPerSecond - 1));
+  EXPECT_THROW(driver.restore(4, 0, 4, kFlicksPerSecond), std::invalid_argument);
+  EXPECT_THROW(driver.restore(5, 0, 4, 0), std::invalid_argument) << "on a tick: none ahead";
+  EXPECT_THROW(driver.restore(6, 0, 4, 1), std::invalid_argument);
+  EXPECT_THROW(driver.restore(4, 0, 4, -1), std::invalid_argument);
+  FixedStepDriver behind(60, 16, OverrunPolicy::DropExcess, FrameTiming::OneTickBehind);
+  EXPECT_THROW(behind.restore(5, 0, 4, 1), std::invalid_argument) << "never ahead";
+  EXPECT_NO_THROW(behind.restore(4, 0, 4, 1));
+}
+
 TEST(FixedStepDriver, NtscFrameRateAddsUpExactly) {
   const Flicks frame = frameDuration(FrameRate{30000, 1001});
   FixedStepDriver driver(60, 16);

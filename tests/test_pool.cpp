@@ -61,6 +61,15 @@ TEST(ParticlePool, CapHoldsAcrossStorageGrowth) {
   }
 }
 
+// Rows are 32-bit indices in the compaction and the spring tables: a capacity of 2^32 or more
+// is held to 2^32 − 1, and one below is kept as asked (nothing is allocated until spawns).
+TEST(ParticlePool, CapacityIsHeldBelowTwoToThe32) {
+  constexpr std::size_t kRows32 = std::size_t{1} << 32;
+  EXPECT_EQ(ParticlePool(kRows32 - 1).maxParticles(), kRows32 - 1);
+  EXPECT_EQ(ParticlePool(kRows32).maxParticles(), kRows32 - 1);
+  EXPECT_EQ(ParticlePool(kRows32 + 5).maxParticles(), kRows32 - 1);
+}
+
 TEST(ParticlePool, ZeroCapacityRefusesEverything) {
   ParticlePool pool(0);
   EXPECT_EQ(pool.spawn(tagged(1.0f), 0), ParticlePool::npos);

@@ -207,6 +207,17 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   EXPECT_EQ(
       s.validate()[0].text(),
       "axis_v: is parallel to axis_u (expected a direction [x, y, z] not parallel to axis_u)");
+  // A cluster's radii must be positive: 0 is refused, the smallest positive double is not.
+  ClusterShape cluster;
+  cluster.linkRadius = 0.0;
+  s = StructureSettings{};
+  s.shape = cluster;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].text(),
+            "link_radius: 0 is out of range (expected metres, a finite number > 0)");
+  cluster.linkRadius = std::numeric_limits<double>::denorm_min();
+  s.shape = cluster;
+  EXPECT_TRUE(s.validate().empty());
   // A structure's birth time is its own to check (the system turns it into a tick).
   s = StructureSettings{};
   s.time = -1.0;
