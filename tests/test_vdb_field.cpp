@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 
+#include "FlippedBitTestSupport.h"
 #include "VdbTestData.h"
 #include "fields/AnalyticField.h"
 #include "fields/ForceSet.h"
@@ -445,25 +446,13 @@ TEST_F(VdbField, EveryFlippedBitLoadsOrIsRefusedWithAMessage) {
   // Bit i mod 8 of byte i flipped, each its own file. OpenVDB 10 read a raw block's bytes before
   // comparing its size with the buffer's ("malloc(): corrupted top size", SIGABRT), and trusted
   // blosc headers and counts. Each file now loads, or is refused naming the file and grid.
-  std::size_t loaded = 0, refused = 0;
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    std::string flipped = bytes;
-    flipped[i] = static_cast<char>(flipped[i] ^ (1 << (i % 8)));
-    const std::string name = path("flip" + std::to_string(i) + ".vdb");
-    std::ofstream(name, std::ios::binary) << flipped;
-    try {
-      const VectorField field(settingsFor(name));
-      ++loaded;
-      EXPECT_EQ(field.valueType(), "vec3s") << "byte " << i;
-    } catch (const std::runtime_error& e) {
-      ++refused;
-      EXPECT_EQ(std::string(e.what()).rfind(name + ": grid 'vel': ", 0), 0u)
-          << "byte " << i << ": " << e.what();
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << "byte " << i << ": not a runtime_error: " << e.what();
-    }
-    fs::remove(name);
-  }
+  const test::FlippedBits flips = test::loadEveryFlippedBit(
+      bytes, [&](std::size_t i) { return path("flip" + std::to_string(i) + ".vdb"); }, "vel",
+      [&](const std::string& name, std::size_t i) {
+        const VectorField field(settingsFor(name));
+        EXPECT_EQ(field.valueType(), "vec3s") << "byte " << i;
+      });
+  const std::size_t loaded = flips.loaded, refused = flips.refusals.size();
   EXPECT_EQ(loaded + refused, bytes.size());
   EXPECT_GT(loaded, 300u);  // values, metadata values, unused bits
   EXPECT_GT(refused, bytes.size() / 2);

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "FlippedBitTestSupport.h"
+#include "PointCacheTestSupport.h"
 #include "VdbTestData.h"
 #include "io/FrameData.h"
 #include "io/VdbPointCache.h"
@@ -398,27 +400,18 @@ TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
   // Bit i mod 8 of byte i flipped, each its own file. OpenVDB 10 trusts the sizes, counts and
   // flags it reads: on hundreds of these files it aborted on an assertion (its paged streams,
   // blosc pages), crashed, or allocated gigabytes. Each now reads, or is refused naming the file.
-  std::size_t read = 0, refused = 0, corrupt = 0;
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    std::string flipped = bytes;
-    flipped[i] = static_cast<char>(flipped[i] ^ (1 << (i % 8)));
-    const fs::path file = path("flip" + std::to_string(i) + ".vdb");
-    std::ofstream(file, std::ios::binary) << flipped;
-    try {
-      const FrameData back = readVdbPointCache(file);
-      ++read;
-      // What was read is a frame of the cache's size, whatever values the flip changed.
-      EXPECT_EQ(back.size(), frame.size()) << "byte " << i;
-    } catch (const std::runtime_error& e) {
-      ++refused;
-      const std::string what = e.what();
-      EXPECT_EQ(what.rfind(file.string() + ": grid 'points': ", 0), 0u)
-          << "byte " << i << ": " << what;
-      if (what.find("the file is corrupt at byte ") != std::string::npos) ++corrupt;
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << "byte " << i << ": not a runtime_error: " << e.what();
-    }
-    fs::remove(file);
+  const test::FlippedBits flips = test::loadEveryFlippedBit(
+      bytes, [&](std::size_t i) { return path("flip" + std::to_string(i) + ".vdb").string(); },
+      "points",
+      [&](const std::string& file, std::size_t i) {
+        const FrameData back = readVdbPointCache(file);
+        // What was read is a frame of the cache's size, whatever values the flip changed.
+        EXPECT_EQ(back.size(), frame.size()) << "byte " << i;
+      });
+  const std::size_t read = flips.loaded, refused = flips.refusals.size();
+  std::size_t corrupt = 0;
+  for (const std::string& what : flips.refusals) {
+    if (what.find("the file is corrupt at byte ") != std::string::npos) ++corrupt;
   }
   EXPECT_EQ(read + refused, bytes.size());
   // Values (positions, velocities, metadata values, unused bits) still read; most of the bytes are
@@ -429,23 +422,9 @@ TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
 
   // The first attribute array's byte count (a uint64, 6 + 12 bytes for one point's P) one too
   // many: OpenVDB's paged stream asserted (mByteIndex <= mUncompressedBytes).
-  FrameData one;
-  one.resize(1, {});
-  one.id = {7};
-  for (int c = 0; c < 3; ++c) {
-    one.position[c][0] = 0.5f + static_cast<float>(c);
-    one.velocity[c][0] = 1.0f;
-  }
-  one.age[0] = 0.0f;
-  one.life[0] = 5.0f;
-  one.mass[0] = 1.0f;
-  writeVdbPointCache(one, sampleMetadata(), path("one.vdb"));
-  std::string damaged = fileBytes(path("one.vdb"));
-  const std::string count{"\x12\0\0\0\0\0\0\0", 8};
-  const std::size_t at = damaged.find(count);
+  writeVdbPointCache(test::onePointFrame(), sampleMetadata(), path("one.vdb"));
+  const std::size_t at = test::overstateFirstAttributeArray(path("one.vdb"));
   ASSERT_NE(at, std::string::npos);
-  damaged[at] = '\x13';
-  std::ofstream(path("one.vdb"), std::ios::binary) << damaged;
   EXPECT_EQ(errorOf(path("one.vdb")), path("one.vdb").string() +
                                           ": grid 'points': cannot read the grid (the file is "
                                           "corrupt at byte " +
