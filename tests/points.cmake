@@ -2,12 +2,13 @@
 # cache read back through OpenVDB itself, the emitter fed from CSV and VDB files with its
 # effect-file messages, and `tickfx run --format vdb` as a user runs it, checked with vdb_print
 # when it is installed. The io/ suites are named io* so that `ctest -R io` selects them. Every
-# test writes into a temporary directory of its own.
+# test writes into a temporary directory of its own. OpenVDB's side (files as other tools write
+# them, the caches read back) is tickfx_test_vdbdata's (VDB_TEST_DATA, see CMakeLists.txt).
 if(TARGET tickfx_io)
   tickfx_add_test(test_vdb_points ${CMAKE_CURRENT_SOURCE_DIR}/test_vdb_points.cpp
-    LIBS tickfx::io OpenVDB::openvdb)
+    LIBS tickfx::io VDB_TEST_DATA)
   tickfx_add_test(test_file_emitter ${CMAKE_CURRENT_SOURCE_DIR}/test_file_emitter.cpp
-    LIBS tickfx::io OpenVDB::openvdb)
+    LIBS tickfx::io VDB_TEST_DATA)
 endif()
 if(TARGET tickfx_cli)
   tickfx_add_test(test_points_cli ${CMAKE_CURRENT_SOURCE_DIR}/test_points_cli.cpp

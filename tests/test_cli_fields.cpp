@@ -3,7 +3,6 @@
 // nothing then; `run` and `check` with effects whose field files are missing, lack the grid, hold
 // the wrong type or are truncated (exit 2 and nothing written for run, a warning for check).
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "CliTestSupport.h"
+#include "VdbTestData.h"
 #include "fields/AnalyticField.h"
 #include "fields/VectorField.h"
 
@@ -320,11 +320,11 @@ TEST_F(CliFields, FieldFilesThatDoNotLoadStopRunAndWarnInCheck) {
   ASSERT_EQ(run("bake-field curl-noise --voxel-size 0.125 --out " + path("fields/noise.vdb")).exit,
             0);
   // A grid of floats where a vector grid is expected.
-  openvdb::initialize();
-  auto scalar = openvdb::FloatGrid::create(0.0f);
-  scalar->setName("vel");
-  scalar->tree().setValueOn({0, 0, 0}, 1.0f);
-  openvdb::io::File(path("fields/scalar.vdb")).write({scalar});
+  vdb_test::GridFileSpec scalar;
+  scalar.name = "vel";
+  scalar.type = vdb_test::GridType::Float;
+  scalar.activeVoxels = {{{0, 0, 0}, {1.0}}};
+  vdb_test::writeGridFile(path("fields/scalar.vdb"), scalar);
   // A file cut inside its grid data.
   const std::string noise = readAll(path("fields/noise.vdb"));
   std::ofstream(path("fields/cut.vdb"), std::ios::binary) << noise.substr(0, noise.size() / 2);

@@ -3,10 +3,6 @@
 // tested in test_emitter.cpp.) Files are written into a temporary directory of the test and
 // removed afterwards.
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/points/PointConversion.h>
-#include <openvdb/points/PointDataGrid.h>
-#include <openvdb/tools/PointIndexGrid.h>
 #include <unistd.h>
 
 #include <bit>
@@ -18,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "VdbTestData.h"
 #include "io/CsvCache.h"
 #include "io/EffectBuilder.h"
 #include "io/EffectParser.h"
@@ -169,17 +166,11 @@ mass = 0.5
 
 TEST_F(ioFileEmitter, BurstsAndAnOffsetAndAFileWithoutVelocities) {
   // A VDB file as another tool writes it: positions only, so the emitter's speed applies.
-  openvdb::initialize();
-  const std::vector<openvdb::Vec3R> positions = {{0.0, 1.0, 2.0}, {-1.0, 0.0, 0.5}};
-  const openvdb::points::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
-  const auto transform = openvdb::math::Transform::createLinearTransform(1.0);
-  const auto index =
-      openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
-  auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec,
-                                                   openvdb::points::PointDataGrid>(*index, wrapper,
-                                                                                   *transform);
-  grid->setName("points");
-  openvdb::io::File(path("bare.vdb")).write(openvdb::GridCPtrVec{grid});
+  vdb_test::PointsFileSpec bare;
+  bare.positions = {{0.0, 1.0, 2.0}, {-1.0, 0.0, 0.5}};
+  bare.voxelSize = 1.0;
+  bare.codec = vdb_test::PositionCodec::Null;
+  vdb_test::writePointsFile(path("bare.vdb"), bare);
 
   const io::EffectSettings effect = load(kHead + R"([[emitters]]
 type = "file"

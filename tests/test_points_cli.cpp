@@ -13,6 +13,7 @@
 #include <string>
 
 #include "CliTestSupport.h"
+#include "PointCacheTestSupport.h"
 #include "io/CsvCache.h"
 #include "io/VdbPointCache.h"
 
@@ -20,7 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using tickfx::cli_test::readAll;
 using tickfx::cli_test::Result;
 
 class CliPoints : public tickfx::cli_test::CliFixture {
@@ -156,23 +156,10 @@ TEST_F(CliPoints, AnEffectSeededFromACacheChecksAndRuns) {
 TEST_F(CliPoints, ACorruptPointsFileIsAnEffectErrorNotACrash) {
   // A one-point cache whose first attribute array (P) says it holds 13 bytes, one too many: the
   // paged stream of OpenVDB 10 asserted on it, so `check` and `run` died of SIGABRT (exit 134).
-  tickfx::io::FrameData one;
-  one.resize(1, {});
-  one.id = {7};
-  for (int c = 0; c < 3; ++c) {
-    one.position[c][0] = 0.5f + static_cast<float>(c);
-    one.velocity[c][0] = 1.0f;
-  }
-  one.age[0] = 0.0f;
-  one.life[0] = 5.0f;
-  one.mass[0] = 1.0f;
-  tickfx::io::writeVdbPointCache(one, tickfx::io::VdbCacheMetadata{}, path("pts.vdb"));
-  std::string bytes = readAll(path("pts.vdb"));
-  const std::string count{"\x12\0\0\0\0\0\0\0", 8};  // 6 + 12 bytes, a uint64
-  const std::size_t at = bytes.find(count);
+  tickfx::io::writeVdbPointCache(tickfx::test::onePointFrame(), tickfx::io::VdbCacheMetadata{},
+                                 path("pts.vdb"));
+  const std::size_t at = tickfx::test::overstateFirstAttributeArray(path("pts.vdb"));
   ASSERT_NE(at, std::string::npos);
-  bytes[at] = '\x13';
-  std::ofstream(path("pts.vdb"), std::ios::binary) << bytes;
   std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"
                                     "[[emitters]]\ntype = \"file\"\nfile = \"pts.vdb\"\n";
   const std::string message =

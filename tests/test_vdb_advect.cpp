@@ -2,8 +2,6 @@
 // schemes of integrators/Advection, the kill policy, and agreement with OpenVDB's own
 // tools::PointAdvect. The fields are baked in memory; nothing is written to disk.
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/PointAdvect.h>
 
 #include <cmath>
 #include <complex>
@@ -11,11 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "VdbTestData.h"
 #include "fields/AnalyticField.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/VectorField.h"
-#include "fields/VectorFieldGrids.h"
 #include "integrators/Integrator.h"
 #include "particles/ParticlePool.h"
 #include "particles/ParticleSystem.h"
@@ -237,12 +235,13 @@ TEST(VdbAdvect, KillAddsNothingOutsideDuringTheStep) {
   EXPECT_EQ(positionOf(a, 0).x(), 0.1f);
 }
 
-// A one-voxel grid active at x (voxels of 0.5 m): a kill region that moves between frames.
-openvdb::Vec3fGrid::Ptr activeAt(float x) {
-  auto grid = openvdb::Vec3fGrid::create();
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(0.5));
-  grid->tree().setValueOn(openvdb::Coord(static_cast<int>(x / 0.5f), 0, 0), openvdb::Vec3f(0.0f));
-  return grid;
+// One-voxel grids (voxels of 0.5 m), the voxel of frame f active at x = activeX[f]: a kill region
+// that moves between frames.
+std::unique_ptr<VectorField> activeAt(const VectorField::Settings& s,
+                                      const std::vector<float>& activeX) {
+  std::vector<vdb_test::Coord> voxels;
+  for (const float x : activeX) voxels.push_back({static_cast<int>(x / 0.5f), 0, 0});
+  return vdb_test::oneVoxelFrames(s, 0.5, voxels);
 }
 
 // Regression (issue 10, item 4): a sequence's frame was ⌊t·fps⌋ in double. At t = 1/49 s and
@@ -253,22 +252,21 @@ TEST(VdbAdvect, ASequencesFrameComesFromTheIntegerClock) {
   s.fps = 49.0;
   s.firstFrame = 1;
   s.lastFrame = 2;
-  const VectorField field(s, VectorField::Grids{{activeAt(0.0f), activeAt(3.0f)}});
+  const std::unique_ptr<VectorField> field = activeAt(s, {0.0f, 3.0f});
   ParticlePool pool(1);
   ParticleInit init;
   init.position = Eigen::Vector3f(3.0f, 0.0f, 0.0f);
   pool.spawn(init, 0);
   ForceSet forces;
-  VectorField::Frames f = field.framesAt(TickInstant{0, 2, 49});  // the end of tick 0: 1/49 s
+  VectorField::Frames f = field->framesAt(TickInstant{0, 2, 49});  // the end of tick 0: 1/49 s
   EXPECT_EQ(f.first, 1u);
   EXPECT_EQ(f.second, 1u);
-  VectorField& killer = static_cast<VectorField&>(forces.add(
-      std::make_unique<VectorField>(s, VectorField::Grids{{activeAt(0.0f), activeAt(3.0f)}})));
+  VectorField& killer = static_cast<VectorField&>(forces.add(activeAt(s, {0.0f, 3.0f})));
   killer.endTick(pool, TickInstant{0, 2, 49});
   EXPECT_EQ(pool.dead()[0], 0) << "inside frame 2's region at frame 2's time";
   killer.endTick(pool, TickInstant{0, 1, 49});  // half a tick: frame 1 still decides
   EXPECT_EQ(pool.dead()[0], 1);
-  f = field.framesAt(TickInstant{0, 1, 49});
+  f = field->framesAt(TickInstant{0, 1, 49});
   EXPECT_EQ(f.first, 0u);
   EXPECT_EQ(f.second, 1u);
   EXPECT_EQ(f.weight, 0.5f);
@@ -279,18 +277,17 @@ TEST(VdbAdvect, ASequencesFrameComesFromTheIntegerClock) {
   many.fps = 30.0;
   many.firstFrame = 0;
   many.lastFrame = 299;
-  const VectorField sequence(
-      many, VectorField::Grids{std::vector<openvdb::GridBase::Ptr>(300, activeAt(0.0f))});
-  f = sequence.framesAt(TickInstant{196, 0, 24});
+  const std::unique_ptr<VectorField> sequence = activeAt(many, std::vector<float>(300, 0.0f));
+  f = sequence->framesAt(TickInstant{196, 0, 24});
   EXPECT_EQ(f.first, 245u);
   EXPECT_EQ(f.weight, 0.0f);
-  f = sequence.framesAt(TickInstant{197, 1, 24});  // 8.229166... s: 246.875 frames
+  f = sequence->framesAt(TickInstant{197, 1, 24});  // 8.229166... s: 246.875 frames
   EXPECT_EQ(f.first, 246u);
   EXPECT_EQ(f.weight, 0.875f);
-  f = sequence.framesAt(TickInstant{1, 0, 7});  // 30/7 = 4 + 2/7
+  f = sequence->framesAt(TickInstant{1, 0, 7});  // 30/7 = 4 + 2/7
   EXPECT_EQ(f.first, 4u);
   EXPECT_EQ(f.weight, 2.0f / 7.0f);
-  f = sequence.framesAt(TickInstant{1000, 0, 24});  // past the last frame: clamped
+  f = sequence->framesAt(TickInstant{1000, 0, 24});  // past the last frame: clamped
   EXPECT_EQ(f.first, 299u);
   EXPECT_EQ(f.second, 299u);
 }
@@ -341,16 +338,14 @@ TEST(VdbAdvect, PinnedParticlesStayPut) {
 /// 10⁴ points advected through a baked curl-noise field for 48 steps by tickfx (through the
 /// integrator `scheme`) and by PointAdvect at `order`; returns the largest difference in metres.
 float pointAdvectDifference(const std::string& scheme, unsigned order, bool threaded) {
-  openvdb::initialize();
   const AnalyticField noise = AnalyticField::curlNoise(11, 4.0, 1.0, 4);
   const auto bake = box(0.05, Eigen::Vector3d::Constant(-1.2), Eigen::Vector3d::Constant(1.2));
   // Each bakes the field for itself: PointAdvect the bare grid, tickfx its VectorField.
-  const openvdb::Vec3fGrid::Ptr grid = bakeGrid(noise, bake);
   std::unique_ptr<VectorField> field = bakeVectorField(noise, bake, advect());
 
   const std::size_t n = 10'000;
   ParticlePool pool(n);
-  std::vector<openvdb::Vec3f> points(n);
+  vdb_test::Positions points(n);
   for (std::size_t i = 0; i < n; ++i) {
     // A Weyl sequence in [−0.8, 0.8]³: deterministic and well spread.
     ParticleInit init;
@@ -359,25 +354,22 @@ float pointAdvectDifference(const std::string& scheme, unsigned order, bool thre
       init.position[c] = static_cast<float>(-0.8 + 1.6 * std::fmod(0.5 + a[c] * (i + 1), 1.0));
     }
     pool.spawn(init, 0);
-    points[i] = openvdb::Vec3f(init.position.x(), init.position.y(), init.position.z());
+    points[i] = {init.position.x(), init.position.y(), init.position.z()};
   }
   ForceSet forces;
   forces.add(std::move(field));
   const std::int64_t rate = 24, ticks = 48;
   run(pool, scheme, forces, rate, ticks);
 
-  // Every option set explicitly: the copy constructor and some paths leave members unset.
-  openvdb::tools::PointAdvect<openvdb::Vec3fGrid, std::vector<openvdb::Vec3f>, false> advector(
-      *grid);
-  advector.setIntegrationOrder(order);
-  advector.setThreaded(threaded);
-  for (std::int64_t k = 0; k < ticks; ++k) advector.advect(points, StepTime{k, rate}.dt(), 1);
+  std::vector<float> steps;
+  for (std::int64_t k = 0; k < ticks; ++k) steps.push_back(StepTime{k, rate}.dt());
+  points = vdb_test::advectWithPointAdvect(noise, bake, points, steps, order, threaded);
 
   float worst = 0.0f;
   for (std::size_t i = 0; i < n; ++i) {
     for (int c = 0; c < 3; ++c) {
-      worst = std::max(worst,
-                       std::abs(pool.position()[c][static_cast<Eigen::Index>(i)] - points[i][c]));
+      worst = std::max(worst, std::abs(pool.position()[c][static_cast<Eigen::Index>(i)] -
+                                       points[i][static_cast<std::size_t>(c)]));
     }
   }
   return worst;

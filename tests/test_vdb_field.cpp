@@ -1,7 +1,6 @@
 // fields/VectorField and fields/AnalyticField: baking, sampling, forces, sequences, errors.
 // Every .vdb file is written into a temporary directory of the test and removed afterwards.
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -11,10 +10,11 @@
 #include <memory>
 #include <string>
 
+#include "FlippedBitTestSupport.h"
+#include "VdbTestData.h"
 #include "fields/AnalyticField.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
-#include "fields/VdbGridFile.h"
 #include "fields/VectorField.h"
 #include "integrators/Integrator.h"
 #include "particles/ParticlePool.h"
@@ -23,6 +23,7 @@ namespace tickfx {
 namespace {
 
 namespace fs = std::filesystem;
+namespace vdbt = tickfx::vdb_test;
 
 class VdbField : public ::testing::Test {
  protected:
@@ -142,16 +143,15 @@ TEST_F(VdbField, AffineFieldsAreReproducedByEverySampler) {
 }
 
 TEST_F(VdbField, ReadsDoubleGrids) {
-  openvdb::initialize();
-  auto grid = openvdb::Vec3dGrid::create(openvdb::Vec3d(0.0));
-  grid->setName("vel");
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(0.5));
-  auto acc = grid->getAccessor();
+  vdbt::GridFileSpec grid;
+  grid.name = "vel";
+  grid.type = vdbt::GridType::Vec3d;
+  grid.voxelSize = 0.5;
   for (int i = -2; i <= 2; ++i)
     for (int j = -2; j <= 2; ++j)
-      for (int k = -2; k <= 2; ++k) acc.setValueOn({i, j, k}, openvdb::Vec3d(0.1, 0.2, 0.3));
+      for (int k = -2; k <= 2; ++k) grid.activeVoxels.push_back({{i, j, k}, {0.1, 0.2, 0.3}});
   const std::string file = path("double.vdb");
-  openvdb::io::File(file).write({grid});
+  vdbt::writeGridFile(file, grid);
   const VectorField field(settingsFor(file));
   EXPECT_EQ(field.valueType(), "vec3d");
   EXPECT_EQ(field.sample({0.3f, -0.2f, 0.7f}), Eigen::Vector3f(0.1f, 0.2f, 0.3f));
@@ -357,12 +357,12 @@ TEST_F(VdbField, MissingGridNamesFileAndGrid) {
 }
 
 TEST_F(VdbField, WrongGridTypeNamesFileAndGrid) {
-  openvdb::initialize();
-  auto grid = openvdb::FloatGrid::create(0.0f);
-  grid->setName("vel");
-  grid->tree().setValueOn({0, 0, 0}, 1.0f);
+  vdbt::GridFileSpec grid;
+  grid.name = "vel";
+  grid.type = vdbt::GridType::Float;
+  grid.activeVoxels = {{{0, 0, 0}, {1.0}}};
   const std::string file = path("scalar.vdb");
-  openvdb::io::File(file).write({grid});
+  vdbt::writeGridFile(file, grid);
   expectLoadError(settingsFor(file), "holds float values");
 }
 
@@ -390,46 +390,50 @@ TEST_F(VdbField, NotAVdbFileNamesFileAndGrid) {
 TEST_F(VdbField, GridsInEveryLayoutOpenVdbWritesLoad) {
   // Checking every byte before OpenVDB reads it must not refuse a valid file: blosc, zip and no
   // compression, active-mask compression or not, half floats, tiles at both levels, double grids.
-  openvdb::initialize();
   struct Layout {
-    std::uint32_t compression;
+    vdbt::Compression compression;
     bool half;
   };
-  const openvdb::Vec3s tile(1.0f, 2.0f, 3.0f);
+  const vdbt::Value tile{1.0, 2.0, 3.0};
+  const std::vector<vdbt::Coord> probes = {{4100, 7, 9}, {1, 8200, 1}, {100, 100, 100}};
   for (const Layout layout :
-       {Layout{openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK, false},
-        Layout{openvdb::io::COMPRESS_BLOSC, true},
-        Layout{openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK, true},
-        Layout{openvdb::io::COMPRESS_ZIP, false}, Layout{openvdb::io::COMPRESS_NONE, false}}) {
-    SCOPED_TRACE(std::to_string(layout.compression) + (layout.half ? " half" : ""));
-    auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.5f, 0.0f, 0.0f));
-    grid->setName("vel");
+       {Layout{vdbt::Compression::BloscActiveMask, false}, Layout{vdbt::Compression::Blosc, true},
+        Layout{vdbt::Compression::ZipActiveMask, true}, Layout{vdbt::Compression::Zip, false},
+        Layout{vdbt::Compression::None, false}}) {
+    SCOPED_TRACE(vdbt::toString(layout.compression) + (layout.half ? " half" : ""));
+    vdbt::GridFileSpec grid;
+    grid.name = "vel";
+    grid.type = vdbt::GridType::Vec3s;
+    grid.background = {0.5, 0.0, 0.0};
+    for (int i = -20; i < 20; ++i) grid.activeVoxels.push_back({{i, 2 * i, 3}, {double(i), 1, 2}});
+    grid.tiles = {{2, {4096, 0, 0}, tile, true},    // a tile of an internal node
+                  {3, {0, 8192, 0}, tile, false}};  // a tile of the root
+    grid.halfFloats = layout.half;
+    grid.compression = layout.compression;
+    vdbt::writeGridFile(path("f.vdb"), grid);
+    std::vector<vdbt::Coord> at;
+    for (int i = -20; i < 20; ++i) at.push_back({i, 2 * i, 3});
+    at.insert(at.end(), probes.begin(), probes.end());
+    const vdbt::GridProbe back = vdbt::probeGridReadByTickfx(path("f.vdb"), "vel", at);
+    ASSERT_EQ(back.type, "Tree_vec3s_5_4_3");
+    EXPECT_EQ(back.activeVoxelCount, 40u + 128u * 128u * 128u);
     for (int i = -20; i < 20; ++i)
-      grid->tree().setValueOn({i, 2 * i, 3}, openvdb::Vec3s(static_cast<float>(i), 1.0f, 2.0f));
-    grid->tree().addTile(2, {4096, 0, 0}, tile, true);   // a tile of an internal node
-    grid->tree().addTile(3, {0, 8192, 0}, tile, false);  // a tile of the root
-    grid->setSaveFloatAsHalf(layout.half);
-    openvdb::io::File out(path("f.vdb"));
-    out.setCompression(layout.compression);
-    out.write({grid});
-    const auto back = openvdb::gridPtrCast<openvdb::Vec3SGrid>(readVdbGrid(path("f.vdb"), "vel"));
-    ASSERT_TRUE(back);
-    EXPECT_EQ(back->activeVoxelCount(), 40u + 128u * 128u * 128u);
-    for (int i = -20; i < 20; ++i)
-      EXPECT_EQ(back->tree().getValue({i, 2 * i, 3}), openvdb::Vec3s(static_cast<float>(i), 1, 2));
-    EXPECT_EQ(back->tree().getValue({4100, 7, 9}), tile);
-    EXPECT_EQ(back->tree().getValue({1, 8200, 1}), tile);
-    EXPECT_FALSE(back->tree().isValueOn({1, 8200, 1}));
-    EXPECT_EQ(back->tree().getValue({100, 100, 100}), openvdb::Vec3s(0.5f, 0.0f, 0.0f));
+      EXPECT_EQ(back.values[static_cast<std::size_t>(i + 20)], (vdbt::Value{double(i), 1, 2}));
+    EXPECT_EQ(back.values[40], tile);
+    EXPECT_EQ(back.values[41], tile);
+    EXPECT_FALSE(back.active[41]);
+    EXPECT_EQ(back.values[42], (vdbt::Value{0.5, 0.0, 0.0}));
   }
-  auto scalar = openvdb::DoubleGrid::create(1.0);
-  scalar->setName("vel");
-  scalar->tree().setValueOn({1, 2, 3}, 4.25);
-  scalar->setSaveFloatAsHalf(true);
-  openvdb::io::File(path("d.vdb")).write({scalar});
-  const auto back = openvdb::gridPtrCast<openvdb::DoubleGrid>(readVdbGrid(path("d.vdb"), "vel"));
-  ASSERT_TRUE(back);
-  EXPECT_EQ(back->tree().getValue({1, 2, 3}), 4.25);
+  vdbt::GridFileSpec scalar;
+  scalar.name = "vel";
+  scalar.type = vdbt::GridType::Double;
+  scalar.background = {1.0};
+  scalar.activeVoxels = {{{1, 2, 3}, {4.25}}};
+  scalar.halfFloats = true;
+  vdbt::writeGridFile(path("d.vdb"), scalar);
+  const vdbt::GridProbe back = vdbt::probeGridReadByTickfx(path("d.vdb"), "vel", {{1, 2, 3}});
+  ASSERT_EQ(back.type, "Tree_double_5_4_3");
+  EXPECT_EQ(back.values[0][0], 4.25);
 }
 
 TEST_F(VdbField, EveryFlippedBitLoadsOrIsRefusedWithAMessage) {
@@ -442,25 +446,13 @@ TEST_F(VdbField, EveryFlippedBitLoadsOrIsRefusedWithAMessage) {
   // Bit i mod 8 of byte i flipped, each its own file. OpenVDB 10 read a raw block's bytes before
   // comparing its size with the buffer's ("malloc(): corrupted top size", SIGABRT), and trusted
   // blosc headers and counts. Each file now loads, or is refused naming the file and grid.
-  std::size_t loaded = 0, refused = 0;
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    std::string flipped = bytes;
-    flipped[i] = static_cast<char>(flipped[i] ^ (1 << (i % 8)));
-    const std::string name = path("flip" + std::to_string(i) + ".vdb");
-    std::ofstream(name, std::ios::binary) << flipped;
-    try {
-      const VectorField field(settingsFor(name));
-      ++loaded;
-      EXPECT_EQ(field.valueType(), "vec3s") << "byte " << i;
-    } catch (const std::runtime_error& e) {
-      ++refused;
-      EXPECT_EQ(std::string(e.what()).rfind(name + ": grid 'vel': ", 0), 0u)
-          << "byte " << i << ": " << e.what();
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << "byte " << i << ": not a runtime_error: " << e.what();
-    }
-    fs::remove(name);
-  }
+  const test::FlippedBits flips = test::loadEveryFlippedBit(
+      bytes, [&](std::size_t i) { return path("flip" + std::to_string(i) + ".vdb"); }, "vel",
+      [&](const std::string& name, std::size_t i) {
+        const VectorField field(settingsFor(name));
+        EXPECT_EQ(field.valueType(), "vec3s") << "byte " << i;
+      });
+  const std::size_t loaded = flips.loaded, refused = flips.refusals.size();
   EXPECT_EQ(loaded + refused, bytes.size());
   EXPECT_GT(loaded, 300u);  // values, metadata values, unused bits
   EXPECT_GT(refused, bytes.size() / 2);

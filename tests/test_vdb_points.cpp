@@ -2,13 +2,6 @@
 // attribute's bits and the run's metadata; broken files fail with the file and grid named.
 // Every file is written into a temporary directory of the test and removed afterwards.
 #include <gtest/gtest.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/points/PointAttribute.h>
-#include <openvdb/points/PointConversion.h>
-#include <openvdb/points/PointCount.h>
-#include <openvdb/points/PointDataGrid.h>
-#include <openvdb/points/PointGroup.h>
-#include <openvdb/tools/PointIndexGrid.h>
 #include <unistd.h>
 
 #include <bit>
@@ -22,6 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "FlippedBitTestSupport.h"
+#include "PointCacheTestSupport.h"
+#include "VdbTestData.h"
 #include "io/FrameData.h"
 #include "io/VdbPointCache.h"
 
@@ -29,7 +25,7 @@ namespace tickfx::io {
 namespace {
 
 namespace fs = std::filesystem;
-namespace vdbp = openvdb::points;
+namespace vdbt = tickfx::vdb_test;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kDenormal = std::numeric_limits<float>::denorm_min();
@@ -126,72 +122,58 @@ void expectSameBits(const FrameData& got, const FrameData& want, bool signOfZero
   }
 }
 
-openvdb::GridBase::Ptr readWithOpenVdb(const fs::path& file, const std::string& grid) {
-  openvdb::initialize();
-  openvdb::io::File in(file.string());
-  in.open(false);
-  openvdb::GridBase::Ptr g = in.readGrid(grid);
-  in.close();
-  return g;
-}
-
 // ---- the cache read back through OpenVDB ------------------------------------------------------
 
 TEST_F(ioVdbPoints, OpenVdbReadsEveryAttributeBitwiseAndTheMetadata) {
   const FrameData frame = oddFrame();
   writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
 
-  const auto grid =
-      openvdb::gridPtrCast<vdbp::PointDataGrid>(readWithOpenVdb(path("f.vdb"), "points"));
-  ASSERT_TRUE(grid);
+  const vdbt::PointsGridRead grid = vdbt::readPointsGrid(path("f.vdb"), "points");
   // The metadata a pipeline reads.
-  EXPECT_EQ(grid->metaValue<std::string>("tickfx_effect_hash"), "0123456789abcdef");
-  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_seed"), 9223372036854775807);
-  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_step_rate"), 240);
-  EXPECT_EQ(grid->metaValue<std::string>("tickfx_integrator"), "velocity_verlet");
-  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_frame"), 42);
-  EXPECT_EQ(grid->metaValue<double>("tickfx_time"), 1.75);
-  EXPECT_EQ(grid->metaValue<std::string>("tickfx_version"), "0.1.0");
-  EXPECT_EQ(grid->metaValue<std::int64_t>("tickfx_point_count"), 10);
-  EXPECT_EQ(grid->voxelSize(), openvdb::Vec3d(1.0));
-  EXPECT_EQ(vdbp::pointCount(grid->tree()), 10u);
+  EXPECT_EQ(grid.stringMetadata.at("tickfx_effect_hash"), "0123456789abcdef");
+  EXPECT_EQ(grid.int64Metadata.at("tickfx_seed"), 9223372036854775807);
+  EXPECT_EQ(grid.int64Metadata.at("tickfx_step_rate"), 240);
+  EXPECT_EQ(grid.stringMetadata.at("tickfx_integrator"), "velocity_verlet");
+  EXPECT_EQ(grid.int64Metadata.at("tickfx_frame"), 42);
+  EXPECT_EQ(grid.doubleMetadata.at("tickfx_time"), 1.75);
+  EXPECT_EQ(grid.stringMetadata.at("tickfx_version"), "0.1.0");
+  EXPECT_EQ(grid.int64Metadata.at("tickfx_point_count"), 10);
+  EXPECT_EQ(grid.voxelSize, (std::array<double, 3>{1.0, 1.0, 1.0}));
+  EXPECT_EQ(grid.pointCount, 10u);
 
   // Each point as OpenVDB gives it: world position (voxel + P) · transform, and the attributes,
   // by id.
-  std::map<std::uint64_t, std::vector<std::uint32_t>> seen;
   std::vector<std::string> names;
-  for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
-    const vdbp::AttributeSet::Descriptor& d = leaf->attributeSet().descriptor();
-    names.assign(d.size(), "");
-    for (const auto& [name, pos] : d.map()) names[pos] = name;
-    EXPECT_EQ(leaf->constAttributeArray("P").codecType(), "null");
-    EXPECT_EQ(d.valueType(d.find("P")), "vec3s");
-    EXPECT_EQ(d.valueType(d.find("v")), "vec3s");
-    EXPECT_EQ(d.valueType(d.find("id")), "int64");
+  for (const std::vector<vdbt::PointAttributeInfo>& leaf : grid.leaves) {
+    names.clear();
+    std::map<std::string, std::string> types;
+    for (const vdbt::PointAttributeInfo& a : leaf) {
+      names.push_back(a.name);
+      types[a.name] = a.valueType;
+      if (a.name == "P") {
+        EXPECT_EQ(a.codec, "null");
+      }
+    }
+    EXPECT_EQ(types["P"], "vec3s");
+    EXPECT_EQ(types["v"], "vec3s");
+    EXPECT_EQ(types["id"], "int64");
     for (const char* name : {"age", "life", "mass", "heat", "Cd_r"})
-      EXPECT_EQ(d.valueType(d.find(name)), "float") << name;
-    vdbp::AttributeHandle<openvdb::Vec3f> p(leaf->constAttributeArray("P"));
-    vdbp::AttributeHandle<openvdb::Vec3f> v(leaf->constAttributeArray("v"));
-    vdbp::AttributeHandle<std::int64_t> id(leaf->constAttributeArray("id"));
-    std::vector<vdbp::AttributeHandle<float>> scalars;
+      EXPECT_EQ(types[name], "float") << name;
+  }
+  std::map<std::uint64_t, std::vector<std::uint32_t>> seen;
+  for (const vdbt::PointRead& point : grid.points) {
+    std::vector<std::uint32_t> values;
+    for (int c = 0; c < 3; ++c) values.push_back(bits(point.world[c]));
+    for (int c = 0; c < 3; ++c) values.push_back(bits(point.floats.at("v").at(c)));
     for (const char* name : {"age", "life", "mass", "heat", "Cd_r"})
-      scalars.emplace_back(leaf->constAttributeArray(name));
-    for (auto index = leaf->beginIndexOn(); index; ++index) {
-      const openvdb::Vec3f offset = p.get(*index);
-      const openvdb::Vec3d world =
-          grid->transform().indexToWorld(index.getCoord().asVec3d() + openvdb::Vec3d(offset));
-      std::vector<std::uint32_t> values;
-      for (int c = 0; c < 3; ++c) values.push_back(bits(static_cast<float>(world[c])));
-      for (int c = 0; c < 3; ++c) values.push_back(bits(v.get(*index)[c]));
-      for (const auto& s : scalars) values.push_back(bits(s.get(*index)));
-      const auto key = static_cast<std::uint64_t>(id.get(*index));
-      EXPECT_EQ(seen.count(key), 0u);
-      seen[key] = values;
-      // Points within the bound sit in their nearest voxel, as OpenVDB's convention has it.
-      for (int c = 0; c < 3; ++c) {
-        if (index.getCoord()[c] != 0) {
-          EXPECT_LE(std::abs(offset[c]), 0.5f);
-        }
+      values.push_back(bits(point.floats.at(name).at(0)));
+    const auto key = static_cast<std::uint64_t>(point.int64s.at("id"));
+    EXPECT_EQ(seen.count(key), 0u);
+    seen[key] = values;
+    // Points within the bound sit in their nearest voxel, as OpenVDB's convention has it.
+    for (int c = 0; c < 3; ++c) {
+      if (point.voxel[c] != 0) {
+        EXPECT_LE(std::abs(point.offset[c]), 0.5f);
       }
     }
   }
@@ -212,7 +194,7 @@ TEST_F(ioVdbPoints, OpenVdbReadsEveryAttributeBitwiseAndTheMetadata) {
     EXPECT_EQ(got, want) << "id " << frame.id[k];
   }
   // Points are spread over voxels (not all kept in one).
-  EXPECT_GT(grid->tree().activeVoxelCount(), 5u);
+  EXPECT_GT(grid.activeVoxelCount, 5u);
 }
 
 TEST_F(ioVdbPoints, ReadBackGivesTheFrameInIdOrderWithItsBitsAndMetadata) {
@@ -253,9 +235,7 @@ TEST_F(ioVdbPoints, ManyPointsOverManyLeavesComeBackInIdOrder) {
   writeVdbPointCache(frame, sampleMetadata(), path("many.vdb"));
   const FrameData back = readVdbPointCache(path("many.vdb"));
   expectSameBits(back, frame);
-  const auto grid =
-      openvdb::gridPtrCast<vdbp::PointDataGrid>(readWithOpenVdb(path("many.vdb"), "points"));
-  EXPECT_GT(grid->tree().leafCount(), 100u);
+  EXPECT_GT(vdbt::readPointsGrid(path("many.vdb"), "points").leaves.size(), 100u);
 }
 
 TEST_F(ioVdbPoints, AnEmptyFrameIsAnEmptyGrid) {
@@ -270,19 +250,14 @@ TEST_F(ioVdbPoints, AnEmptyFrameIsAnEmptyGrid) {
 TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
   // Points as another tool writes them: OpenVDB's own conversion, a 0.25 m voxel, P in a 16-bit
   // fixed-point codec, no v, id or age; one extra float attribute and an int one.
-  openvdb::initialize();
-  const std::vector<openvdb::Vec3R> positions = {
-      {0.1, 0.2, 0.3}, {-1.0, 2.0, 0.5}, {3.0, -3.0, 1.0}};
-  const vdbp::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
-  const auto transform = openvdb::math::Transform::createLinearTransform(0.25);
-  const auto index =
-      openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
-  auto grid = vdbp::createPointDataGrid<vdbp::FixedPointCodec<false>, vdbp::PointDataGrid>(
-      *index, wrapper, *transform);
-  vdbp::appendAttribute<float>(grid->tree(), "density", 2.5f);
-  vdbp::appendAttribute<std::int32_t>(grid->tree(), "flags", 7);
-  grid->setName("points");
-  openvdb::io::File(path("foreign.vdb").string()).write(openvdb::GridCPtrVec{grid});
+  vdbt::PointsFileSpec foreign;
+  foreign.positions = {{0.1, 0.2, 0.3}, {-1.0, 2.0, 0.5}, {3.0, -3.0, 1.0}};
+  foreign.voxelSize = 0.25;
+  foreign.codec = vdbt::PositionCodec::FixedPoint16;
+  foreign.attributes = {{"density", vdbt::PointAttributeSpec::Type::Float, {2.5f}},
+                        {"flags", vdbt::PointAttributeSpec::Type::Int32, {7.0f}}};
+  vdbt::writePointsFile(path("foreign.vdb"), foreign);
+  const auto& positions = foreign.positions;
 
   VdbCacheContents contents;
   const FrameData back = readVdbPointCache(path("foreign.vdb"), &contents);
@@ -301,7 +276,7 @@ TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
     EXPECT_EQ(back.attributes[0][r], 2.5f);
     for (std::size_t k = 0; k < 3; ++k) {
       const Eigen::Vector3d p(back.position.x[r], back.position.y[r], back.position.z[r]);
-      if ((p - Eigen::Vector3d(positions[k].x(), positions[k].y(), positions[k].z())).norm() < 1e-5)
+      if ((p - Eigen::Vector3d(positions[k][0], positions[k][1], positions[k][2])).norm() < 1e-5)
         matched[k] = true;
     }
   }
@@ -312,29 +287,23 @@ TEST_F(ioVdbPoints, PointsFilesInEveryLayoutOpenVdbWritesRead) {
   // Checking every byte before OpenVDB reads it must not refuse a valid file: paged blosc arrays
   // over many leaves, raw arrays (no blosc: no compression, or zip, which points do not use), a
   // strided array, a uniform one, a string attribute and a group.
-  openvdb::initialize();
-  std::vector<openvdb::Vec3R> positions;
-  for (int i = 0; i < 300; ++i) positions.emplace_back(0.1 * i, 0.05 * i, -0.07 * i);
-  const vdbp::PointAttributeVector<openvdb::Vec3R> wrapper(positions);
-  const auto transform = openvdb::math::Transform::createLinearTransform(0.5);
-  const auto index =
-      openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapper, *transform);
-  auto grid =
-      vdbp::createPointDataGrid<vdbp::NullCodec, vdbp::PointDataGrid>(*index, wrapper, *transform);
-  vdbp::appendAttribute<float>(grid->tree(), "density", 2.5f);
-  vdbp::appendAttribute<float>(grid->tree(), "triple", 1.0f, /*stride=*/3);
-  vdbp::appendAttribute<openvdb::Name>(grid->tree(), "label");
-  vdbp::appendGroup(grid->tree(), "chosen");
-  vdbp::appendAttribute<openvdb::Vec3f>(grid->tree(), "v", openvdb::Vec3f(1.0f, 2.0f, 3.0f));
-  grid->setName("points");
-  ASSERT_GT(grid->tree().leafCount(), 5u);
-  for (const std::uint32_t compression :
-       {std::uint32_t{openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK},
-        std::uint32_t{openvdb::io::COMPRESS_NONE}, std::uint32_t{openvdb::io::COMPRESS_ZIP}}) {
-    SCOPED_TRACE(compression);
-    openvdb::io::File out(path("p.vdb").string());
-    out.setCompression(compression);
-    out.write({grid});
+  using Type = vdbt::PointAttributeSpec::Type;
+  vdbt::PointsFileSpec layout;
+  for (int i = 0; i < 300; ++i) layout.positions.push_back({0.1 * i, 0.05 * i, -0.07 * i});
+  layout.voxelSize = 0.5;
+  layout.attributes = {{"density", Type::Float, {2.5f}},
+                       {"triple", Type::Float, {1.0f}, /*stride=*/3},
+                       {"label", Type::String},
+                       {"chosen", Type::Group},
+                       {"v", Type::Vec3s, {1.0f, 2.0f, 3.0f}}};
+  const auto& positions = layout.positions;
+  vdbt::writePointsFile(path("p.vdb"), layout);
+  ASSERT_GT(vdbt::readPointsGrid(path("p.vdb"), "points").leaves.size(), 5u);
+  for (const vdbt::Compression compression :
+       {vdbt::Compression::BloscActiveMask, vdbt::Compression::None, vdbt::Compression::Zip}) {
+    SCOPED_TRACE(vdbt::toString(compression));
+    layout.compression = compression;
+    vdbt::writePointsFile(path("p.vdb"), layout);
     const FrameData back = readVdbPointCache(path("p.vdb"));
     ASSERT_EQ(back.size(), positions.size());
     EXPECT_EQ(back.attributeNames, (std::vector<std::string>{"density", "triple"}));
@@ -386,13 +355,15 @@ TEST_F(ioVdbPoints, MissingTruncatedAndForeignFilesNameTheFileAndGrid) {
   EXPECT_EQ(errorOf(head), head + ": grid 'points': cannot read the grid (the file is truncated)");
 
   // A file without the grid, and a "points" grid of another type.
-  auto density = openvdb::FloatGrid::create(1.0f);
-  density->setName("density");
-  openvdb::io::File(path("density.vdb").string()).write(openvdb::GridCPtrVec{density});
+  vdbt::GridFileSpec density;
+  density.name = "density";
+  density.type = vdbt::GridType::Float;
+  density.background = {1.0};
+  vdbt::writeGridFile(path("density.vdb"), density);
   EXPECT_EQ(errorOf(path("density.vdb")),
             path("density.vdb").string() + ": grid 'points': no such grid (the file has: density)");
-  density->setName("points");
-  openvdb::io::File(path("float.vdb").string()).write(openvdb::GridCPtrVec{density});
+  density.name = "points";
+  vdbt::writeGridFile(path("float.vdb"), density);
   EXPECT_EQ(errorOf(path("float.vdb")), path("float.vdb").string() +
                                             ": grid 'points': is a grid of type Tree_float_5_4_3 "
                                             "(expected a PointDataGrid)");
@@ -429,27 +400,18 @@ TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
   // Bit i mod 8 of byte i flipped, each its own file. OpenVDB 10 trusts the sizes, counts and
   // flags it reads: on hundreds of these files it aborted on an assertion (its paged streams,
   // blosc pages), crashed, or allocated gigabytes. Each now reads, or is refused naming the file.
-  std::size_t read = 0, refused = 0, corrupt = 0;
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    std::string flipped = bytes;
-    flipped[i] = static_cast<char>(flipped[i] ^ (1 << (i % 8)));
-    const fs::path file = path("flip" + std::to_string(i) + ".vdb");
-    std::ofstream(file, std::ios::binary) << flipped;
-    try {
-      const FrameData back = readVdbPointCache(file);
-      ++read;
-      // What was read is a frame of the cache's size, whatever values the flip changed.
-      EXPECT_EQ(back.size(), frame.size()) << "byte " << i;
-    } catch (const std::runtime_error& e) {
-      ++refused;
-      const std::string what = e.what();
-      EXPECT_EQ(what.rfind(file.string() + ": grid 'points': ", 0), 0u)
-          << "byte " << i << ": " << what;
-      if (what.find("the file is corrupt at byte ") != std::string::npos) ++corrupt;
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << "byte " << i << ": not a runtime_error: " << e.what();
-    }
-    fs::remove(file);
+  const test::FlippedBits flips = test::loadEveryFlippedBit(
+      bytes, [&](std::size_t i) { return path("flip" + std::to_string(i) + ".vdb").string(); },
+      "points",
+      [&](const std::string& file, std::size_t i) {
+        const FrameData back = readVdbPointCache(file);
+        // What was read is a frame of the cache's size, whatever values the flip changed.
+        EXPECT_EQ(back.size(), frame.size()) << "byte " << i;
+      });
+  const std::size_t read = flips.loaded, refused = flips.refusals.size();
+  std::size_t corrupt = 0;
+  for (const std::string& what : flips.refusals) {
+    if (what.find("the file is corrupt at byte ") != std::string::npos) ++corrupt;
   }
   EXPECT_EQ(read + refused, bytes.size());
   // Values (positions, velocities, metadata values, unused bits) still read; most of the bytes are
@@ -460,23 +422,9 @@ TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
 
   // The first attribute array's byte count (a uint64, 6 + 12 bytes for one point's P) one too
   // many: OpenVDB's paged stream asserted (mByteIndex <= mUncompressedBytes).
-  FrameData one;
-  one.resize(1, {});
-  one.id = {7};
-  for (int c = 0; c < 3; ++c) {
-    one.position[c][0] = 0.5f + static_cast<float>(c);
-    one.velocity[c][0] = 1.0f;
-  }
-  one.age[0] = 0.0f;
-  one.life[0] = 5.0f;
-  one.mass[0] = 1.0f;
-  writeVdbPointCache(one, sampleMetadata(), path("one.vdb"));
-  std::string damaged = fileBytes(path("one.vdb"));
-  const std::string count{"\x12\0\0\0\0\0\0\0", 8};
-  const std::size_t at = damaged.find(count);
+  writeVdbPointCache(test::onePointFrame(), sampleMetadata(), path("one.vdb"));
+  const std::size_t at = test::overstateFirstAttributeArray(path("one.vdb"));
   ASSERT_NE(at, std::string::npos);
-  damaged[at] = '\x13';
-  std::ofstream(path("one.vdb"), std::ios::binary) << damaged;
   EXPECT_EQ(errorOf(path("one.vdb")), path("one.vdb").string() +
                                           ": grid 'points': cannot read the grid (the file is "
                                           "corrupt at byte " +
