@@ -10,7 +10,7 @@ if(TARGET tickfx_cli)
       -DCXX_COMPILER=${CMAKE_CXX_COMPILER}
       -DTICKFX_CLI=$<TARGET_FILE:tickfx_cli>
       -P ${CMAKE_CURRENT_SOURCE_DIR}/scripts/EmbedTest.cmake)
-  set_tests_properties(embed.find_package PROPERTIES
-    PASS_REGULAR_EXPRESSION "embed and tickfx run agree: [0-9a-f]+"
-    TIMEOUT 900)
+  # Judged by the script's exit code (every check ends in FATAL_ERROR), not by a line of its
+  # output: ctest ignores the exit code of a test that has a PASS_REGULAR_EXPRESSION.
+  set_tests_properties(embed.find_package PROPERTIES TIMEOUT 900)
 endif()

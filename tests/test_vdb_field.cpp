@@ -366,6 +366,31 @@ TEST_F(VdbField, WrongGridTypeNamesFileAndGrid) {
   expectLoadError(settingsFor(file), "holds float values");
 }
 
+// In a sequence the message names the frame whose grid is wrong, not the first frame's file.
+TEST_F(VdbField, WrongGridTypeInALaterFrameNamesThatFrame) {
+  BakeSettings b;
+  b.voxelSize = 0.5;
+  bakeField(AnalyticField::uniform({1.0, 0.0, 0.0}), b, path("wind.0004.vdb"));
+  bakeField(AnalyticField::uniform({2.0, 0.0, 0.0}), b, path("wind.0005.vdb"));
+  vdbt::GridFileSpec scalar;
+  scalar.name = "vel";
+  scalar.type = vdbt::GridType::Float;
+  scalar.activeVoxels = {{{0, 0, 0}, {1.0}}};
+  vdbt::writeGridFile(path("wind.0006.vdb"), scalar);
+  VectorField::Settings s = settingsFor(path("wind.{frame}.vdb"));
+  s.fps = 24.0;
+  s.firstFrame = 4;
+  s.lastFrame = 6;
+  try {
+    const VectorField field(s);
+    ADD_FAILURE() << "loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(path("wind.0006.vdb") + ": grid 'vel': holds float", 0),
+              0u)
+        << e.what();
+  }
+}
+
 TEST_F(VdbField, TruncatedFileNamesFileAndGrid) {
   const std::string file = bake(AnalyticField::curlNoise(3, 2.0, 1.0), "cut.vdb", 0.125, -1, 1);
   const auto size = fs::file_size(file);
