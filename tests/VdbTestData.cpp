@@ -22,28 +22,35 @@ namespace {
 
 namespace vdbp = openvdb::points;
 
-std::uint32_t compressionFlags(Compression c) {
-  switch (c) {
-    case Compression::Default:
-      break;
-    case Compression::None:
-      return openvdb::io::COMPRESS_NONE;
-    case Compression::Zip:
-      return openvdb::io::COMPRESS_ZIP;
-    case Compression::ZipActiveMask:
-      return openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK;
-    case Compression::Blosc:
-      return openvdb::io::COMPRESS_BLOSC;
-    case Compression::BloscActiveMask:
-      return openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK;
+// Each Compression's name and io::File flags (Default: none of its own, setCompression() is not
+// called).
+struct CompressionInfo {
+  Compression compression;
+  const char* name;
+  std::uint32_t flags;
+};
+constexpr CompressionInfo kCompressions[] = {
+    {Compression::Default, "default", 0},
+    {Compression::None, "none", openvdb::io::COMPRESS_NONE},
+    {Compression::Zip, "zip", openvdb::io::COMPRESS_ZIP},
+    {Compression::ZipActiveMask, "zip|active_mask",
+     openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK},
+    {Compression::Blosc, "blosc", openvdb::io::COMPRESS_BLOSC},
+    {Compression::BloscActiveMask, "blosc|active_mask",
+     openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK},
+};
+
+const CompressionInfo& infoOf(Compression c) {
+  for (const CompressionInfo& info : kCompressions) {
+    if (info.compression == c) return info;
   }
-  throw std::logic_error("compressionFlags: Default has no flags of its own");
+  throw std::logic_error("no such Compression");
 }
 
 void writeOneGrid(const std::filesystem::path& path, const openvdb::GridBase::Ptr& grid,
                   Compression compression) {
   openvdb::io::File out(path.string());
-  if (compression != Compression::Default) out.setCompression(compressionFlags(compression));
+  if (compression != Compression::Default) out.setCompression(infoOf(compression).flags);
   out.write(openvdb::GridCPtrVec{grid});
   out.close();
 }
@@ -109,23 +116,7 @@ void readMetadata(const openvdb::MetaMap& meta, std::map<std::string, T>& out) {
 
 }  // namespace
 
-std::string toString(Compression compression) {
-  switch (compression) {
-    case Compression::Default:
-      return "default";
-    case Compression::None:
-      return "none";
-    case Compression::Zip:
-      return "zip";
-    case Compression::ZipActiveMask:
-      return "zip|active_mask";
-    case Compression::Blosc:
-      return "blosc";
-    case Compression::BloscActiveMask:
-      return "blosc|active_mask";
-  }
-  return "?";
-}
+std::string toString(Compression compression) { return infoOf(compression).name; }
 
 void writeGridFile(const std::filesystem::path& path, const GridFileSpec& spec) {
   openvdb::initialize();
