@@ -291,16 +291,11 @@ int frameSpan(const VectorField::Settings& s) {
   return s.fps > 0.0 ? s.lastFrame - s.firstFrame + 1 : 1;
 }
 
-// fps as numerator / 2^shift exactly: fps = m · 2^e with m < 2^53 (frexp and ldexp are exact),
-// and 1e-6 <= fps <= 1e6 keeps the shift below 73.
+// fps as numerator / 2^shift exactly (exact::dyadic); 1e-6 <= fps <= 1e6 keeps the shift below 73.
 std::pair<unsigned __int128, int> exactFps(double fps) {
   if (!(fps > 0.0)) return {0, 0};
-  int e = 0;
-  const double m = std::frexp(fps, &e);
-  const auto numerator = static_cast<std::uint64_t>(std::ldexp(m, 53));
-  const int shift = 53 - e;
-  if (shift < 0) return {static_cast<unsigned __int128>(numerator) << -shift, 0};
-  return {numerator, shift};
+  const exact::Dyadic d = exact::dyadic(fps);
+  return {d.numerator, d.shift};
 }
 
 }  // namespace

@@ -5,20 +5,23 @@
 
 namespace tickfx::exact {
 
+Dyadic dyadic(double x) {
+  if (!(x >= 0.0 && x < 0x1p53)) throw std::invalid_argument("dyadic needs 0 <= x < 2^53");
+  int e = 0;
+  const double fraction = std::frexp(x, &e);
+  return {static_cast<std::uint64_t>(std::ldexp(fraction, 53)), 53 - e};
+}
+
 std::int64_t tickAtOrAfter(double seconds, std::int64_t stepRateHz) {
   if (!std::isfinite(seconds) || seconds < 0.0 || seconds > 1.0e9) {
     throw std::invalid_argument("time must be a number of seconds in [0, 1e9]");
   }
   if (stepRateHz <= 0) throw std::invalid_argument("step rate must be positive");
-  // ⌈seconds · H⌉ exactly: seconds = m · 2^e with m < 2^53 (frexp and ldexp are exact), so
-  // m · H < 2^73 fits in 128 bits and the power of two is a shift.
-  int e = 0;
-  const double fraction = std::frexp(seconds, &e);
-  const auto m = static_cast<std::uint64_t>(std::ldexp(fraction, 53));
-  const u128 scaled = static_cast<u128>(m) * static_cast<u128>(stepRateHz);
-  // seconds <= 1e9 < 2^30, so e <= 30: the binary point is always right of m's last bit, and
-  // the power of two is a right shift by at least 23.
-  const int shift = 53 - e;
+  // ⌈seconds · H⌉ exactly: seconds = m / 2^shift with m < 2^53, so m · H < 2^73 fits in 128
+  // bits and the power of two is a right shift (by at least 23: seconds <= 1e9 < 2^30).
+  const Dyadic d = dyadic(seconds);
+  const u128 scaled = static_cast<u128>(d.numerator) * static_cast<u128>(stepRateHz);
+  const int shift = d.shift;
   u128 ceil = 0;
   if (shift < 128) {
     const u128 whole = scaled >> shift;

@@ -10,6 +10,15 @@ namespace tickfx::exact {
 
 using u128 = unsigned __int128;
 
+/// A double x in [0, 2^53) as numerator / 2^shift exactly, numerator < 2^53 and shift >= 0
+/// (frexp and ldexp are exact): the form in which a time or a rate in seconds meets integers.
+/// Throws std::invalid_argument outside that range.
+struct Dyadic {
+  std::uint64_t numerator = 0;
+  int shift = 0;
+};
+Dyadic dyadic(double x);
+
 /// The first tick k whose time k / stepRateHz, rounded to the nearest double, is at or after
 /// `seconds` (finite, in [0, 1e9]). So a time written as k/H in any form that reads back as the
 /// double nearest k/H (0.1 at 10 Hz, 1/1024 at 1024 Hz, 1.0/3 at 3 Hz) is tick k exactly, and no
