@@ -233,6 +233,33 @@ TEST(FixedStepDriver, RestoreRefusesStatesNoRunReaches) {
   EXPECT_NO_THROW(behind.restore(4, 0, 4, 1));
 }
 
+// A driver restored from another's four numbers is that driver: it reads them back and the next
+// frames issue the same ticks, drops and interpolation factors.
+TEST(FixedStepDriver, ARestoredDriverContinuesAsTheOneItWasSavedFrom) {
+  const Flicks frame = frameDuration(FrameRate{30000, 1001});
+  FixedStepDriver saved(60, 3);
+  saved.advance(kFlicksPerSecond / 4);  // 15 ticks due, the cap of 3 drops 12
+  for (int f = 0; f < 7; ++f) saved.advance(frame);
+  ASSERT_GT(saved.ticksDroppedTotal(), 0);
+  ASSERT_GT(saved.remainder(), 0);
+  FixedStepDriver restored(60, 3);
+  restored.restore(saved.ticksIssued(), saved.ticksDroppedTotal(), saved.ticksDue(),
+                   saved.remainder());
+  EXPECT_EQ(restored.ticksIssued(), saved.ticksIssued());
+  EXPECT_EQ(restored.ticksDroppedTotal(), saved.ticksDroppedTotal());
+  EXPECT_EQ(restored.ticksDue(), saved.ticksDue());
+  EXPECT_EQ(restored.remainder(), saved.remainder());
+  EXPECT_EQ(restored.frameOffset(), saved.frameOffset());
+  for (int f = 0; f < 20; ++f) {
+    const AdvanceResult a = saved.advance(f % 3 == 0 ? 2 * frame : frame);
+    const AdvanceResult b = restored.advance(f % 3 == 0 ? 2 * frame : frame);
+    ASSERT_EQ(a.ticks, b.ticks) << "frame " << f;
+    ASSERT_EQ(a.ticksDropped, b.ticksDropped) << "frame " << f;
+    ASSERT_EQ(test::bitsOf(a.alpha), test::bitsOf(b.alpha)) << "frame " << f;
+  }
+  EXPECT_EQ(restored.ticksDroppedTotal(), saved.ticksDroppedTotal());
+}
+
 TEST(FixedStepDriver, NtscFrameRateAddsUpExactly) {
   const Flicks frame = frameDuration(FrameRate{30000, 1001});
   FixedStepDriver driver(60, 16);

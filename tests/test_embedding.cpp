@@ -261,6 +261,31 @@ TEST_F(Embedding, ACopyIntoTooSmallABufferWritesNothingAndSaysHowManyRows) {
   EXPECT_EQ(ids[0], 3u);
 }
 
+// restoreClock() gives back what a saved state needs for its render copies between ticks: the
+// velocities at the tick's start (without them, render velocities fall back to the tick's own).
+TEST_F(Embedding, RestoreClockGivesBackTheTickStartVelocitiesRenderCopiesUse) {
+  const auto saved = fountainBetweenTicks();
+  const auto restored = fountainBetweenTicks();
+  ASSERT_NE(saved->tickStartVelocities(), nullptr);
+  const Vec3Column tickStart = *saved->tickStartVelocities();
+  Vec3Column expected, velocity;
+  saved->renderVelocities(expected);
+
+  restored->restoreClock(restored->tickCount(), nullptr);
+  EXPECT_EQ(restored->tickStartVelocities(), nullptr);
+  restored->renderVelocities(velocity);
+  EXPECT_NE(bitsOf(velocity.y[5]), bitsOf(expected.y[5])) << "the tick's own velocities";
+
+  restored->restoreClock(restored->tickCount(), &tickStart);
+  ASSERT_NE(restored->tickStartVelocities(), nullptr);
+  restored->renderVelocities(velocity);
+  for (int c = 0; c < 3; ++c) {
+    for (Eigen::Index i = 0; i < expected.x.size(); ++i) {
+      ASSERT_EQ(bitsOf(velocity[c][i]), bitsOf(expected[c][i])) << c << ", row " << i;
+    }
+  }
+}
+
 TEST_F(Embedding, IdsAndNamedColumnsCopyTheCurrentTick) {
   const auto system = fountainBetweenTicks();
   const ParticlePool& pool = system->pool();

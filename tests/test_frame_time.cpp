@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <tuple>
 #include <vector>
 
@@ -51,6 +52,33 @@ TEST(ExactTime, TimeKOverHIsTickKAtEveryStepRate) {
 
 // A burst and a structure at 1/1024 s at 1024 Hz are born at tick 1: after one second their age
 // is 1023/1024 s (it was 1022/1024, a tick late).
+// dyadic() is exact: numerator · 2^-shift gives x back, with numerator < 2^53, for normal and
+// subnormal doubles, 0 and the largest accepted.
+TEST(ExactTime, DyadicIsTheDoubleExactly) {
+  for (const double x : {0.0, 0.75, 1.0, 0.1, 1.0 / 3.0, 1e9, 0x1p-76, 0x1.8p-76, 1e-300,
+                         std::numeric_limits<double>::denorm_min(), std::nextafter(0x1p53, 0.0)}) {
+    const exact::Dyadic d = exact::dyadic(x);
+    EXPECT_LT(d.numerator, std::uint64_t{1} << 53) << x;
+    EXPECT_GE(d.shift, 0) << x;
+    EXPECT_EQ(std::ldexp(static_cast<double>(d.numerator), -d.shift), x) << x;
+  }
+  EXPECT_EQ(exact::dyadic(0.75).numerator, 3ull << 51);
+  EXPECT_EQ(exact::dyadic(0.75).shift, 53);
+  EXPECT_THROW(exact::dyadic(0x1p53), std::invalid_argument);
+  EXPECT_THROW(exact::dyadic(-0.5), std::invalid_argument);
+}
+
+// Times so small that m · H must be shifted right by 127, 128 or 129 bits (2^-75, 2^-76, 2^-77):
+// past the width of the integers, where a shift would be undefined, and still after tick 0.
+TEST(ExactTime, TheSmallestPositiveTimesAreTickOne) {
+  for (const double t : {0x1p-75, 0x1.fffffffffffffp-76, 0x1p-76, 0x1.8p-76, 0x1p-77}) {
+    for (const std::int64_t h : {1, 60, 1'000'000}) {
+      EXPECT_EQ(exact::tickAtOrAfter(t, h), 1) << t << " s at " << h << " Hz";
+    }
+  }
+  EXPECT_EQ(exact::dyadic(0x1p-76).shift, 128);
+}
+
 TEST(ExactTime, BurstsAndStructuresAreBornOnTheirTick) {
   SystemSettings settings = test::referenceSettings();
   settings.stepRateHz = 1024;

@@ -207,6 +207,20 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   EXPECT_EQ(
       s.validate()[0].text(),
       "axis_v: is parallel to axis_u (expected a direction [x, y, z] not parallel to axis_u)");
+  // A side below 2 is the one problem: the particle count is judged only for sides that can be.
+  cloth = ClothShape{};
+  cloth.width = 2'000'000;
+  cloth.height = 1;
+  s.shape = cloth;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].text(),
+            "height: 1 is out of range (expected particles, an integer of at least 2)");
+  cloth.height = 2;
+  s.shape = cloth;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].text(),
+            "height: 2000000 x 2 = 4000000 particles are too many (expected width x height at "
+            "most 1000000)");
   // A cluster's radii must be positive: 0 is refused, the smallest positive double is not.
   ClusterShape cluster;
   cluster.linkRadius = 0.0;
@@ -902,7 +916,8 @@ TEST(Pinning, APinnedParticleGetsNoAccelerationFromAnyForce) {
   pool.spawn(free, 0);
   EXPECT_EQ(pool.inverseMass()[0], 0.0f);
   ForceSet forces = test::gravityOnly();
-  forces.add(std::make_unique<LinearDrag>(0.5f, Eigen::Vector3f(3.0f, 0.0f, 0.0f)));
+  // The wind is oblique so that the pinned particle's drag is non-zero on every axis.
+  forces.add(std::make_unique<LinearDrag>(0.5f, Eigen::Vector3f(3.0f, 1.0f, -2.0f)));
   addNetwork(forces).add(Spring{0, 1, 1.0f, 20.0f, 0.5f, 0.0f});
   forces.beginTick(pool, 0);
   Vec3Column a;
@@ -912,11 +927,11 @@ TEST(Pinning, APinnedParticleGetsNoAccelerationFromAnyForce) {
       {pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), TickInstant{}},
       RowRange{0, 2}, rows);
   for (int c = 0; c < 3; ++c) EXPECT_EQ(bitsOf(a[c][0]), 0u) << "component " << c;
-  // The free end: gravity, drag 0.5·(3 − 1) = 1 along x, and the spring (stretch 0.5) pulling up
-  // 20·0.5/1 = 10.
+  // The free end: gravity, drag 0.5·((3, 1, −2) − (1, 0, 0)) = (1, 0.5, −1), and the spring
+  // (stretch 0.5) pulling up 20·0.5/1 = 10. Float sums of these few terms are within 2 ulps.
   EXPECT_NEAR(a.x[1], 1.0f, 1e-6f);
-  EXPECT_NEAR(a.y[1], -9.81f + 10.0f, 1e-5f);
-  EXPECT_EQ(a.z[1], 0.0f);
+  EXPECT_NEAR(a.y[1], -9.81f + 0.5f + 10.0f, 1e-5f);
+  EXPECT_NEAR(a.z[1], -1.0f, 1e-6f);
 }
 
 // ---- a damped hanging chain settles to its static shape ----------------------------------------
@@ -1074,6 +1089,30 @@ TEST(SpringLifecycle, SpringsWhoseEndDiesAreRemoved) {
       << "momentum " << momentum().transpose() << " was " << p0.transpose();
   const Eigen::Vector3d d = positionOf(pool, 1) - positionOf(pool, 0);
   EXPECT_LT(d.norm(), 1.2) << "the 1–2 spring still acts";
+}
+
+// A structure born into a pool with room for only part of it keeps the springs between the
+// particles that were born and no other: a spring to a refused particle has no end to pull.
+TEST(SpringLifecycle, AStructureCutShortByAFullPoolKeepsOnlyTheSpringsOfItsBornParticles) {
+  StructureSettings s;
+  RopeShape rope;
+  rope.start = Eigen::Vector3d(0.0, 1.0, 0.0);
+  rope.end = Eigen::Vector3d(0.5, 0.0, 0.25);
+  rope.count = 9;
+  s.shape = rope;
+  SystemSettings settings = settingsFor("semi_implicit_euler", 60);
+  settings.maxParticles = 5;
+  ParticleSystem system(settings, {}, test::gravityOnly(), {s});
+  system.step();
+  ASSERT_EQ(system.pool().size(), 5u);
+  EXPECT_EQ(system.pool().droppedSpawns(), 4u);
+  ASSERT_NE(system.springs(), nullptr);
+  const std::vector<Spring>& springs = system.springs()->springs();
+  ASSERT_EQ(springs.size(), 4u) << "0–1, 1–2, 2–3, 3–4 of the rope's 8";
+  for (std::size_t i = 0; i < springs.size(); ++i) {
+    EXPECT_EQ(springs[i].a, i);
+    EXPECT_EQ(springs[i].b, i + 1);
+  }
 }
 
 // A spring to a particle not born yet does nothing; once it is born, it pulls.

@@ -500,10 +500,33 @@ TEST(AnalyticField, CurlNoiseIsDeterministicAndDivergenceFree) {
   EXPECT_GT(a.at(x).norm(), 0.01);
 }
 
+// Regression guard: an effect's curl noise is a function of its seed, frequency, amplitude and
+// octaves alone, so a seed keeps its look across versions. Pinned to 1e-12 (a few hundred ulps:
+// room for another compiler's libm-free rounding, far below any change of a term).
+TEST(AnalyticField, CurlNoiseOfAKnownSeedKeepsItsValuesAcrossVersions) {
+  const Eigen::Vector3d x(0.3, -0.1, 0.7);
+  const Eigen::Vector3d one = AnalyticField::curlNoise(42, 3.0, 1.0, 1).at(x);
+  const Eigen::Vector3d two = AnalyticField::curlNoise(42, 3.0, 1.0, 2).at(x);
+  const Eigen::Vector3d evolving = AnalyticField::curlNoise(42, 3.0, 1.0, 2, 0.5).at(x, 1.25);
+  const Eigen::Vector3d kOne(-0.012079550580577275, 0.16717560148579372, -0.034046769937689375);
+  const Eigen::Vector3d kTwo(0.12608484211514986, 0.30274343534800097, -0.30412139899779289);
+  const Eigen::Vector3d kEvolving(0.26452571618985132, 0.3408860657923557, -0.28524801039588127);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(one[c], kOne[c], 1e-12) << c;
+    EXPECT_NEAR(two[c], kTwo[c], 1e-12) << c;
+    EXPECT_NEAR(evolving[c], kEvolving[c], 1e-12) << c;
+  }
+}
+
 TEST(AnalyticField, RejectsDegenerateInput) {
   EXPECT_THROW(AnalyticField::vortex({0, 0, 0}, {0, 0, 0}, 1.0), std::invalid_argument);
   EXPECT_THROW(AnalyticField::shear({0, 0, 0}, {1, 0, 0}, {0, 0, 0}, 1.0), std::invalid_argument);
   EXPECT_THROW(AnalyticField::curlNoise(1, 0.0, 1.0), std::invalid_argument);
+  ASSERT_EQ(AnalyticField::validateCurlNoise(1.0, 0).size(), 1u);
+  EXPECT_EQ(AnalyticField::validateCurlNoise(1.0, 0)[0].text(),
+            "octaves: 0 is out of range (expected an integer of at least 1)");
+  EXPECT_TRUE(AnalyticField::validateCurlNoise(1.0, 1).empty());
+  EXPECT_THROW(AnalyticField::curlNoise(1, 1.0, 1.0, 0), std::invalid_argument);
   EXPECT_THROW(AnalyticField::curlNoise(1, 1.0, 1.0).materialAcceleration(), std::logic_error);
   BakeSettings s;
   s.voxelSize = 0.0;
