@@ -11,7 +11,6 @@
 #include "app/DeterminismCheck.h"
 #include "app/HashLogRun.h"
 #include "io/AtomicFile.h"
-#include "io/Checkpoint.h"
 #include "io/EffectBuilder.h"
 #include "io/EffectParser.h"
 #include "io/FrameTimes.h"
@@ -98,7 +97,7 @@ struct LogOptions {
 };
 
 int recordCommand(const io::EffectSettings& effect, const std::string& effectPath,
-                  const std::vector<std::string>& overrides, const LogOptions& options) {
+                  std::uint64_t fingerprint, const LogOptions& options) {
   const std::string& logPath = options.logPath;
   const FrameRate fps = options.fps.value_or(effect.output.fps);
   const double seconds = options.seconds;
@@ -106,7 +105,7 @@ int recordCommand(const io::EffectSettings& effect, const std::string& effectPat
 
   io::HashLogHeader header = describeThisBuild();
   header.effect = effectPath;
-  header.fingerprint = io::effectFingerprint(effectPath, overrides);
+  header.fingerprint = fingerprint;
   header.seed = effect.simulation.seed;
   header.stepRateHz = effect.simulation.stepRateHz;
   header.length = flicksFromSeconds(seconds);
@@ -134,13 +133,13 @@ int recordCommand(const io::EffectSettings& effect, const std::string& effectPat
   return kExitOk;
 }
 
-int compareCommand(const io::EffectSettings& effect, const std::string& effectPath,
-                   const std::vector<std::string>& overrides, const std::string& logPath) {
+int compareCommand(const io::EffectSettings& effect, std::uint64_t fingerprint,
+                   const std::string& logPath) {
   LogComparison c;
   io::HashLog log;
   try {
     log = io::readHashLog(logPath);
-    c = compareWithHashLog(effect, io::effectFingerprint(effectPath, overrides), logPath, log);
+    c = compareWithHashLog(effect, fingerprint, logPath, log);
   } catch (const io::BuildError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitUsage;
@@ -231,8 +230,8 @@ int logCommand(Arguments& args, const std::vector<std::string>& overrides,
   const io::LoadResult load = io::loadEffectFile(path, overrides);
   for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
   if (!load.ok()) return kExitUsage;
-  return compare ? compareCommand(*load.effect, path, overrides, options.logPath)
-                 : recordCommand(*load.effect, path, overrides, options);
+  return compare ? compareCommand(*load.effect, load.fingerprint, options.logPath)
+                 : recordCommand(*load.effect, path, load.fingerprint, options);
 }
 
 std::string hashAt(const DriveTrace& t, std::int64_t tick) {

@@ -196,7 +196,7 @@ int runCommand(Arguments& args) {
     throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
   const std::filesystem::path checkpoints =
       checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
-  const std::uint64_t effectHash = io::effectFingerprint(effectPath, overrides);
+  const std::uint64_t effectHash = load.fingerprint;
   // What a VDB cache records of the run, for the pipeline that reads it.
   const io::VdbCacheMetadata vdbMeta{hashToHex(effectHash), effect.simulation.seed,
                                      effect.simulation.stepRateHz, effect.simulation.integrator,

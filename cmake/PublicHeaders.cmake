@@ -43,6 +43,7 @@ set(TICKFX_EFFECTS_PUBLIC_HEADERS
   io/EffectLoader.h
   io/EffectParser.h
   io/EffectSettings.h
+  io/Fingerprint.h
   io/FrameData.h
   io/PlyCache.h
   io/SourceMap.h

@@ -5,7 +5,6 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -38,14 +37,6 @@ void forEachFloatColumn(Pool& pool, F&& f) {
   for (auto* c : {&pool.age(), &pool.lifetime(), &pool.mass(), &pool.inverseMass()}) f(*c);
 }
 constexpr int kFloatColumns = 16;
-
-std::uint64_t mix(std::uint64_t h, std::uint64_t word) {
-  h = (h ^ word) * 0x100000001b3ULL;
-  h ^= h >> 29;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 32;
-  return h;
-}
 
 std::uint64_t loadU64(const char* p) {
   std::uint64_t v = 0;
@@ -354,27 +345,6 @@ std::string readWholeFile(const std::filesystem::path& path) {
 }
 
 }  // namespace
-
-std::uint64_t fingerprint(std::string_view bytes) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  std::size_t i = 0;
-  for (; i + 8 <= bytes.size(); i += 8) h = mix(h, loadU64(bytes.data() + i));
-  if (i < bytes.size()) {
-    char tail[8] = {};
-    std::memcpy(tail, bytes.data() + i, bytes.size() - i);
-    h = mix(h, loadU64(tail));
-  }
-  // Without the length, inputs that differ only by trailing zero bytes would collide.
-  return mix(h, bytes.size());
-}
-
-std::uint64_t effectFingerprint(const std::filesystem::path& effectFile,
-                                const std::vector<std::string>& overrides) {
-  std::ifstream in(effectFile, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const std::string& o : overrides) bytes += '\0' + o;
-  return fingerprint(bytes);
-}
 
 void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,
                      const CheckpointInfo& info) {

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "io/Fingerprint.h"
 #include "particles/Clock.h"
 #include "particles/ParticleSystem.h"
 
@@ -73,19 +74,5 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
 /// left exactly as it was.
 CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
                               std::uint64_t expectedEffectHash);
-
-/// A 64-bit non-cryptographic fingerprint of `bytes`, for effect hashes and the checksum.
-///
-/// Stable across versions and platforms (it is part of the file format): starting from
-/// h = 0xcbf29ce484222325, each 8-byte little-endian word w of the input (the last one padded
-/// with zero bytes) is mixed in as h = (h ^ w) · 0x100000001b3, h ^= h >> 29,
-/// h *= 0xbf58476d1ce4e5b9, h ^= h >> 32; then the byte count is mixed in the same way. Every
-/// step is a bijection of h, so any change confined to one word always changes the result.
-std::uint64_t fingerprint(std::string_view bytes);
-
-/// The effect as a checkpoint, a VDB cache and a hash log know it: fingerprint() of the file's
-/// bytes and every override, in order, each after a zero byte.
-std::uint64_t effectFingerprint(const std::filesystem::path& effectFile,
-                                const std::vector<std::string>& overrides);
 
 }  // namespace tickfx::io

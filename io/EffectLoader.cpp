@@ -3,7 +3,6 @@
 #include <exception>
 #include <new>
 
-#include "io/Checkpoint.h"
 #include "io/EffectBuilder.h"
 #include "io/EffectLint.h"
 #include "io/EffectParser.h"
@@ -60,7 +59,7 @@ LoadedEffect loadEffect(const std::filesystem::path& path,
     }
     if (options.lint) appendLint(*result.effect, &result.system->forces(), result.diagnostics);
     io::sortDiagnostics(result.diagnostics);
-    result.fingerprint = io::effectFingerprint(path, texts);
+    result.fingerprint = load.fingerprint;
   } catch (const std::bad_alloc&) {
     result.system.reset();
     result.fingerprint = 0;

@@ -19,6 +19,7 @@
 #include "io/CsvCache.h"
 #include "io/EditDistance.h"
 #include "io/EffectBuilder.h"
+#include "io/Fingerprint.h"
 #include "io/SettingOverrides.h"
 #include "io/VdbPointCache.h"
 #include "io/VectorFieldSource.h"
@@ -1634,6 +1635,7 @@ bool migrateToCurrent(Context& cx, toml::table& document) {
 LoadResult parseEffect(std::string_view text, std::string_view fileName,
                        const std::vector<std::string>& overrides) {
   LoadResult result;
+  result.fingerprint = effectFingerprint(text, overrides);
   const std::string file(fileName);
   toml::table document;
   try {

@@ -1,6 +1,7 @@
 // Reading effect files: TOML text → validated EffectSettings, or every error in the file.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -18,6 +19,10 @@ namespace tickfx::io {
 struct LoadResult {
   std::optional<EffectSettings> effect;
   std::vector<Diagnostic> diagnostics;
+  /// effectFingerprint() of the very text parsed and the overrides, whether or not it loaded
+  /// (0 when the file could not be read): the effect's identity for checkpoints, caches and hash
+  /// logs, from the same bytes as the effect, so an edit between the two cannot split them.
+  std::uint64_t fingerprint = 0;
 
   bool ok() const { return effect.has_value(); }
 };

@@ -1,6 +1,6 @@
 #include "io/FrameData.h"
 
-#include "io/Checkpoint.h"
+#include "io/Fingerprint.h"
 #include "particles/ParticleSystem.h"
 
 namespace tickfx::io {

@@ -21,7 +21,7 @@
 
 #include "fields/VdbGridFile.h"
 #include "io/AtomicFile.h"
-#include "io/Checkpoint.h"
+#include "io/Fingerprint.h"
 
 namespace tickfx::io {
 namespace {

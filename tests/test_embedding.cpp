@@ -98,9 +98,9 @@ TEST_F(Embedding, OverridesAreAppliedAsTheCommandLineAppliesThem) {
   // The identity `tickfx run --set ...` records in caches and checkpoints: the file and each
   // override as key=value, in order.
   EXPECT_EQ(fx.fingerprint,
-            io::effectFingerprint(kSamples / "fountain.toml",
-                                  {"simulation.step_rate=240", "simulation.integrator=rk4",
-                                   "emitters.0.direction=[1, 0, 0]"}));
+            io::effectFileFingerprint(kSamples / "fountain.toml",
+                                      {"simulation.step_rate=240", "simulation.integrator=rk4",
+                                       "emitters.0.direction=[1, 0, 0]"}));
   EXPECT_NE(fx.fingerprint, loadEffect(kSamples / "fountain.toml").fingerprint);
 }
 
@@ -273,6 +273,10 @@ TEST_F(Embedding, RestoreClockGivesBackTheTickStartVelocitiesRenderCopiesUse) {
 
   restored->restoreClock(restored->tickCount(), nullptr);
   EXPECT_EQ(restored->tickStartVelocities(), nullptr);
+  LoadedEffect atStart = loadEffect(kSamples / "fountain.toml");
+  ASSERT_TRUE(atStart.ok()) << atStart.text();
+  atStart.system->restoreClock(0, nullptr);
+  EXPECT_EQ(atStart.system->tickStartVelocities(), nullptr) << "none at tick 0 either";
   restored->renderVelocities(velocity);
   EXPECT_NE(bitsOf(velocity.y[5]), bitsOf(expected.y[5])) << "the tick's own velocities";
 

@@ -77,7 +77,7 @@ TEST_F(HashLog, ALogComparedWithItselfIsIdentical) {
   EXPECT_EQ(log[find(log, "step_rate: ")], "step_rate: 120");
   EXPECT_EQ(log[find(log, "fps: ")], "fps: 30/1");
   EXPECT_EQ(log[find(log, "fingerprint: ")],
-            "fingerprint: " + tickfx::hashToHex(tickfx::io::effectFingerprint(
+            "fingerprint: " + tickfx::hashToHex(tickfx::io::effectFileFingerprint(
                                   TICKFX_SOURCE_DIR "/samples/fountain.toml", {})));
   // The last tick's line holds the plain run's hash; its frame comes right after it.
   const int last = find(log, "tick 120 ");
@@ -170,7 +170,7 @@ TEST_F(HashLog, ALogOfAnotherEffectSeedOrStepRateIsRefused) {
   const std::string log = path("a.log");
   const auto fp = [](const std::string& effect, const std::vector<std::string>& overrides) {
     return tickfx::hashToHex(
-        tickfx::io::effectFingerprint(TICKFX_SOURCE_DIR "/" + effect, overrides));
+        tickfx::io::effectFileFingerprint(TICKFX_SOURCE_DIR "/" + effect, overrides));
   };
   const std::string fountain = fp("samples/fountain.toml", {});
 
@@ -181,8 +181,8 @@ TEST_F(HashLog, ALogOfAnotherEffectSeedOrStepRateIsRefused) {
   Result r = run("determinism " + copy + " --compare " + log);
   EXPECT_EQ(r.exit, 2) << r.out << r.err;
   EXPECT_EQ(r.err, log + ": error: the log is of another effect (fingerprint " + fountain +
-                       ", this run " + tickfx::hashToHex(tickfx::io::effectFingerprint(copy, {})) +
-                       ")\n");
+                       ", this run " +
+                       tickfx::hashToHex(tickfx::io::effectFileFingerprint(copy, {})) + ")\n");
   r = run("determinism samples/fountain.toml --set forces.1.k=0.3 --compare " + log);
   EXPECT_EQ(r.exit, 2) << r.out << r.err;
   EXPECT_EQ(r.err, log + ": error: the log is of another effect (fingerprint " + fountain +

@@ -21,6 +21,7 @@
 #include "CoreTestSupport.h"
 #include "fields/Gravity.h"
 #include "io/Checkpoint.h"
+#include "io/EffectParser.h"
 #include "particles/StateHash.h"
 
 namespace fs = std::filesystem;
@@ -736,11 +737,29 @@ TEST_F(ioCheckpoint, WritingIntoAMissingFolderFails) {
 // ---- fingerprint ----------------------------------------------------------------------------
 
 // Effect hashes written by one version are compared by the next: the values are pinned (and
-// agree with an independent implementation of the algorithm documented in Checkpoint.h).
+// agree with an independent implementation of the algorithm documented in Fingerprint.h).
 TEST(ioFingerprint, IsStable) {
   EXPECT_EQ(hashToHex(fingerprint("")), "0556470532b24426");
   EXPECT_EQ(hashToHex(fingerprint("tickfx")), "17ef229f63032e7f");
   EXPECT_EQ(hashToHex(fingerprint("[simulation]\nstep_rate = 60\n")), "78c5581e6d6768f3");
+}
+
+// An effect's identity is the fingerprint of the very text parsed and its overrides, each after a
+// zero byte; a file that cannot be read has none (0).
+TEST(ioFingerprint, AnEffectsIsOfTheTextParsedAndItsOverrides) {
+  const std::string text = "[simulation]\nstep_rate = 60\n";
+  EXPECT_EQ(hashToHex(parseEffect(text, "a.toml").fingerprint), "78c5581e6d6768f3");
+  const std::vector<std::string> overrides{"simulation.seed=3", "simulation.step_rate=120"};
+  const std::uint64_t withOverrides = parseEffect(text, "a.toml", overrides).fingerprint;
+  EXPECT_EQ(withOverrides, fingerprint(text + '\0' + overrides[0] + '\0' + overrides[1]));
+  EXPECT_EQ(withOverrides, effectFingerprint(text, overrides));
+  const std::filesystem::path file = std::filesystem::temp_directory_path() /
+                                     ("tickfx_fp_" + std::to_string(::getpid()) + ".toml");
+  std::ofstream(file, std::ios::binary) << text;
+  EXPECT_EQ(loadEffectFile(file, overrides).fingerprint, withOverrides);
+  EXPECT_EQ(effectFileFingerprint(file, overrides), withOverrides);
+  std::filesystem::remove(file);
+  EXPECT_EQ(loadEffectFile(file, overrides).fingerprint, 0u) << "no file, no identity";
 }
 
 TEST(ioFingerprint, EveryBitAndTheLengthCount) {

@@ -215,12 +215,22 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   ASSERT_EQ(s.validate().size(), 1u);
   EXPECT_EQ(s.validate()[0].text(),
             "height: 1 is out of range (expected particles, an integer of at least 2)");
-  cloth.height = 2;
+  cloth.width = 1;
+  cloth.height = 2'000'000;
+  s.shape = cloth;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].key, "width");
+  // The smallest sides that can be too many: 2 x 500001.
+  cloth.width = 2;
+  cloth.height = 500'001;
   s.shape = cloth;
   ASSERT_EQ(s.validate().size(), 1u);
   EXPECT_EQ(s.validate()[0].text(),
-            "height: 2000000 x 2 = 4000000 particles are too many (expected width x height at "
-            "most 1000000)");
+            "height: 2 x 500001 = 1000002 particles are too many (expected width x height at most "
+            "1000000)");
+  cloth.height = 500'000;
+  s.shape = cloth;
+  EXPECT_TRUE(s.validate().empty());
   // A cluster's radii must be positive: 0 is refused, the smallest positive double is not.
   ClusterShape cluster;
   cluster.linkRadius = 0.0;
