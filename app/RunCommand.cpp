@@ -135,6 +135,23 @@ std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t f
   return dir / name;
 }
 
+void reportNonfiniteStop(const std::string& effectPath, const NonfiniteEvent& event,
+                         const std::vector<io::Diagnostic>& lint, std::int64_t lastWritten,
+                         std::int64_t firstFrame, const std::optional<std::filesystem::path>& out) {
+  std::fprintf(stderr,
+               "%s: error: %s; the run stops there (simulation.nonfinite = \"stop\"; \"kill\" "
+               "removes such particles instead)\n",
+               effectPath.c_str(), event.describe().c_str());
+  if (const io::Diagnostic* cause = io::instabilityWarning(lint)) {
+    std::fprintf(stderr, "likely cause: %s\n", cause->format().c_str());
+  }
+  if (out && lastWritten >= firstFrame) {
+    std::fprintf(stderr, "caches written: %s (frame_%04lld to frame_%04lld)\n",
+                 out->string().c_str(), static_cast<long long>(firstFrame),
+                 static_cast<long long>(lastWritten));
+  }
+}
+
 std::filesystem::path checkpointPath(const std::filesystem::path& dir, std::int64_t frame) {
   char name[64];
   std::snprintf(name, sizeof name, "checkpoint_%06" PRId64 ".tfxc", frame);
@@ -213,8 +230,8 @@ int runCommand(Arguments& args) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitUsage;
   }
-  for (const io::Diagnostic& d : io::lintEffect(effect, &system->forces()))
-    std::fprintf(stderr, "%s\n", d.format().c_str());
+  const std::vector<io::Diagnostic> lint = io::lintEffect(effect, &system->forces());
+  for (const io::Diagnostic& d : lint) std::fprintf(stderr, "%s\n", d.format().c_str());
   std::int64_t firstFrame = 1;
   Flicks elapsed = 0;
   if (resume) {
@@ -268,6 +285,13 @@ int runCommand(Arguments& args) {
   while (const std::optional<Flicks> duration = schedule.next()) {
     const std::int64_t f = schedule.framesDone();
     system->advance(*duration);
+    if (system->nonfiniteStop()) {
+      // The frame holding the tick is not written; those before it are, whole.
+      progress.finish();
+      reportNonfiniteStop(effectPath, *system->nonfiniteStop(), lint, f - 1, firstFrame,
+                          formats.empty() ? std::nullopt : std::optional(outDir));
+      return kExitFailure;
+    }
     elapsed += *duration;
     lastFrame = f;
     if (!formats.empty()) {
@@ -309,6 +333,10 @@ int runCommand(Arguments& args) {
     std::printf("particles alive: %zu (emitted %llu, refused by max_particles: %llu)\n",
                 pool.size(), static_cast<unsigned long long>(pool.nextId() + pool.droppedSpawns()),
                 static_cast<unsigned long long>(pool.droppedSpawns()));
+    if (effect.simulation.nonfinite == NonfinitePolicy::Kill) {
+      std::printf("removed for a non-finite position or velocity: %llu\n",
+                  static_cast<unsigned long long>(system->nonfiniteKilled()));
+    }
     std::printf("wall time: %.3f s\n", wall);
     if (!formats.empty() && lastFrame >= firstFrame) {
       std::printf("caches: %s (frame_%04lld to frame_%04lld)\n", outDir.string().c_str(),

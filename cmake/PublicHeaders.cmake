@@ -8,6 +8,7 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   particles/EmissionRate.h
   particles/Emitter.h
   particles/FixedStepDriver.h
+  particles/NonfiniteState.h
   particles/ParticlePool.h
   particles/ParticleSystem.h
   particles/Random.h

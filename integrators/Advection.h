@@ -36,7 +36,9 @@ class Advection {
  public:
   explicit Advection(AdvectionScheme scheme) : scheme_(scheme) {}
   AdvectionScheme scheme() const { return scheme_; }
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time);
+  /// `afterEachTile`: as runPasses() takes it.
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+            const RowPass& afterEachTile = {});
 
  private:
   AdvectionScheme scheme_;

@@ -9,6 +9,8 @@
 
 #include "fields/ForceSet.h"
 #include "integrators/Advection.h"
+#include "integrators/StagePasses.h"
+#include "particles/NonfiniteState.h"
 #include "particles/ParticlePool.h"
 
 namespace tickfx {
@@ -49,15 +51,21 @@ class Integrator {
   /// How this scheme advances x' = u(x, t) when the forces prescribe velocity.
   virtual AdvectionScheme advectionScheme() const = 0;
 
-  /// Advances rows [0, pool.size()) by one tick: integrate(), or the advection scheme.
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time);
+  /// Advances rows [0, pool.size()) by one tick: integrate(), or the advection scheme. With
+  /// `check`, each tile's new positions and velocities are checked for non-finite values inside
+  /// the scheme's last pass over it (see NonfiniteCheck); the state's bits are the same either way.
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+            NonfiniteCheck* check = nullptr);
 
  protected:
   /// The scheme itself, under forces that add acceleration.
   virtual void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) = 0;
+  /// What integrate() hands runPasses() as its afterEachTile: the step's NonfiniteCheck, if any.
+  RowPass afterEachTile(ParticlePool& pool) const;
 
  private:
   std::unique_ptr<Advection> advection_;  // made on the first advected step
+  NonfiniteCheck* check_ = nullptr;       // during step() only
 };
 
 /// The integrator called `name`; throws std::invalid_argument for an unknown name.

@@ -26,7 +26,8 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
              [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), vr = rowsOf(v, tile.rows());
                for (int c = 0; c < 3; ++c) vr[c] += a[c] * dt;
-             }});
+             }},
+            afterEachTile(pool));
 }
 
 }  // namespace tickfx

@@ -14,7 +14,8 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   const std::size_t n = pool.size();
   const TickInstant t0 = time.stage(0);
   runPasses(n, forces.isLocal(), scratch_,
-            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0),
+             [&](const Tile& tile) {
                const RowRange r = tile.rows();
                // A new particle has no history: give it the position it would have had a step ago.
                const RowRange started = intersect(r, fresh, n);
@@ -36,7 +37,8 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
                  pr[c] = next[c];
                  vr[c] = (pr[c] - old[c]) * invDt;
                }
-             }});
+             }},
+            afterEachTile(pool));
 }
 
 }  // namespace tickfx

@@ -35,22 +35,23 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
       }
     };
   };
-  runPasses(
-      pool.size(), forces.isLocal(), scratch_,
-      {evaluate(kState, kState, t0, K1), advance(kState, K1, P2, V2, halfH),
-       evaluate(P2, V2, tHalf, K2), advance(V2, K2, P3, V3, halfH), evaluate(P3, V3, tHalf, K3),
-       advance(V3, K3, P4, V4, h), evaluate(P4, V4, t1, K4), [&](const Tile& tile) {
-         Vec3Rows k1 = tile.stage(K1), k2 = tile.stage(K2), k3 = tile.stage(K3),
-                  k4 = tile.stage(K4);
-         Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
-         Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                  old = rowsOf(prev, tile.rows());
-         for (int c = 0; c < 3; ++c) {
-           old[c] = pr[c];
-           pr[c] += ((vr[c] + v2[c] * 2.0f) + (v3[c] * 2.0f + v4[c])) * sixthH;
-           vr[c] += ((k1[c] + k2[c] * 2.0f) + (k3[c] * 2.0f + k4[c])) * sixthH;
-         }
-       }});
+  runPasses(pool.size(), forces.isLocal(), scratch_,
+            {evaluate(kState, kState, t0, K1), advance(kState, K1, P2, V2, halfH),
+             evaluate(P2, V2, tHalf, K2), advance(V2, K2, P3, V3, halfH),
+             evaluate(P3, V3, tHalf, K3), advance(V3, K3, P4, V4, h), evaluate(P4, V4, t1, K4),
+             [&](const Tile& tile) {
+               Vec3Rows k1 = tile.stage(K1), k2 = tile.stage(K2), k3 = tile.stage(K3),
+                        k4 = tile.stage(K4);
+               Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
+               Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                        old = rowsOf(prev, tile.rows());
+               for (int c = 0; c < 3; ++c) {
+                 old[c] = pr[c];
+                 pr[c] += ((vr[c] + v2[c] * 2.0f) + (v3[c] * 2.0f + v4[c])) * sixthH;
+                 vr[c] += ((k1[c] + k2[c] * 2.0f) + (k3[c] * 2.0f + k4[c])) * sixthH;
+               }
+             }},
+            afterEachTile(pool));
 }
 
 }  // namespace tickfx

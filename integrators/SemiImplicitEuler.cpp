@@ -10,7 +10,8 @@ void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces,
   Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0);
   runPasses(pool.size(), forces.isLocal(), scratch_,
-            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0),
+             [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                         old = rowsOf(prev, tile.rows());
                for (int c = 0; c < 3; ++c) {
@@ -18,7 +19,8 @@ void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces,
                  vr[c] += a[c] * dt;
                  pr[c] += vr[c] * dt;
                }
-             }});
+             }},
+            afterEachTile(pool));
 }
 
 }  // namespace tickfx

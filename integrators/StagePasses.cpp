@@ -32,7 +32,7 @@ void StageScratch::ensureRows(std::size_t rows) {
 }
 
 void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
-               std::initializer_list<RowPass> passes) {
+               std::initializer_list<RowPass> passes, const RowPass& afterEachTile) {
   const int count = scratch.count();
   if (fused) {
     parallelForRows(rows, [&](std::size_t b, std::size_t e) {
@@ -44,6 +44,7 @@ void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
         }
         const Tile tile(RowRange{t, std::min(e, t + Tile::kRows)}, stage, count, t);
         for (const RowPass& pass : passes) pass(tile);
+        if (afterEachTile) afterEachTile(tile);
       }
     });
     return;
@@ -53,11 +54,13 @@ void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
   for (int k = 0; k < count; ++k) {
     for (int c = 0; c < 3; ++c) stage[k][c] = scratch.column(k)[c].data();
   }
-  for (const RowPass& pass : passes) {
+  const auto overAllRows = [&](const RowPass& pass) {
     parallelForRows(rows, [&](std::size_t b, std::size_t e) {
       pass(Tile(RowRange{b, e}, stage, count, 0));
     });
-  }
+  };
+  for (const RowPass& pass : passes) overAllRows(pass);
+  if (afterEachTile) overAllRows(afterEachTile);
 }
 
 namespace {

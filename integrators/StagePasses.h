@@ -61,8 +61,11 @@ using RowPass = std::function<void(const Tile&)>;
 /// each pass finishes for all rows before the next starts, because a non-local force reads rows
 /// that other blocks are updating. Each row sees exactly the same arithmetic either way, so the
 /// bits do not depend on the mode, the tile size or the thread count.
+///
+/// `afterEachTile`, when set, runs on each tile once every pass is done with it (in a fused run
+/// while the tile's rows are still in cache): a read-only check of the tile's new state.
 void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
-               std::initializer_list<RowPass> passes);
+               std::initializer_list<RowPass> passes, const RowPass& afterEachTile = {});
 
 /// In forcePass() and flowPass(): the pool's own column instead of a stage value.
 inline constexpr int kPoolColumn = -1;

@@ -38,7 +38,8 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            vr[c] += (ar[c] + aNew[c]) * halfDt;
            ar[c] = aNew[c];
          }
-       }});
+       }},
+      afterEachTile(pool));
 }
 
 }  // namespace tickfx

@@ -1,6 +1,7 @@
 #include "io/CsvCache.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -16,6 +17,11 @@ constexpr const char* kFixedHeader = "id,px,py,pz,vx,vy,vz,age,life,mass";
 constexpr int kFixedFloatColumns = 9;
 
 void appendFloat(std::string& line, float value) {
+  // printf spells a NaN with its sign bit "-nan", which most CSV readers refuse: one spelling.
+  if (std::isnan(value)) {
+    line += ",nan";
+    return;
+  }
   char text[32];
   std::snprintf(text, sizeof text, ",%.9g", static_cast<double>(value));
   line += text;

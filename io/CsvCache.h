@@ -9,7 +9,8 @@ namespace tickfx::io {
 
 /// Writes `frame` to `path` (atomically): a header `id,px,py,pz,vx,vy,vz,age,life,mass` followed
 /// by the custom attributes' names, then one row a particle in id order. Floats are printed with
-/// %.9g, which reads back to the same float bits.
+/// %.9g, which reads back to the same float bits; a non-finite value (an effect run with
+/// simulation.nonfinite = "keep") as `inf`, `-inf` or `nan` (any NaN, whatever its sign or payload).
 void writeCsvCache(const FrameData& frame, const std::filesystem::path& path);
 
 /// Reads a file written by writeCsvCache. Throws std::runtime_error naming the file and line on

@@ -13,6 +13,10 @@
 namespace tickfx::io {
 namespace {
 
+// The words of the warnings about an unstable step, which instabilityWarning() looks for.
+const std::string kGrowsWithoutBound = "grows without bound";
+const std::string kAddsEnergy = "adds energy to";
+
 // Energy drift the drift warnings tolerate over the whole output.
 constexpr double kTolerableDrift = 0.01;
 constexpr std::int64_t kHighestStepRate = 1'000'000'000;
@@ -195,14 +199,14 @@ void lintAnchorSprings(const EffectSettings& effect, std::vector<Diagnostic>& ou
     const std::string together = one ? " "
                                      : " with k = " + quantity(k) + " N/m, the stiffnesses of " +
                                            springs + " added up (each pulls on every particle), ";
-    out.push_back(warning(
-        effect, where,
-        "omega*dt = " + rounded(omegaDt, 4) + " is past " + integrator + "'s stability limit of " +
-            rounded(*limit, 4) + " (omega = sqrt(k/m) = " + rounded(omega, 4) + " rad/s" +
-            together + "for the lightest mass, " + rounded(mass, 4) + " kg, and dt = 1/" +
-            std::to_string(stepRate) + " s): the " + (one ? "spring's" : "springs'") +
-            " motion grows without bound (use a step_rate of at least " + std::to_string(needed) +
-            " Hz)"));
+    out.push_back(warning(effect, where,
+                          "omega*dt = " + rounded(omegaDt, 4) + " is past " + integrator +
+                              "'s stability limit of " + rounded(*limit, 4) +
+                              " (omega = sqrt(k/m) = " + rounded(omega, 4) + " rad/s" + together +
+                              "for the lightest mass, " + rounded(mass, 4) + " kg, and dt = 1/" +
+                              std::to_string(stepRate) + " s): the " +
+                              (one ? "spring's" : "springs'") + " motion " + kGrowsWithoutBound +
+                              " (use a step_rate of at least " + std::to_string(needed) + " Hz)"));
     return;
   }
 
@@ -216,8 +220,8 @@ void lintAnchorSprings(const EffectSettings& effect, std::vector<Diagnostic>& ou
   if (integrator == "explicit_euler" && c < k / rate) {
     // |λ|² = det of the step matrix [[1, dt], [−ω²dt, 1 − (c/m)dt]].
     perStep = [=](double h) { return 1.0 + (k / h - c) / (mass * h); };
-    verb = one ? "adds energy to this spring every step"
-               : "adds energy to " + springs + " every step" + added;
+    verb = one ? kAddsEnergy + " this spring every step"
+               : kAddsEnergy + " " + springs + " every step" + added;
     change = "gain";
     extra = ", damping of at least " + rounded(k / rate, 4) + " N·s/m (k·dt" +
             (one ? "" : ", in all") + ")";
@@ -342,8 +346,8 @@ void lintStructures(const EffectSettings& effect, std::vector<Diagnostic>& out) 
         "omega*dt = " + rounded(omegaDt, 4) + " is past " + integrator + "'s stability limit of " +
             rounded(*limit, 4) + " (omega = sqrt(k_eff/m) = " + quantity(omega) + " rad/s, " +
             keff + ", m = " + rounded(m, 4) + " kg, and dt = 1/" + std::to_string(stepRate) +
-            " s): the " + type + "'s fastest vibration grows without bound (use a step_rate of " +
-            "at least " + std::to_string(needed) + " Hz)"));
+            " s): the " + type + "'s fastest vibration " + kGrowsWithoutBound +
+            " (use a step_rate of " + "at least " + std::to_string(needed) + " Hz)"));
     return;
   }
   if (integrator != "explicit_euler" || cTotal >= kTotal / rate) return;
@@ -367,9 +371,9 @@ void lintStructures(const EffectSettings& effect, std::vector<Diagnostic>& out) 
            " Hz to keep the gain over the output under 1%";
   }
   out.push_back(warning(effect, where,
-                        "explicit_euler adds energy to this " + type + "'s springs every step (x" +
-                            factorText(perStep(rate)) + " per step, " + totalText(total) +
-                            " over the " + rounded(duration, 4) +
+                        "explicit_euler " + kAddsEnergy + " this " + type +
+                            "'s springs every step (x" + factorText(perStep(rate)) + " per step, " +
+                            totalText(total) + " over the " + rounded(duration, 4) +
                             " s of output, for its fastest vibration) (" + fix + ")"));
 }
 
@@ -404,6 +408,17 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet*
   lintTickCap(effect, out);
   sortDiagnostics(out);
   return out;
+}
+
+const Diagnostic* instabilityWarning(const std::vector<Diagnostic>& lint) {
+  for (const Diagnostic& d : lint) {
+    if (d.severity != Severity::Warning) continue;
+    if (d.message.find(kGrowsWithoutBound) != std::string::npos ||
+        d.message.find(kAddsEnergy) != std::string::npos) {
+      return &d;
+    }
+  }
+  return nullptr;
 }
 
 }  // namespace tickfx::io

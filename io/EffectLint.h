@@ -87,4 +87,8 @@ StructureStiffness structureStiffness(const StructureSettings& structure);
 /// loaded (or baked) here.
 std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built = nullptr);
 
+/// Of lintEffect()'s findings, the first that says a step grows without bound or adds energy every
+/// step: the likely cause when a run's state stops being finite. nullptr when none says so.
+const Diagnostic* instabilityWarning(const std::vector<Diagnostic>& lint);
+
 }  // namespace tickfx::io

@@ -476,6 +476,10 @@ void readSimulation(Context& cx, const toml::table& table, SystemSettings& s) {
   }
   r.integer("threads", s.threads, "worker threads, an integer from 0 (all cores) to 1024", 0,
             kMaxThreads);
+  std::string nonfinite;
+  if (r.choice("nonfinite", nonfinite, nonfinitePolicyNames(), "nonfinite policy")) {
+    s.nonfinite = nonfinitePolicyNamed(nonfinite);
+  }
   r.finish();
 }
 

@@ -96,9 +96,9 @@ void ParticleSystem::stepTicks(std::int64_t ticks) {
 }
 
 void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
-  if (ticks <= 0) return;
+  if (ticks <= 0 || nonfiniteStop_) return;
   runParallel([&] {
-    for (std::int64_t i = 0; i < ticks; ++i) {
+    for (std::int64_t i = 0; i < ticks && !nonfiniteStop_; ++i) {
       // Only the last tick of a frame needs its starting velocities, for interpolation.
       runTick(keepVelocities && i == ticks - 1);
       if (tickObserver_) tickObserver_(*this);
@@ -119,7 +119,9 @@ void ParticleSystem::runTick(bool keepVelocities) {
   }
   forces_.beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};
-  integrator_->step(pool_, forces_, time);
+  const bool check = settings_.nonfinite != NonfinitePolicy::Keep;
+  integrator_->step(pool_, forces_, time, check ? &nonfiniteCheck_ : nullptr);
+  if (nonfiniteCheck_.found()) takeNonfinite();
   pool_.markAllStepped();
   forces_.endTick(pool_, time.stage(2));
   ++tick_;
@@ -129,6 +131,29 @@ void ParticleSystem::runTick(bool keepVelocities) {
     velocitiesTick_ = tick_;
   }
   pool_.removeDead();
+}
+
+// Rare (the run is broken): a plain scan in row order, so the count and the ids do not depend on
+// how the check's tiles were spread over threads.
+void ParticleSystem::takeNonfinite() {
+  nonfiniteCheck_.clear();
+  const bool kill = settings_.nonfinite == NonfinitePolicy::Kill;
+  NonfiniteEvent event;
+  event.tick = tick_ + 1;
+  event.stepRateHz = settings_.stepRateHz;
+  std::uint8_t* dead = pool_.dead().data();
+  for (std::size_t i = 0; i < pool_.size(); ++i) {
+    if ((dead[i] & NonfiniteCheck::kFlag) == 0) continue;
+    ++event.particles;
+    if (event.firstIds.size() < NonfiniteEvent::kIdsKept) event.firstIds.push_back(pool_.id()[i]);
+    // Killed rows keep the flag: removeDead() takes them with the tick's other deaths.
+    if (!kill) dead[i] = static_cast<std::uint8_t>(dead[i] & ~NonfiniteCheck::kFlag);
+  }
+  if (kill) {
+    nonfiniteKilled_ += event.particles;
+  } else {
+    nonfiniteStop_ = std::move(event);
+  }
 }
 
 void ParticleSystem::restoreClock(std::int64_t tick, const Vec3Column* tickStartVelocities) {

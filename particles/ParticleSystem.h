@@ -13,6 +13,7 @@
 #include "integrators/Integrator.h"
 #include "particles/Emitter.h"
 #include "particles/FixedStepDriver.h"
+#include "particles/NonfiniteState.h"
 #include "particles/ParticlePool.h"
 #include "particles/RenderDestination.h"
 #include "particles/Structure.h"
@@ -31,6 +32,8 @@ struct SystemSettings {
   OverrunPolicy overrunPolicy = OverrunPolicy::DropExcess;
   FrameTiming frameTiming = FrameTiming::AtFrameTime;  // which time advance() leaves on show
   int threads = 0;                                     // 0: all cores
+  /// What a tick does with particles whose position or velocity stops being finite.
+  NonfinitePolicy nonfinite = NonfinitePolicy::Stop;
 };
 
 /// The simulation. One tick does, in this order: emit the tick's particles, let the forces
@@ -64,6 +67,14 @@ class ParticleSystem {
   void step();
   /// Runs `ticks` ticks, as step() does.
   void stepTicks(std::int64_t ticks);
+
+  /// Under NonfinitePolicy::Stop, the tick that left particles with a non-finite position or
+  /// velocity. Once set, advance(), step() and stepTicks() run no more ticks: the state stays the
+  /// one that tick made, for the host to look at (the render copies show it too).
+  const std::optional<NonfiniteEvent>& nonfiniteStop() const { return nonfiniteStop_; }
+  /// Under NonfinitePolicy::Kill, the particles removed for a non-finite position or velocity
+  /// since the system was made (a restored system counts from its restore).
+  std::uint64_t nonfiniteKilled() const { return nonfiniteKilled_; }
 
   /// Ticks completed so far: the state is the state after tick tickCount() − 1 (or the initial
   /// state for 0), at time tickCount() / stepRate seconds.
@@ -139,6 +150,7 @@ class ParticleSystem {
   struct PendingStructure;
   void runTicks(std::int64_t ticks, bool keepVelocities);
   void runTick(bool keepVelocities);
+  void takeNonfinite();
   void spawnStructure(const StructureBuild& build);
 
   SystemSettings settings_;
@@ -168,6 +180,9 @@ class ParticleSystem {
   // kept by advance() for interpolation; valid while velocitiesTick_ == tick_.
   Vec3Column previousVelocity_;
   std::int64_t velocitiesTick_ = -1;
+  NonfiniteCheck nonfiniteCheck_;
+  std::optional<NonfiniteEvent> nonfiniteStop_;
+  std::uint64_t nonfiniteKilled_ = 0;
 };
 
 }  // namespace tickfx

@@ -204,6 +204,53 @@ TEST_F(Cli, FailureAtRunTimeExitsOne) {
   EXPECT_TRUE(fs::exists(path("c/frame_0001.csv")));
 }
 
+// Regression (issue 12, item 1): the flag under explicit Euler at 30 Hz (lint: x712 energy per
+// step) was written for 10 s as rows of "-nan" with exit 0. Its state is first non-finite at tick
+// 19 (0.6333 s); at 60 fps frame 37 (0.6167 s) already needs tick 19 to interpolate, so frames
+// 1–36 are the ones before it.
+TEST_F(Cli, AnEffectThatBlowsUpStopsAtTheTickWithItsLikelyCauseAfterTheFramesBeforeIt) {
+  const std::string unstable =
+      "run samples/flag.toml --set simulation.step_rate=30 --set simulation.integrator="
+      "explicit_euler --seconds 10 --format csv --out ";
+  const Result stop = run(unstable + path("stop"));
+  EXPECT_EQ(stop.exit, 1);
+  EXPECT_NE(stop.err.find("samples/flag.toml: error: tick 19 (t = 0.633333333 s): 58 particles "
+                          "have a non-finite position or velocity (ids 10, 11, 12, 13, 14, 15, "
+                          "16, 17, ...); the run stops there (simulation.nonfinite = \"stop\"; "
+                          "\"kill\" removes such particles instead)\n"
+                          "likely cause: samples/flag.toml:24:13: warning: emitters.0.stiffness: "
+                          "explicit_euler adds energy to this cloth's springs every step"),
+            std::string::npos)
+      << stop.err;
+  EXPECT_NE(stop.err.find("caches written: " + path("stop") + " (frame_0001 to frame_0036)"),
+            std::string::npos)
+      << stop.err;
+  EXPECT_TRUE(fs::exists(path("stop/frame_0036.csv")));
+  EXPECT_FALSE(fs::exists(path("stop/frame_0037.csv")));
+  const tickfx::io::FrameData last = tickfx::io::readCsvCache(path("stop/frame_0036.csv"));
+  EXPECT_EQ(last.size(), 160u);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_TRUE(last.position[c].allFinite());
+    EXPECT_TRUE(last.velocity[c].allFinite());
+  }
+
+  // "kill": the run goes on without them, and says how many went.
+  const Result kill = run(unstable + path("kill") + " --set simulation.nonfinite=kill");
+  EXPECT_EQ(kill.exit, 0) << kill.err;
+  EXPECT_NE(kill.out.find("particles alive: 10 (emitted 160, refused by max_particles: 0)\n"
+                          "removed for a non-finite position or velocity: 150\n"),
+            std::string::npos)
+      << kill.out;
+  EXPECT_EQ(readAll(path("kill/frame_0600.csv")).find("nan"), std::string::npos);
+
+  // "keep": today's values, in the one documented spelling (never printf's "-nan").
+  const Result keep = run(unstable + path("keep") + " --set simulation.nonfinite=keep");
+  EXPECT_EQ(keep.exit, 0) << keep.err;
+  const std::string frame = readAll(path("keep/frame_0600.csv"));
+  EXPECT_NE(frame.find(",nan"), std::string::npos);
+  EXPECT_EQ(frame.find("-nan"), std::string::npos);
+}
+
 // Regression (issue 10, item 15): two identical runs wrote VDB files that differed in about 30
 // bytes (OpenVDB's random file UUID). Every format is now the same bytes for the same run; a
 // VDB file's UUID comes from the effect, its seed and the frame.

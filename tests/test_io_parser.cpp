@@ -158,7 +158,7 @@ rate = 10
 )"),
       (Lines{"bad.toml:4:1: error: simulation.colour: unknown key \"colour\" (expected one of: "
              "step_rate, integrator, seed, max_particles, max_ticks_per_frame, overrun, "
-             "threads)"}));
+             "threads, nonfinite)"}));
 }
 
 TEST(ioParse, MisspeltIntegratorShapeAndForceType) {
@@ -168,6 +168,7 @@ TEST(ioParse, MisspeltIntegratorShapeAndForceType) {
 step_rate = 60
 integrator = "velocity_verlett"
 overrun = "fallbehind"
+nonfinite = "kil"
 [[emitters]]
 shape = "sphre"
 [[forces]]
@@ -179,11 +180,13 @@ type = "magnet"
              "\"velocity_verlett\" (did you mean \"velocity_verlet\"?)",
              "bad.toml:5:11: error: simulation.overrun: unknown overrun policy \"fallbehind\" "
              "(did you mean \"fall_behind\"?)",
-             "bad.toml:7:9: error: emitters.0.shape: unknown shape \"sphre\" (did you mean "
+             "bad.toml:6:13: error: simulation.nonfinite: unknown nonfinite policy \"kil\" (did "
+             "you mean \"kill\"?)",
+             "bad.toml:8:9: error: emitters.0.shape: unknown shape \"sphre\" (did you mean "
              "\"sphere\"?)",
-             "bad.toml:9:8: error: forces.0.type: unknown force type \"gravty\" (did you mean "
+             "bad.toml:10:8: error: forces.0.type: unknown force type \"gravty\" (did you mean "
              "\"gravity\"?)",
-             "bad.toml:11:8: error: forces.1.type: unknown force type \"magnet\" (expected one "
+             "bad.toml:12:8: error: forces.1.type: unknown force type \"magnet\" (expected one "
              "of: gravity, drag, wind, anchor_spring, vector_field)"}));
   // Case is not a spelling: "RK4" is one edit-free step from "rk4" but still wrong.
   EXPECT_EQ(
@@ -603,6 +606,7 @@ TEST(ioParse, MinimalFileGetsTheDocumentedDefaults) {
   EXPECT_EQ(e.simulation.maxTicksPerFrame, 16);
   EXPECT_EQ(e.simulation.overrunPolicy, OverrunPolicy::DropExcess);
   EXPECT_EQ(e.simulation.threads, 0);
+  EXPECT_EQ(e.simulation.nonfinite, NonfinitePolicy::Stop);
   ASSERT_EQ(e.emitters.size(), 1u);
   const EmitterSettings& m = e.emitters[0];
   EXPECT_EQ(m.name, "emitter_0");

@@ -144,6 +144,25 @@ void bindColumnViews(py::class_<PySystem>& system,
   }
 }
 
+void bindNonfiniteEvent(py::module_& m) {
+  py::class_<NonfiniteEvent>(
+      m, "NonfiniteEvent",
+      "The tick that left particles with a non-finite position or velocity, under "
+      "simulation.nonfinite = \"stop\" (System.nonfinite_stop). str() gives the message "
+      "`tickfx run` prints.")
+      .def_readonly(
+          "tick", &NonfiniteEvent::tick,
+          "Ticks done: the state at tick / step_rate seconds is the first non-finite one.")
+      .def_property_readonly("time", &NonfiniteEvent::seconds, "tick / step_rate, in seconds.")
+      .def_readonly("particles", &NonfiniteEvent::particles,
+                    "How many particles have a non-finite position or velocity component.")
+      .def_readonly("first_ids", &NonfiniteEvent::firstIds,
+                    "The ids of the first of them (at most 8), increasing.")
+      .def("__str__", &NonfiniteEvent::describe)
+      .def("__repr__",
+           [](const NonfiniteEvent& e) { return "<NonfiniteEvent " + e.describe() + ">"; });
+}
+
 void bindSystemClass(py::module_& m) {
   py::class_<PySystem> cls(
       m, "System",
@@ -215,6 +234,19 @@ void bindSystemClass(py::module_& m) {
             return names;
           },
           "Names of the pool's custom float attributes (see attribute()).")
+      .def_property_readonly(
+          "nonfinite_stop",
+          [](const PySystem& s) -> py::object {
+            const auto& event = s.system().nonfiniteStop();
+            return event ? py::cast(*event) : py::none();
+          },
+          "None, or the NonfiniteEvent of the tick that left particles non-finite under "
+          "simulation.nonfinite = \"stop\": advance() and step() then run no more ticks, and the "
+          "state stays the one that tick made.")
+      .def_property_readonly(
+          "nonfinite_killed", [](const PySystem& s) { return s.system().nonfiniteKilled(); },
+          "Particles removed for a non-finite position or velocity under simulation.nonfinite = "
+          "\"kill\".")
       .def(
           "state_hash", [](const PySystem& s) { return hashToHex(stateHash(s.system().pool())); },
           "The state hash after the newest tick: the 16 hex digits `tickfx run --hash` prints as "
@@ -307,6 +339,7 @@ void bindSystemClass(py::module_& m) {
 }  // namespace
 
 void bindSystem(py::module_& m) {
+  bindNonfiniteEvent(m);
   bindSystemClass(m);
 
   m.def(

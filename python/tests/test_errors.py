@@ -95,3 +95,35 @@ def test_override_values_are_checked(samples):
         tickfx.load_effect(samples / "fountain.toml", [("simulation.seed", 1)])
     with pytest.raises(TypeError):
         tickfx.load_effect(samples / "fountain.toml", {1: 2})
+
+
+# The flag under explicit Euler at 30 Hz: `tickfx run` stops at tick 19 (test_cli.cpp); here the
+# same event comes back as a value, and the system runs no further.
+UNSTABLE_FLAG = {"simulation.step_rate": 30, "simulation.integrator": "explicit_euler"}
+
+
+def test_nonfinite_stop_is_reported_as_a_value(samples):
+    system = tickfx.load_effect(samples / "flag.toml", UNSTABLE_FLAG)
+    assert system.nonfinite_stop is None
+    system.advance(1.0)
+    event = system.nonfinite_stop
+    assert isinstance(event, tickfx.NonfiniteEvent)
+    assert (event.tick, event.particles, event.first_ids) == (19, 58, list(range(10, 18)))
+    assert event.time == pytest.approx(19 / 30, rel=1e-15)
+    assert str(event) == (
+        "tick 19 (t = 0.633333333 s): 58 particles have a non-finite position or velocity "
+        "(ids 10, 11, 12, 13, 14, 15, 16, 17, ...)"
+    )
+    assert system.tick == 19
+    system.step(10)
+    system.advance(1.0)
+    assert system.tick == 19, "a stopped system runs no more ticks"
+
+
+def test_nonfinite_kill_counts_the_removed(samples):
+    system = tickfx.load_effect(
+        samples / "flag.toml", {**UNSTABLE_FLAG, "simulation.nonfinite": "kill"}
+    )
+    system.advance(10.0)
+    assert system.nonfinite_stop is None
+    assert (system.nonfinite_killed, system.count) == (150, 10)

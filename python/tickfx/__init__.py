@@ -24,13 +24,14 @@ from fractions import Fraction
 import numpy as np
 
 from . import _tickfx
-from ._tickfx import FLICKS_PER_SECOND, CacheError, System, __version__
+from ._tickfx import FLICKS_PER_SECOND, CacheError, NonfiniteEvent, System, __version__
 
 __all__ = [
     "AdvanceResult",
     "CacheError",
     "EffectError",
     "FLICKS_PER_SECOND",
+    "NonfiniteEvent",
     "System",
     "check",
     "load_effect",

@@ -1,0 +1,77 @@
+#include "particles/NonfiniteState.h"
+
+#include <bit>
+#include <cstdio>
+#include <stdexcept>
+
+namespace tickfx {
+
+namespace {
+
+// A float is ±inf or NaN exactly when its exponent bits are all ones. Integer OR-reductions are
+// associative, so the compiler vectorises this loop (a float test would need -ffast-math).
+std::uint32_t anyNonfinite(const float* x, std::size_t n) {
+  constexpr std::uint32_t kExponent = 0x7f800000u;
+  std::uint32_t any = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    any |=
+        static_cast<std::uint32_t>((std::bit_cast<std::uint32_t>(x[i]) & kExponent) == kExponent);
+  }
+  return any;
+}
+
+bool finite(float x) { return (std::bit_cast<std::uint32_t>(x) & 0x7f800000u) != 0x7f800000u; }
+
+}  // namespace
+
+const std::vector<std::string>& nonfinitePolicyNames() {
+  static const std::vector<std::string> names{"stop", "kill", "keep"};
+  return names;
+}
+
+NonfinitePolicy nonfinitePolicyNamed(std::string_view name) {
+  const std::vector<std::string>& names = nonfinitePolicyNames();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) return static_cast<NonfinitePolicy>(i);
+  }
+  throw std::invalid_argument("nonfinite policy \"" + std::string(name) +
+                              "\" is not one of stop, kill, keep");
+}
+
+std::string_view nameOf(NonfinitePolicy policy) {
+  return nonfinitePolicyNames()[static_cast<std::size_t>(policy)];
+}
+
+std::string NonfiniteEvent::describe() const {
+  char time[64];
+  std::snprintf(time, sizeof time, "%.9g", seconds());
+  std::string text = "tick " + std::to_string(tick) + " (t = " + time +
+                     " s): " + std::to_string(particles) +
+                     (particles == 1 ? " particle has" : " particles have") +
+                     " a non-finite position or velocity (" + (firstIds.size() == 1 ? "id" : "ids");
+  for (std::size_t i = 0; i < firstIds.size(); ++i) {
+    text += (i == 0 ? " " : ", ") + std::to_string(firstIds[i]);
+  }
+  return text + (particles > firstIds.size() ? ", ...)" : ")");
+}
+
+void NonfiniteCheck::scan(ParticlePool& pool, std::size_t begin, std::size_t end) {
+  const std::size_t n = end - begin;
+  std::uint32_t any = 0;
+  for (const Vec3Column* column : {&pool.position(), &pool.velocity()}) {
+    for (int c = 0; c < 3; ++c) any |= anyNonfinite((*column)[c].data() + begin, n);
+  }
+  if (any == 0) return;
+  std::uint8_t* dead = pool.dead().data();
+  for (std::size_t i = begin; i < end; ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    bool ok = true;
+    for (const Vec3Column* column : {&pool.position(), &pool.velocity()}) {
+      for (int c = 0; c < 3; ++c) ok = ok && finite((*column)[c][r]);
+    }
+    if (!ok) dead[i] = static_cast<std::uint8_t>(dead[i] | kFlag);
+  }
+  found_.store(true, std::memory_order_relaxed);
+}
+
+}  // namespace tickfx

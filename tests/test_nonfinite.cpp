@@ -1,0 +1,182 @@
+// Non-finite state: the check finds every non-finite component, and each policy does what it says
+// at the tick the arithmetic predicts, whatever the threads and the pass layout.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "CoreTestSupport.h"
+#include "fields/SpringNetwork.h"
+#include "particles/NonfiniteState.h"
+#include "particles/StateHash.h"
+
+namespace tickfx {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Row r (r = 0 … 5) gets a non-finite value in component r of (position, velocity) only: the
+// check must look at all six. Rows 6 and 7 are finite, one of them at the largest float.
+TEST(NonfiniteCheck, FlagsExactlyTheRowsWithANonFiniteComponent) {
+  ParticlePool pool(8);
+  for (int r = 0; r < 8; ++r) pool.spawn(ParticleInit{}, 0);
+  const float bad[6] = {kInf, -kInf, kNaN, -kNaN, kInf, kNaN};
+  for (int r = 0; r < 6; ++r) {
+    Vec3Column& column = r < 3 ? pool.position() : pool.velocity();
+    column[r % 3][r] = bad[r];
+  }
+  pool.position().x[6] = std::numeric_limits<float>::max();
+  pool.velocity().z[7] = -std::numeric_limits<float>::denorm_min();
+  pool.dead()[7] = 1;  // an ordinary death keeps its flag
+  NonfiniteCheck check;
+  check.scan(pool, 6, 8);
+  EXPECT_FALSE(check.found());
+  // Two calls over disjoint rows, as two threads' tiles would.
+  check.scan(pool, 0, 3);
+  check.scan(pool, 3, 6);
+  EXPECT_TRUE(check.found());
+  for (int r = 0; r < 6; ++r) EXPECT_EQ(pool.dead()[r], NonfiniteCheck::kFlag) << "row " << r;
+  EXPECT_EQ(pool.dead()[6], 0);
+  EXPECT_EQ(pool.dead()[7], 1);
+  check.clear();
+  EXPECT_FALSE(check.found());
+}
+
+TEST(NonfinitePolicy, NamesRoundTripAndOthersAreRefused) {
+  EXPECT_EQ(nonfinitePolicyNames(), (std::vector<std::string>{"stop", "kill", "keep"}));
+  for (const std::string& name : nonfinitePolicyNames()) {
+    EXPECT_EQ(nameOf(nonfinitePolicyNamed(name)), name);
+  }
+  try {
+    nonfinitePolicyNamed("explode");
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "nonfinite policy \"explode\" is not one of stop, kill, keep");
+  }
+}
+
+TEST(NonfiniteEvent, DescribesTheTickTimeCountAndIds) {
+  NonfiniteEvent e{95, 30, 24, {0, 1, 2, 3, 4, 5, 6, 7}};
+  EXPECT_EQ(e.describe(),
+            "tick 95 (t = 3.16666667 s): 24 particles have a non-finite position or velocity (ids "
+            "0, 1, 2, 3, 4, 5, 6, 7, ...)");
+  e = NonfiniteEvent{3, 60, 1, {12}};
+  EXPECT_EQ(e.describe(),
+            "tick 3 (t = 0.05 s): 1 particle has a non-finite position or velocity (id 12)");
+}
+
+// Drag k = 600/s at 60 Hz under semi-implicit Euler: v ← v + (−k·v)·dt = −9·v each tick, an
+// unstable step, so |v| = 9ⁿ·|v₀| after n ticks. The first value to overflow float (max 3.4e38)
+// is the acceleration k·|v|, once |v| > 3.4e38 / 600 = 5.7e35: it is infinite in the tick after
+// the first n with 9ⁿ·|v₀| > 5.7e35, and velocity and position with it. For |v₀| = 1 and 2 that
+// n is 38 (9³⁷ = 2.0e35, 2·9³⁷ = 4.1e35 are below; 9³⁸ = 1.8e36 is above), so tick 39; for 1e-3
+// it is 41 (1e-3·9⁴⁰ = 1.5e35, 1e-3·9⁴¹ = 1.3e36), so tick 42. The factor is rounded in float,
+// within 1e-6 of −9 over 42 ticks: far from these margins (the narrowest is 1.4×).
+struct Exploding {
+  static constexpr std::int64_t kFirstTick = 39, kLastTick = 42;
+
+  std::unique_ptr<ParticleSystem> system;
+
+  Exploding(NonfinitePolicy policy, int threads, bool split) {
+    SystemSettings s;
+    s.stepRateHz = 60;
+    s.integrator = "semi_implicit_euler";
+    s.threads = threads;
+    s.nonfinite = policy;
+    ForceSet forces;
+    forces.add(std::make_unique<LinearDrag>(600.0f));
+    // A spring network (even empty) is not local: the integrator runs each pass over all rows
+    // in turn instead of tile by tile, and the check runs as a pass of its own.
+    if (split) forces.add(std::make_unique<SpringNetwork>());
+    system = std::make_unique<ParticleSystem>(s, std::vector<EmitterSettings>{}, std::move(forces));
+    const Eigen::Vector3f velocities[] = {
+        {0.0f, 0.0f, 2.0f}, {0.0f, 1e-3f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
+    // Many quiet rows around them, so that the bad ones sit in different tiles and blocks.
+    for (int r = 0; r < 3000; ++r) {
+      ParticleInit p;
+      p.position = Eigen::Vector3f(0.001f * static_cast<float>(r), 0.0f, 0.0f);
+      if (r % 1000 == 0) p.velocity = velocities[r / 1000];
+      system->pool().spawn(p, 0);
+    }
+  }
+};
+
+bool finiteState(const ParticlePool& pool) {
+  for (const Vec3Column* c : {&pool.position(), &pool.velocity()}) {
+    for (int k = 0; k < 3; ++k) {
+      if (!(*c)[k].head(static_cast<Eigen::Index>(pool.size())).allFinite()) return false;
+    }
+  }
+  return true;
+}
+
+class NonfiniteRun : public ::testing::TestWithParam<std::tuple<int, bool>> {
+ protected:
+  Exploding make(NonfinitePolicy policy) const {
+    return Exploding(policy, std::get<0>(GetParam()), std::get<1>(GetParam()));
+  }
+};
+
+TEST_P(NonfiniteRun, StopHaltsAtTheTickTheArithmeticPredictsWithTheStateItMade) {
+  Exploding stop = make(NonfinitePolicy::Stop), keep = make(NonfinitePolicy::Keep);
+  for (std::int64_t tick = 1; tick < Exploding::kFirstTick; ++tick) {
+    stop.system->step();
+    keep.system->step();
+    ASSERT_FALSE(stop.system->nonfiniteStop()) << "tick " << tick;
+    ASSERT_TRUE(finiteState(keep.system->pool())) << "tick " << tick;
+  }
+  stop.system->step();
+  keep.system->step();
+  ASSERT_TRUE(stop.system->nonfiniteStop());
+  const NonfiniteEvent& e = *stop.system->nonfiniteStop();
+  EXPECT_EQ(e.tick, Exploding::kFirstTick);
+  EXPECT_EQ(e.stepRateHz, 60);
+  EXPECT_EQ(e.particles, 2u);
+  EXPECT_EQ(e.firstIds, (std::vector<std::uint64_t>{0, 2000}));
+  EXPECT_FALSE(finiteState(keep.system->pool()));
+  // The check reads and flags, never changes a value: the stopped state is the kept one.
+  EXPECT_EQ(stop.system->tickCount(), Exploding::kFirstTick);
+  EXPECT_EQ(stateHash(stop.system->pool()), stateHash(keep.system->pool()));
+  EXPECT_EQ(stop.system->pool().size(), 3000u) << "nobody removed";
+  // And nothing more runs, by any door.
+  stop.system->stepTicks(5);
+  stop.system->advance(kFlicksPerSecond);
+  EXPECT_EQ(stop.system->tickCount(), Exploding::kFirstTick);
+  EXPECT_EQ(stateHash(stop.system->pool()), stateHash(keep.system->pool()));
+}
+
+TEST_P(NonfiniteRun, KillRemovesEachParticleAtItsOwnTickAndCountsIt) {
+  Exploding kill = make(NonfinitePolicy::Kill);
+  kill.system->stepTicks(Exploding::kFirstTick - 1);
+  EXPECT_EQ(kill.system->pool().size(), 3000u);
+  kill.system->step();
+  EXPECT_EQ(kill.system->pool().size(), 2998u);
+  EXPECT_EQ(kill.system->nonfiniteKilled(), 2u);
+  kill.system->stepTicks(Exploding::kLastTick - Exploding::kFirstTick - 1);
+  EXPECT_EQ(kill.system->nonfiniteKilled(), 2u);
+  kill.system->step();
+  EXPECT_EQ(kill.system->nonfiniteKilled(), 3u);
+  EXPECT_EQ(kill.system->pool().size(), 2997u);
+  EXPECT_FALSE(kill.system->nonfiniteStop());
+  kill.system->stepTicks(100);
+  EXPECT_TRUE(finiteState(kill.system->pool()));
+  EXPECT_EQ(kill.system->pool().size(), 2997u) << "the quiet rows live on";
+  EXPECT_EQ(kill.system->tickCount(), Exploding::kLastTick + 100);
+}
+
+std::string layoutName(const ::testing::TestParamInfo<std::tuple<int, bool>>& info) {
+  return std::to_string(std::get<0>(info.param)) + "threads_" +
+         (std::get<1>(info.param) ? "split" : "fused");
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, NonfiniteRun,
+                         ::testing::Combine(::testing::Values(1, 3), ::testing::Bool()),
+                         layoutName);
+
+}  // namespace
+}  // namespace tickfx
