@@ -137,8 +137,10 @@ class HandWrittenLoop {
 
 // ---- tickfx side -----------------------------------------------------------------------------
 
-std::unique_ptr<tickfx::ParticleSystem> makeSystem(std::size_t n, int threads) {
+std::unique_ptr<tickfx::ParticleSystem> makeSystem(
+    std::size_t n, int threads, tickfx::NonfinitePolicy nonfinite = tickfx::NonfinitePolicy::Stop) {
   tickfx::SystemSettings settings;
+  settings.nonfinite = nonfinite;
   settings.stepRateHz = kStepRateHz;
   settings.integrator = "semi_implicit_euler";
   settings.maxParticles = n;
@@ -221,10 +223,14 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   HandWrittenLoop aos(n);
   std::unique_ptr<tickfx::ParticleSystem> one = makeSystem(n, 1);
   std::unique_ptr<tickfx::ParticleSystem> all = allThreads > 1 ? makeSystem(n, 0) : nullptr;
+  // The same system without the per-tick non-finite check: what the check costs a tick.
+  std::unique_ptr<tickfx::ParticleSystem> unchecked =
+      makeSystem(n, 1, tickfx::NonfinitePolicy::Keep);
 
   // Tick 0 from the identical initial state on every side.
   aos.tick();
   one->step();
+  unchecked->step();
   Difference d = compare(aos, one->pool());
   if (all) {
     all->step();
@@ -264,6 +270,9 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   cases.emplace_back("tickfx step(), " + threadsLabel(1), [&](std::int64_t ticks) {
     for (std::int64_t i = 0; i < ticks; ++i) one->step();
   });
+  cases.emplace_back("tickfx step(), 1 t., no check", [&](std::int64_t ticks) {
+    for (std::int64_t i = 0; i < ticks; ++i) unchecked->step();
+  });
   if (all) {
     cases.emplace_back("tickfx step(), " + threadsLabel(allThreads), [&](std::int64_t ticks) {
       for (std::int64_t i = 0; i < ticks; ++i) all->step();
@@ -283,7 +292,8 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   }
   std::fflush(stdout);
 
-  checksum += positionSum(aos) + positionSum(one->pool()) + (all ? positionSum(all->pool()) : 0.0);
+  checksum += positionSum(aos) + positionSum(one->pool()) + positionSum(unchecked->pool()) +
+              (all ? positionSum(all->pool()) : 0.0);
   return d.withinRoundOff;
 }
 

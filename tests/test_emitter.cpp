@@ -156,6 +156,16 @@ TEST(EmitterDirections, ConeSpreadStaysWithinTheHalfAngle) {
                                     s.direction.normalized()) >= cosHalf;
                        }),
               0.5, kFractionTolerance);
+  // And uniform in azimuth about the axis: every half-space whose plane holds the axis has half.
+  for (const Eigen::Vector3d& w : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, -1),
+                                   Eigen::Vector3d(1, 1, -1), Eigen::Vector3d(1, -1, 1)}) {
+    ASSERT_NEAR(w.dot(s.direction), 0.0, 1e-15);
+    EXPECT_NEAR(
+        fraction(all,
+                 [&](const ParticleInit& p) { return p.velocity.cast<double>().dot(w) > 0.0; }),
+        0.5, kFractionTolerance)
+        << w.transpose();
+  }
 }
 
 TEST(EmitterDirections, NoSpreadIsTheDirectionAndFullSpreadIsTheSphere) {

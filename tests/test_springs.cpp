@@ -242,6 +242,10 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   cluster.linkRadius = std::numeric_limits<double>::denorm_min();
   s.shape = cluster;
   EXPECT_TRUE(s.validate().empty());
+  s = StructureSettings{};
+  s.lifetime = 0.0;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].text(), "lifetime: 0 is out of range (expected seconds, a number > 0)");
   // A structure's birth time is its own to check (the system turns it into a tick).
   s = StructureSettings{};
   s.time = -1.0;
@@ -419,6 +423,31 @@ TEST(BuildStructure, ClusterJoinsThePairsBornWithinTheLinkRadius) {
   const StructureBuild tiny = buildStructure(s, kSeed, 2);
   EXPECT_EQ(tiny.particles.size(), 2000u);
   EXPECT_TRUE(tiny.springs.empty());
+}
+
+// A cluster fills its ball uniformly: by radius (a fraction (r/R)³ within r) and by direction
+// (every half-space through the centre holds half). N = 4000: 5 binomial standard deviations at
+// p = 1/2 are 0.040, at p = 1/8 0.026.
+TEST(BuildStructure, ClusterFillsItsBallUniformly) {
+  StructureSettings s;
+  const Eigen::Vector3d center(0.5, 4.0, -1.0);
+  constexpr int kN = 4000;
+  s.shape = ClusterShape{center, 0.3, kN, 1e-30};
+  const StructureBuild b = buildStructure(s, kSeed, 1);
+  ASSERT_EQ(b.particles.size(), static_cast<std::size_t>(kN));
+  const auto fraction = [&](const std::function<bool(const Eigen::Vector3d&)>& f) {
+    int count = 0;
+    for (const ParticleInit& p : b.particles) count += f(p.position.cast<double>() - center);
+    return static_cast<double>(count) / kN;
+  };
+  EXPECT_EQ(fraction([](const Eigen::Vector3d& d) { return d.norm() <= 0.3 + 1e-6; }), 1.0);
+  EXPECT_NEAR(fraction([](const Eigen::Vector3d& d) { return d.norm() <= 0.15; }), 0.125, 0.026);
+  for (const Eigen::Vector3d& w :
+       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1),
+        Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(1, -1, 0), Eigen::Vector3d(1, 1, 1)}) {
+    EXPECT_NEAR(fraction([&](const Eigen::Vector3d& d) { return d.dot(w) > 0.0; }), 0.5, 0.04)
+        << w.transpose();
+  }
 }
 
 // Pinned particles have infinite mass (inverse mass 0): each pin setting pins exactly its grid
