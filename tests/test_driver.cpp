@@ -233,6 +233,19 @@ TEST(FixedStepDriver, RestoreRefusesStatesNoRunReaches) {
   EXPECT_NO_THROW(behind.restore(4, 0, 4, 1));
 }
 
+// A frame a flick before the next tick: offset/F = 1 − 1.4e-9 rounds to 1.0f. At frame time
+// that is the float nearest the frame's time; one tick behind must stay below the newest tick.
+TEST(FixedStepDriver, AlphaAFlickBeforeATickRoundsToOneOnlyAtFrameTime) {
+  FixedStepDriver atFrame(60, 16);
+  atFrame.restore(5, 0, 4, kFlicksPerSecond - 1);
+  EXPECT_EQ(atFrame.frameOffset(), kFlicksPerSecond - 1);
+  EXPECT_EQ(atFrame.alpha(), 1.0f);
+  FixedStepDriver behind(60, 16, OverrunPolicy::DropExcess, FrameTiming::OneTickBehind);
+  behind.restore(4, 0, 4, kFlicksPerSecond - 1);
+  EXPECT_EQ(behind.frameOffset(), kFlicksPerSecond - 1);
+  EXPECT_EQ(behind.alpha(), std::nextafter(1.0f, 0.0f));
+}
+
 // A driver restored from another's four numbers is that driver: it reads them back and the next
 // frames issue the same ticks, drops and interpolation factors.
 TEST(FixedStepDriver, ARestoredDriverContinuesAsTheOneItWasSavedFrom) {

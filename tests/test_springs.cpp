@@ -242,6 +242,18 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   cluster.linkRadius = std::numeric_limits<double>::denorm_min();
   s.shape = cluster;
   EXPECT_TRUE(s.validate().empty());
+  cluster.radius = 0.0;
+  cluster.count = 1'000'001;
+  s.shape = cluster;
+  ASSERT_EQ(s.validate().size(), 2u);
+  EXPECT_EQ(s.validate()[0].text(),
+            "count: 1000001 is out of range (expected particles, an integer from 1 to 1000000)");
+  EXPECT_EQ(s.validate()[1].text(),
+            "radius: 0 is out of range (expected metres, a finite number > 0)");
+  cluster.radius = std::numeric_limits<double>::denorm_min();
+  cluster.count = 1'000'000;
+  s.shape = cluster;
+  EXPECT_TRUE(s.validate().empty());
   s = StructureSettings{};
   s.lifetime = 0.0;
   ASSERT_EQ(s.validate().size(), 1u);
