@@ -192,6 +192,14 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()), "rope " + problems[0].text());
   }
+  // The same end as start, away from the origin: no length at all.
+  rope.start = rope.end = Eigen::Vector3d(1.0, 2.0, 3.0);
+  s = StructureSettings{};
+  s.shape = rope;
+  ASSERT_EQ(s.validate().size(), 1u);
+  EXPECT_EQ(s.validate()[0].text(),
+            "end: is 0 m from start, too close to give the rope a length in double precision "
+            "(expected [x, y, z] in metres, at least 1.5e-154 m from start)");
   // Cloth axes: each must normalise, and then not be parallel.
   ClothShape cloth;
   cloth.axisU = Eigen::Vector3d(1e-200, 0.0, 0.0);
