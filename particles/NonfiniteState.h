@@ -49,9 +49,10 @@ struct NonfiniteEvent {
 };
 
 /// Finds non-finite positions and velocities inside the integrator's own pass over each tile,
-/// while the values it just wrote are in cache: a few integer operations per value, no pass of
-/// its own over the columns. Rows found get kFlag in the pool's dead flags. scan() may run on
-/// disjoint rows from several threads; what it flags does not depend on how rows are split.
+/// while the values it just wrote are in cache: a packet sum of the tile's six columns (one add
+/// per value) that is finite unless a value is not (or the sum overflows), and a per-row test only
+/// then. Rows found get kFlag in the pool's dead flags. scan() may run on disjoint rows from
+/// several threads; what it flags does not depend on how rows are split.
 class NonfiniteCheck {
  public:
   /// The bit of ParticlePool::dead() that marks a non-finite row (1 is an ordinary death).

@@ -30,7 +30,9 @@ TEST(NonfiniteCheck, FlagsExactlyTheRowsWithANonFiniteComponent) {
     Vec3Column& column = r < 3 ? pool.position() : pool.velocity();
     column[r % 3][r] = bad[r];
   }
+  // Finite values whose sum overflows: the quick test passes them on, the exact one clears them.
   pool.position().x[6] = std::numeric_limits<float>::max();
+  pool.position().y[6] = std::numeric_limits<float>::max();
   pool.velocity().z[7] = -std::numeric_limits<float>::denorm_min();
   pool.dead()[7] = 1;  // an ordinary death keeps its flag
   NonfiniteCheck check;
