@@ -200,6 +200,11 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   EXPECT_EQ(s.validate()[0].text(),
             "end: is 0 m from start, too close to give the rope a length in double precision "
             "(expected [x, y, z] in metres, at least 1.5e-154 m from start)");
+  // Exactly the shortest length: its square, 2^-1022, is the smallest normal double.
+  rope.start = Eigen::Vector3d::Zero();
+  rope.end = Eigen::Vector3d(0x1p-511, 0.0, 0.0);
+  s.shape = rope;
+  EXPECT_TRUE(s.validate().empty());
   // Cloth axes: each must normalise, and then not be parallel.
   ClothShape cloth;
   cloth.axisU = Eigen::Vector3d(1e-200, 0.0, 0.0);
