@@ -192,6 +192,15 @@ TEST(BuildStructure, ValidateNamesEachProblemByItsKeyAndBuildThrowsTheFirst) {
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()), "rope " + problems[0].text());
   }
+  // A cloth's spacing must be a finite length.
+  for (const double spacing : {0.0, -0.5, std::numeric_limits<double>::infinity()}) {
+    ClothShape bad;
+    bad.spacing = spacing;
+    StructureSettings withCloth;
+    withCloth.shape = bad;
+    ASSERT_EQ(withCloth.validate().size(), 1u) << spacing;
+    EXPECT_EQ(withCloth.validate()[0].key, "spacing");
+  }
   // The same end as start, away from the origin: no length at all.
   rope.start = rope.end = Eigen::Vector3d(1.0, 2.0, 3.0);
   s = StructureSettings{};
@@ -1177,6 +1186,32 @@ TEST(SpringLifecycle, AStructureCutShortByAFullPoolKeepsOnlyTheSpringsOfItsBornP
     EXPECT_EQ(springs[i].a, i);
     EXPECT_EQ(springs[i].b, i + 1);
   }
+}
+
+// When a particle in the middle of the rows dies, the rows after it are no longer their ids minus
+// the first id: a spring between two of them is found by search, kept, and still pulls.
+TEST(SpringLifecycle, SpringsPastADeadRowKeepTheirEnds) {
+  ForceSet forces;
+  SpringNetwork& network = addNetwork(forces);
+  ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
+  ParticlePool& pool = system.pool();
+  for (int i = 0; i < 4; ++i) {
+    ParticleInit p;
+    p.position = Eigen::Vector3f(1.5f * static_cast<float>(i), 0.0f, 0.0f);
+    p.lifetime = i == 1 ? 0.5f : std::numeric_limits<float>::infinity();
+    pool.spawn(p, 0);
+  }
+  network.add(Spring{0, 1, 1.0f, 10.0f, 0.0f, 0.0f});
+  network.add(Spring{2, 3, 1.0f, 10.0f, 0.0f, 0.0f});
+  system.stepTicks(31);  // particle 1 dies after tick 30
+  ASSERT_EQ(pool.size(), 3u);
+  ASSERT_EQ(pool.id()[1], 2u);
+  ASSERT_EQ(network.springs().size(), 1u);
+  EXPECT_EQ(network.springs()[0].a, 2u);
+  EXPECT_EQ(network.springs()[0].b, 3u);
+  // Stretched by 0.5 m at the start, the pair has moved together since, as one spring does.
+  EXPECT_LT(pool.position().x[2] - pool.position().x[1], 1.5f);
+  EXPECT_EQ(bitsOf(pool.velocity().x[1]), bitsOf(-pool.velocity().x[2]));
 }
 
 // A spring to a particle not born yet does nothing; once it is born, it pulls.
