@@ -135,6 +135,14 @@ std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t f
   return dir / name;
 }
 
+// "DIR (frame_0001 to frame_0036)": where a run's caches are, as its messages name them.
+std::string cacheRange(const std::filesystem::path& dir, std::int64_t first, std::int64_t last) {
+  char frames[64];
+  std::snprintf(frames, sizeof frames, " (frame_%04lld to frame_%04lld)",
+                static_cast<long long>(first), static_cast<long long>(last));
+  return dir.string() + frames;
+}
+
 void reportNonfiniteStop(const std::string& effectPath, const NonfiniteEvent& event,
                          const std::vector<io::Diagnostic>& lint, std::int64_t lastWritten,
                          std::int64_t firstFrame, const std::optional<std::filesystem::path>& out) {
@@ -146,9 +154,7 @@ void reportNonfiniteStop(const std::string& effectPath, const NonfiniteEvent& ev
     std::fprintf(stderr, "likely cause: %s\n", cause->format().c_str());
   }
   if (out && lastWritten >= firstFrame) {
-    std::fprintf(stderr, "caches written: %s (frame_%04lld to frame_%04lld)\n",
-                 out->string().c_str(), static_cast<long long>(firstFrame),
-                 static_cast<long long>(lastWritten));
+    std::fprintf(stderr, "caches written: %s\n", cacheRange(*out, firstFrame, lastWritten).c_str());
   }
 }
 
@@ -339,8 +345,7 @@ int runCommand(Arguments& args) {
     }
     std::printf("wall time: %.3f s\n", wall);
     if (!formats.empty() && lastFrame >= firstFrame) {
-      std::printf("caches: %s (frame_%04lld to frame_%04lld)\n", outDir.string().c_str(),
-                  static_cast<long long>(firstFrame), static_cast<long long>(lastFrame));
+      std::printf("caches: %s\n", cacheRange(outDir, firstFrame, lastFrame).c_str());
     }
     if (dump) std::printf("state dump: %s\n", dump->c_str());
   }

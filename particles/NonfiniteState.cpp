@@ -1,16 +1,10 @@
 #include "particles/NonfiniteState.h"
 
-#include <bit>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
 namespace tickfx {
-
-namespace {
-
-bool finite(float x) { return (std::bit_cast<std::uint32_t>(x) & 0x7f800000u) != 0x7f800000u; }
-
-}  // namespace
 
 const std::vector<std::string>& nonfinitePolicyNames() {
   static const std::vector<std::string> names{"stop", "kill", "keep"};
@@ -58,13 +52,13 @@ void NonfiniteCheck::scan(ParticlePool& pool, std::size_t begin, std::size_t end
                      (p.z.segment(first, n) + v.x.segment(first, n)) +
                      (v.y.segment(first, n) + v.z.segment(first, n)))
                         .sum();
-  if (finite(sum)) return;
+  if (std::isfinite(sum)) return;
   std::uint8_t* dead = pool.dead().data();
   for (std::size_t i = begin; i < end; ++i) {
     const auto r = static_cast<Eigen::Index>(i);
     bool ok = true;
     for (const Vec3Column* column : {&pool.position(), &pool.velocity()}) {
-      for (int c = 0; c < 3; ++c) ok = ok && finite((*column)[c][r]);
+      for (int c = 0; c < 3; ++c) ok = ok && std::isfinite((*column)[c][r]);
     }
     if (!ok) {
       dead[i] = static_cast<std::uint8_t>(dead[i] | kFlag);

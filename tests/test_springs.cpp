@@ -1126,6 +1126,17 @@ TEST_P(EveryScheme, AClothPinnedAtTwoCornersComesToRest) {
 
 // ---- deaths, late births, breaks ---------------------------------------------------------------
 
+// `count` particles at tick 0, particle i at i·step, all immortal but particle `dies`, which lives
+// 0.5 s.
+void spawnInARow(ParticlePool& pool, int count, const Eigen::Vector3f& step, int dies) {
+  for (int i = 0; i < count; ++i) {
+    ParticleInit p;
+    p.position = static_cast<float>(i) * step;
+    p.lifetime = i == dies ? 0.5f : std::numeric_limits<float>::infinity();
+    pool.spawn(p, 0);
+  }
+}
+
 // Three particles in a row, springs 0–1 and 1–2, both stretched; particle 0 lives 0.5 s (30 ticks).
 // Its spring is gone from the tick after it died, and from then on nothing pulls on the survivors
 // from outside: their momentum (equal masses: v1 + v2) stays put, where before it did not.
@@ -1134,12 +1145,7 @@ TEST(SpringLifecycle, SpringsWhoseEndDiesAreRemoved) {
   SpringNetwork& network = addNetwork(forces);
   ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
   ParticlePool& pool = system.pool();
-  for (int i = 0; i < 3; ++i) {
-    ParticleInit p;
-    p.position = Eigen::Vector3f(1.1f * static_cast<float>(i), 0.1f * static_cast<float>(i), 0.0f);
-    p.lifetime = i == 0 ? 0.5f : std::numeric_limits<float>::infinity();
-    pool.spawn(p, 0);
-  }
+  spawnInARow(pool, 3, Eigen::Vector3f(1.1f, 0.1f, 0.0f), 0);
   network.add(Spring{0, 1, 1.0f, 10.0f, 0.1f, 0.0f});
   network.add(Spring{1, 2, 1.0f, 10.0f, 0.1f, 0.0f});
   auto momentum = [&] {
@@ -1195,12 +1201,7 @@ TEST(SpringLifecycle, SpringsPastADeadRowKeepTheirEnds) {
   SpringNetwork& network = addNetwork(forces);
   ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
   ParticlePool& pool = system.pool();
-  for (int i = 0; i < 4; ++i) {
-    ParticleInit p;
-    p.position = Eigen::Vector3f(1.5f * static_cast<float>(i), 0.0f, 0.0f);
-    p.lifetime = i == 1 ? 0.5f : std::numeric_limits<float>::infinity();
-    pool.spawn(p, 0);
-  }
+  spawnInARow(pool, 4, Eigen::Vector3f(1.5f, 0.0f, 0.0f), 1);
   network.add(Spring{0, 1, 1.0f, 10.0f, 0.0f, 0.0f});
   network.add(Spring{2, 3, 1.0f, 10.0f, 0.0f, 0.0f});
   system.stepTicks(31);  // particle 1 dies after tick 30
