@@ -20,7 +20,7 @@
 namespace tickfx::app {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kBakeFieldHelp =
     "usage: tickfx bake-field KIND --out FILE.vdb [--voxel-size V] [--bounds x0,y0,z0,x1,y1,z1]\n"
     "                         [--grid NAME] [KIND's options] [--frames A..B --fps F]\n"
     "\n"
@@ -157,7 +157,7 @@ std::string numberText(double v) {
 
 int bakeFieldCommand(Arguments& args) {
   if (args.flag("--help")) {
-    std::fputs(kHelp, stdout);
+    std::fputs(kBakeFieldHelp, stdout);
     return kExitOk;
   }
   const auto out = args.value("--out");

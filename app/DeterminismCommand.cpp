@@ -19,7 +19,7 @@
 namespace tickfx::app {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kDeterminismHelp =
     "usage: tickfx determinism EFFECT.toml [--seconds S] [--threads LIST] [--frame-times FILE]\n"
     "                          [--set key.path=value]...\n"
     "\n"
@@ -245,7 +245,7 @@ std::string hashAt(const DriveTrace& t, std::int64_t tick) {
 
 int determinismCommand(Arguments& args) {
   if (args.flag("--help")) {
-    std::fputs(kHelp, stdout);
+    std::fputs(kDeterminismHelp, stdout);
     return kExitOk;
   }
   const std::vector<std::string> overrides = args.values("--set");

@@ -28,7 +28,7 @@
 namespace tickfx::app {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kRunHelp =
     "usage: tickfx run EFFECT.toml [options]\n"
     "\n"
     "Simulates EFFECT.toml and writes one interpolated cache per frame (frame_0001.csv, ...).\n"
@@ -168,7 +168,7 @@ std::filesystem::path checkpointPath(const std::filesystem::path& dir, std::int6
 
 int runCommand(Arguments& args) {
   if (args.flag("--help")) {
-    std::fputs(kHelp, stdout);
+    std::fputs(kRunHelp, stdout);
     return kExitOk;
   }
   const std::vector<std::string> overrides = args.values("--set");

@@ -18,7 +18,7 @@
 namespace tickfx::io {
 namespace {
 
-constexpr std::string_view kMagic = "TICKFXCK";
+constexpr std::string_view kCheckpointMagic = "TICKFXCK";
 constexpr std::size_t kHeaderBytes = 32;  // magic, version, flags, length, effect hash
 constexpr std::size_t kTrailerBytes = 8;  // checksum
 constexpr std::size_t kMinimumBytes = kHeaderBytes + kTrailerBytes;
@@ -113,9 +113,9 @@ struct Malformed {
   std::string what;
 };
 
-class Reader {
+class CheckpointReader {
  public:
-  explicit Reader(std::string_view bytes) : bytes_(bytes) {}
+  explicit CheckpointReader(std::string_view bytes) : bytes_(bytes) {}
 
   std::uint32_t u32(const char* what) { return loadU32(take(4, what)); }
   std::uint64_t u64(const char* what) { return loadU64(take(8, what)); }
@@ -170,7 +170,7 @@ struct Parsed {
 };
 
 Parsed parsePayload(std::string_view payload) {
-  Reader r(payload);
+  CheckpointReader r(payload);
   Parsed p;
   p.stepRateHz = r.i64("the step rate");
   p.integrator = r.str("the integrator name");
@@ -352,7 +352,7 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   const FixedStepDriver& driver = system.driver();
   const std::size_t n = pool.size();
   Writer w;
-  w.bytes().append(kMagic);
+  w.bytes().append(kCheckpointMagic);
   w.u32(kCheckpointVersion);
   w.u32(0);  // flags: none defined in version 1
   w.u64(0);  // the file length, patched below
@@ -423,7 +423,8 @@ CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem&
 
   // A prefix of the magic (an empty file included) is what an interrupted copy leaves: call it
   // truncated; anything else is some other file.
-  if (bytes.compare(0, kMagic.size(), kMagic, 0, std::min(found, kMagic.size())) != 0) {
+  if (bytes.compare(0, kCheckpointMagic.size(), kCheckpointMagic, 0,
+                    std::min(found, kCheckpointMagic.size())) != 0) {
     fail(path, "not a tickfx checkpoint (it does not start with TICKFXCK)");
   }
   if (found < kFlagsOffset) truncated("at least " + std::to_string(kMinimumBytes));

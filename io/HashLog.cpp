@@ -13,7 +13,7 @@
 namespace tickfx::io {
 namespace {
 
-constexpr const char* kMagic = "tickfx hash log 1";
+constexpr const char* kHashLogMagic = "tickfx hash log 1";
 
 std::string hex16(std::uint64_t v) {
   char text[17];
@@ -35,9 +35,9 @@ std::vector<std::string> split(const std::string& line) {
   return fields;
 }
 
-class Reader {
+class HashLogReader {
  public:
-  explicit Reader(const std::filesystem::path& path) : path_(path), in_(path) {
+  explicit HashLogReader(const std::filesystem::path& path) : path_(path), in_(path) {
     if (!in_) throw std::runtime_error(path_.string() + ": error: cannot read the hash log");
   }
 
@@ -97,7 +97,7 @@ class Reader {
 void writeHashLog(const std::filesystem::path& path, const HashLog& log) {
   const HashLogHeader& h = log.header;
   writeFileAtomically(path, [&](std::ostream& os) {
-    os << kMagic << '\n';
+    os << kHashLogMagic << '\n';
     os << "machine: " << oneLine(h.machine) << '\n';
     os << "cpu: " << oneLine(h.cpu) << '\n';
     os << "compiler: " << oneLine(h.compiler) << '\n';
@@ -150,12 +150,12 @@ void writeHashLog(const std::filesystem::path& path, const HashLog& log) {
 }
 
 HashLog readHashLog(const std::filesystem::path& path) {
-  Reader r(path);
+  HashLogReader r(path);
   HashLog log;
   HashLogHeader& h = log.header;
-  if (!r.next()) r.failAt(1, "the file is empty (expected '" + std::string(kMagic) + "')");
-  if (r.line() != kMagic) {
-    r.fail("not a tickfx hash log: '" + r.line() + "' (expected '" + kMagic + "')");
+  if (!r.next()) r.failAt(1, "the file is empty (expected '" + std::string(kHashLogMagic) + "')");
+  if (r.line() != kHashLogMagic) {
+    r.fail("not a tickfx hash log: '" + r.line() + "' (expected '" + kHashLogMagic + "')");
   }
   h.machine = r.header("machine");
   h.cpu = r.header("cpu");

@@ -12,8 +12,6 @@ namespace {
 
 using Big = boost::multiprecision::cpp_int;
 
-constexpr std::int64_t kMicros = 1'000'000;
-
 // `seconds` as the shortest decimal that reads back as it: numerator / 10^scale, exactly.
 struct Decimal {
   Big numerator;
@@ -60,7 +58,7 @@ EmissionRate::EmissionRate(std::int64_t rateMicros, double start, double stop,
     throw std::invalid_argument("emission rate settings out of range");
   }
   const Decimal s = decimalOf(start);
-  const Big h(stepRateHz), r(rateMicros), perTick = Big(stepRateHz) * kMicros;
+  const Big h(stepRateHz), r(rateMicros), perTick = Big(stepRateHz) * kMicrosPerSecond;
   // The first tick whose end is after start: k + 1 > start·H.
   firstTick_ = static_cast<std::int64_t>(floorDiv(s.numerator * h, pow10(s.scale)));
   // P(start) = R·start / 10⁶ particles; with Y = R·start·H (so P = Y / (10⁶·H)), a tick's count is
@@ -79,14 +77,14 @@ EmissionRate::EmissionRate(std::int64_t rateMicros, double start, double stop,
   // ⌊R·(stop − start) / 10⁶⌋ over the common denominator 10^max(scale).
   const int scale = std::max(s.scale, t.scale);
   const Big span = t.numerator * pow10(scale - t.scale) - s.numerator * pow10(scale - s.scale);
-  total_ = static_cast<std::uint64_t>(floorDiv(r * span, pow10(scale) * kMicros));
+  total_ = static_cast<std::uint64_t>(floorDiv(r * span, pow10(scale) * kMicrosPerSecond));
 }
 
 std::uint64_t EmissionRate::madeThrough(std::int64_t tick) const {
   if (rateMicros_ == 0 || tick < firstTick_) return 0;
   if (tick >= lastTick_) return total_;
   const __int128 units = static_cast<__int128>(tick + 1) * rateMicros_;
-  const __int128 perTick = static_cast<__int128>(stepRate_) * kMicros;
+  const __int128 perTick = static_cast<__int128>(stepRate_) * kMicrosPerSecond;
   return static_cast<std::uint64_t>(units / perTick - startWhole_ -
                                     (units % perTick < startThreshold_ ? 1 : 0));
 }

@@ -15,6 +15,9 @@ namespace tickfx {
 /// as a whole number of 10⁻⁶ particle/s; everything after that is exact rational arithmetic.
 class EmissionRate {
  public:
+  /// Rate units (particles per 10⁶ s) in one particle per second.
+  static constexpr std::int64_t kMicrosPerSecond = 1'000'000;
+
   /// `rateMicros` particles per 10⁶ s (>= 0), `start` >= 0, `stop` >= start (+∞ for never),
   /// both in seconds and at most 1e9 (or +∞ for stop); `stepRateHz` > 0.
   EmissionRate(std::int64_t rateMicros, double start, double stop, std::int64_t stepRateHz);

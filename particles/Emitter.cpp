@@ -11,8 +11,6 @@
 namespace tickfx {
 namespace {
 
-constexpr std::int64_t kMicros = 1'000'000;
-
 // Two unit vectors completing `n` (unit) to a right-handed orthonormal basis, without a branch
 // on a threshold that a tiny change of n could flip (Duff et al. 2017).
 void basis(const Eigen::Vector3d& n, Eigen::Vector3d& b1, Eigen::Vector3d& b2) {
@@ -99,8 +97,8 @@ Emitter::Emitter(EmitterSettings settings, std::uint32_t index, std::int64_t ste
   // Both normalise in double: validate() made sure they can.
   s_.direction.normalize();
   if (auto* disc = std::get_if<DiscShape>(&s_.shape)) disc->normal.normalize();
-  rate_ = EmissionRate(std::llround(s_.rate * static_cast<double>(kMicros)), s_.start, s_.stop,
-                       stepRate_);
+  rate_ = EmissionRate(std::llround(s_.rate * static_cast<double>(EmissionRate::kMicrosPerSecond)),
+                       s_.start, s_.stop, stepRate_);
   for (const Burst& b : s_.bursts)
     burstTicks_.emplace_back(exact::tickAtOrAfter(b.time, stepRate_), b.count);
   std::stable_sort(burstTicks_.begin(), burstTicks_.end(),
