@@ -13,22 +13,54 @@ TICKFX_PACKAGES=(
   python3-dev pybind11-dev python3-numpy python3-pytest
 )
 
-# Installs the packages that are missing. As root it runs apt-get itself (with one update first,
-# since a fresh machine has no package lists); otherwise it prints the one command to run.
+# What scripts/test's aarch64 stage adds: Debian's cross compiler, qemu-user, and the arm64 builds
+# of the libraries (Multi-Arch: same, installed beside the amd64 ones). OpenVDB comes as its
+# runtime package only: its -dev package is not Multi-Arch (cmake/toolchains/aarch64-linux-gnu.cmake
+# says how the cross build does without it).
+# shellcheck disable=SC2034 # scripts/test installs them with the rest
+TICKFX_AARCH64_PACKAGES=(
+  g++-aarch64-linux-gnu qemu-user
+  libtbb-dev:arm64 libtomlplusplus-dev:arm64 libblosc-dev:arm64 libimath-dev:arm64
+  libboost-iostreams-dev:arm64 zlib1g-dev:arm64 libopenvdb10.0:arm64
+)
+
+# The architectures named by PKG:ARCH arguments that dpkg does not know yet, one a line.
+new_architectures() {
+  local known p
+  known=" $(dpkg --print-architecture) $(dpkg --print-foreign-architectures | tr '\n' ' ') "
+  for p in "$@"; do
+    if [[ $p == *:* && $known != *" ${p##*:} "* ]]; then
+      echo "${p##*:}"
+    fi
+  done | sort -u
+}
+
+# ensure_packages [PACKAGE...]: installs those of the packages (default TICKFX_PACKAGES) that are
+# missing. As root it runs apt-get itself, first adding the foreign architectures that PKG:ARCH
+# names need and updating the package lists (a fresh machine has none, nor those of an
+# architecture it has just been given); otherwise it prints the commands to run.
 ensure_packages() {
-  local missing=() p
-  for p in "${TICKFX_PACKAGES[@]}"; do
+  local wanted=("$@") missing=() p arch archs
+  [ $# -eq 0 ] && wanted=("${TICKFX_PACKAGES[@]}")
+  for p in "${wanted[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
       missing+=("$p")
     fi
   done
   [ ${#missing[@]} -eq 0 ] && return 0
+  archs=$(new_architectures "${missing[@]}")
   echo "tickfx: installing Debian packages: ${missing[*]}"
   if [ "$(id -u)" -ne 0 ]; then
     echo "tickfx: not root; run this, then try again:" >&2
+    for arch in $archs; do
+      echo "  sudo dpkg --add-architecture $arch" >&2
+    done
     echo "  sudo apt-get update && sudo apt-get install -y ${missing[*]}" >&2
     exit 1
   fi
+  for arch in $archs; do
+    dpkg --add-architecture "$arch"
+  done
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -15,6 +15,7 @@ foreach(var SOURCE_DIR WORK_DIR GENERATOR MAIN_TICKFX MAIN_NAME GOLDEN_FILE GOLD
     message(FATAL_ERROR "BuildVariants.cmake: -D${var}=... is required")
   endif()
 endforeach()
+include(${CMAKE_CURRENT_LIST_DIR}/GoldenRuns.cmake)
 
 # clang is one of the project's required Debian packages (scripts/common.sh): a machine without it
 # is misconfigured, and skipping would hide exactly the difference this test exists to find.
@@ -104,101 +105,8 @@ foreach(v ${variants})
   endif()
 endforeach()
 
-set(runs ${MAIN_NAME} ${variants})
 set(${MAIN_NAME}_tickfx ${MAIN_TICKFX})
-
-# Each list names effects in its own folder: the samples', and the golden effects' beside their
-# list. Effects are kept as paths relative to SOURCE_DIR, where the runs start.
-get_filename_component(effects_dir ${GOLDEN_EFFECTS_FILE} DIRECTORY)
-file(RELATIVE_PATH effects_folder ${SOURCE_DIR} ${effects_dir})
-set(effects "")
-foreach(list_and_folder "${GOLDEN_FILE}|samples" "${GOLDEN_EFFECTS_FILE}|${effects_folder}")
-  string(REPLACE "|" ";" list_and_folder "${list_and_folder}")
-  list(GET list_and_folder 0 list_file)
-  list(GET list_and_folder 1 folder)
-  file(STRINGS ${list_file} lines)
-  set(listed 0)
-  foreach(line ${lines})
-    if(line MATCHES "^([^# \t]+)[ \t]+([0-9a-f]+)[ \t]*$")
-      list(APPEND effects ${folder}/${CMAKE_MATCH_1})
-      set(golden_${folder}/${CMAKE_MATCH_1} ${CMAKE_MATCH_2})
-      math(EXPR listed "${listed} + 1")
-    endif()
-  endforeach()
-  if(listed EQUAL 0)
-    message(FATAL_ERROR "determinism.compilers: no hashes in ${list_file}")
-  endif()
-endforeach()
-
-# Left-aligns `text` in `width` columns, appended to the variable `out`.
-function(append_cell out text width)
-  string(LENGTH "${text}" n)
-  set(spaces "")
-  if(n LESS width)
-    math(EXPR pad "${width} - ${n}")
-    string(REPEAT " " ${pad} spaces)
-  endif()
-  set(${out} "${${out}}${text}${spaces}  " PARENT_SCOPE)
-endfunction()
-
-# The hash `tickfx` gives for `effect` (a path relative to SOURCE_DIR), or a word saying why there
-# is none. 60 fps frames take the driver's path, as a user's run does, where the golden test takes
-# stepTicks. The run must have run exactly 2 s of ticks (`run` never drops one): any other count is
-# a failure of its own.
-function(hash_of out tickfx effect)
-  if(NOT tickfx)
-    set(${out} "no-build" PARENT_SCOPE)
-    return()
-  endif()
-  execute_process(
-    COMMAND ${tickfx} run ${effect} --seconds 2 --fps 60 --format none --hash
-    WORKING_DIRECTORY ${SOURCE_DIR}
-    RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE stderr)
-  set(hash "")
-  if(stdout MATCHES "state-hash: ([0-9a-f]+)")
-    set(hash ${CMAKE_MATCH_1})
-  endif()
-  if(NOT rc EQUAL 0 OR NOT hash)
-    message("${tickfx} run ${effect} failed (${rc}):\n${stdout}\n${stderr}")
-    set(${out} "run-failed" PARENT_SCOPE)
-  elseif(NOT stdout MATCHES "\\(([0-9]+) ticks at ([0-9]+) Hz")
-    message("${tickfx} run ${effect}: no tick count in the summary:\n${stdout}")
-    set(${out} "no-tick-count" PARENT_SCOPE)
-  else()
-    set(ran ${CMAKE_MATCH_1})
-    math(EXPR twoSeconds "2 * ${CMAKE_MATCH_2}")
-    if(NOT ran EQUAL twoSeconds)
-      message("${tickfx} run ${effect}: ran ${ran} ticks, not 2 s:\n${stdout}")
-      set(${out} "wrong-ticks" PARENT_SCOPE)
-    else()
-      set(${out} ${hash} PARENT_SCOPE)
-    endif()
-  endif()
-endfunction()
-
-set(table "")
-append_cell(table "effect" 52)
-append_cell(table "golden" 16)
-foreach(r ${runs})
-  append_cell(table "${r}" 17)
-endforeach()
-string(APPEND table "\n")
-foreach(e ${effects})
-  append_cell(table "${e}" 52)
-  append_cell(table "${golden_${e}}" 16)
-  foreach(r ${runs})
-    hash_of(cell "${${r}_tickfx}" ${e})
-    if(NOT cell STREQUAL "${golden_${e}}")
-      string(APPEND cell "*")
-      math(EXPR failures "${failures} + 1")
-    endif()
-    append_cell(table "${cell}" 17)
-  endforeach()
-  string(APPEND table "\n")
-endforeach()
-
-message("state hashes of `tickfx run <effect> --seconds 2 --fps 60 --format none --hash` "
-        "(* not the golden hash):\n${table}")
+golden_check(failures ${MAIN_NAME} ${variants})
 if(failures GREATER 0)
   message(FATAL_ERROR "determinism.compilers: ${failures} build(s) or run(s) did not give the "
                       "golden hash of ${GOLDEN_FILE} or ${GOLDEN_EFFECTS_FILE}. The promise is "
