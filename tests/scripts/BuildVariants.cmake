@@ -1,6 +1,6 @@
 # cmake -P script behind the determinism.compilers test.
 #
-# Builds only the tickfx CLI in four more variants (clang++ Release, g++ at -O0, and clang++ and g++
+# Builds only the tickfx CLI, as unity builds, in four more variants (clang++ Release, g++ at -O0, and clang++ and g++
 # at -O3 -march=native, as a host that builds tickfx for its own CPU would), runs every sample of
 # GOLDEN_FILE and every golden effect of GOLDEN_EFFECTS_FILE through each of them and through the
 # main build's MAIN_TICKFX, and fails with a table unless every state hash is the golden one.
@@ -87,10 +87,15 @@ foreach(v ${variants})
     set(flags_option "-DCMAKE_CXX_FLAGS_${type_upper}=${${v}_flags}")
     set(label "${label} ${${v}_flags}")
   endif()
+  # Unity builds: each library compiles as a few large translation units, so the headers (Eigen,
+  # OpenVDB, the standard library) are parsed a few times instead of 71, and a variant costs half
+  # the CPU time (g++ -O0: 87 s against 205 s; clang++ -O3 -march=native: 115 s against 213 s).
+  # It is another legitimate build of the same sources, with more inlining across files, not
+  # less: the rules have to hold for it as for any other.
   run_step("configuring ${v}" ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${dir} -G ${GENERATOR}
       -DCMAKE_CXX_COMPILER=${${v}_compiler} -DCMAKE_BUILD_TYPE=${${v}_type} ${flags_option}
       -DTICKFX_BUILD_TESTS=OFF -DTICKFX_BUILD_BENCH=OFF -DTICKFX_BUILD_SAMPLES=OFF
-      -DTICKFX_BUILD_CLI=ON -DTICKFX_WERROR=OFF -DTICKFX_SANITIZE=OFF)
+      -DTICKFX_BUILD_CLI=ON -DTICKFX_WERROR=OFF -DTICKFX_SANITIZE=OFF -DCMAKE_UNITY_BUILD=ON)
   if(step_ok)
     run_step("building ${v} (${label})"
              ${CMAKE_COMMAND} --build ${dir} --target tickfx_cli -j ${jobs})
