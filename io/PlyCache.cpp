@@ -1,10 +1,14 @@
 #include "io/PlyCache.h"
 
 #include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "io/AtomicFile.h"
 
@@ -95,16 +99,34 @@ FrameData readPlyCache(const std::filesystem::path& path) {
   for (std::size_t k = 0; k < 9; ++k) {
     if (floats[k] != kFixedFloats[k]) fail("unexpected property order at '" + floats[k] + "'");
   }
+  // The body's size is known from the header: checked against the file before any row is
+  // allocated, so a damaged count is a message, not an allocation of its size.
+  const std::size_t rowBytes = sizeof(double) + floats.size() * sizeof(float);
+  const std::streamoff bodyStart = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff fileEnd = in.tellg();
+  in.seekg(bodyStart);
+  const auto bodyBytes = static_cast<std::uint64_t>(fileEnd - bodyStart);
+  if (count > bodyBytes / rowBytes) {
+    fail("truncated body (" + std::to_string(count) + " vertices of " + std::to_string(rowBytes) +
+         " bytes, " + std::to_string(bodyBytes) + " bytes after the header)");
+  }
   frame.resize(count, std::vector<std::string>(floats.begin() + 9, floats.end()));
   std::vector<FloatColumn*> cols = {&frame.position.x, &frame.position.y, &frame.position.z,
                                     &frame.velocity.x, &frame.velocity.y, &frame.velocity.z,
                                     &frame.age,        &frame.life,       &frame.mass};
   for (FloatColumn& a : frame.attributes) cols.push_back(&a);
-  std::vector<char> row(sizeof(double) + cols.size() * sizeof(float));
+  std::vector<char> row(rowBytes);
   for (std::size_t i = 0; i < count; ++i) {
     if (!in.read(row.data(), static_cast<std::streamsize>(row.size()))) fail("truncated body");
     double id = 0;
     std::memcpy(&id, row.data(), sizeof id);
+    // Ids are written as doubles (exact below 2⁵³); anything else is not an id.
+    if (!(id >= 0.0 && id < 0x1p64 && id == std::floor(id))) {
+      char text[40];
+      std::snprintf(text, sizeof text, "%.17g", id);
+      fail("vertex " + std::to_string(i) + ": id " + text + " is not a whole number in [0, 2^64)");
+    }
     frame.id[i] = static_cast<std::uint64_t>(id);
     for (std::size_t c = 0; c < cols.size(); ++c) {
       std::memcpy(&(*cols[c])[static_cast<Eigen::Index>(i)],

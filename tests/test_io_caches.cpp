@@ -2,12 +2,15 @@
 // loudly with their name and place.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <memory>
 #include <numeric>
+#include <string>
+#include <utility>
 
 #include "fields/Gravity.h"
 #include "io/CsvCache.h"
@@ -119,13 +122,20 @@ TEST_F(Caches, PlyRoundTripIsBitExactWithHeaderAndMetadata) {
 }
 
 TEST_F(Caches, TruncatedOrForeignFilesAreRefusedByName) {
-  writePlyCache(sampleFrame(), dir_ / "f.ply");
+  const FrameData frame = sampleFrame();
+  writePlyCache(frame, dir_ / "f.ply");
   fs::resize_file(dir_ / "f.ply", fs::file_size(dir_ / "f.ply") - 7);
+  // Rows of an 8-byte id and 10 floats (9 columns and "heat"); the count is checked against the
+  // file's size before any row is allocated.
+  const std::size_t rows = frame.size();
   try {
     readPlyCache(dir_ / "f.ply");
     FAIL() << "a truncated PLY was read";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), (dir_ / "f.ply").string() + ": truncated body");
+    EXPECT_EQ(std::string(e.what()), (dir_ / "f.ply").string() + ": truncated body (" +
+                                         std::to_string(rows) + " vertices of 48 bytes, " +
+                                         std::to_string(rows * 48 - 7) +
+                                         " bytes after the header)");
   }
   std::ofstream(dir_ / "bad.csv")
       << "id,px,py,pz,vx,vy,vz,age,life,mass\n0,1,2,3,4,5,6,7,8,9\n1,1,2,x,4,5,6,7,8,9\n";
@@ -135,6 +145,40 @@ TEST_F(Caches, TruncatedOrForeignFilesAreRefusedByName) {
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), (dir_ / "bad.csv").string() + ":3: bad number 'x'");
   }
+}
+
+// Found by fuzz_ply: an id that is not a whole number in [0, 2⁶⁴) was converted to uint64_t
+// (undefined behaviour); a vertex count far past the file's end was allocated before the body was
+// read.
+TEST_F(Caches, PlyIdsThatAreNoIdAndCountsPastTheFileAreRefused) {
+  const FrameData frame = sampleFrame();
+  writePlyCache(frame, dir_ / "f.ply");
+  std::ifstream in(dir_ / "f.ply", std::ios::binary);
+  const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t body = good.find("end_header\n") + 11;
+  const fs::path bad = dir_ / "bad.ply";
+  auto refusal = [&](const std::string& bytes) -> std::string {
+    std::ofstream(bad, std::ios::binary) << bytes;
+    try {
+      readPlyCache(bad);
+      return "accepted";
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+  };
+  const std::pair<double, const char*> notIds[] = {
+      {-1.0, "-1"}, {0.5, "0.5"}, {0x1p64, "1.8446744073709552e+19"}, {std::nan(""), "nan"}};
+  for (const auto& [id, text] : notIds) {
+    std::string bytes = good;
+    std::memcpy(bytes.data() + body + 48, &id, sizeof id);  // the second vertex
+    EXPECT_EQ(refusal(bytes),
+              bad.string() + ": vertex 1: id " + text + " is not a whole number in [0, 2^64)");
+  }
+  std::string huge = good;
+  const std::string count = "element vertex " + std::to_string(frame.size());
+  huge.replace(huge.find(count), count.size(), "element vertex 1000000000000");
+  EXPECT_EQ(refusal(huge), bad.string() + ": truncated body (1000000000000 vertices of 48 bytes, " +
+                               std::to_string(frame.size() * 48) + " bytes after the header)");
 }
 
 TEST_F(Caches, AFailedWriteLeavesTheOldFileAndNoTemporary) {
