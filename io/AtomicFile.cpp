@@ -1,50 +1,124 @@
 #include "io/AtomicFile.h"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <stdexcept>
+#include <streambuf>
 #include <string>
 #include <system_error>
 
 namespace tickfx::io {
+namespace {
 
-void writeFileAtomically(const std::filesystem::path& path,
-                         const std::function<void(std::ostream&)>& write) {
-  writeFileAtomicallyByName(path, [&](const std::filesystem::path& temp) {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot create " + temp.string());
-    write(out);
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write " + temp.string());
-  });
+// std::ofstream reports a failed write as a bit, without its cause: this buffer writes to a file
+// descriptor itself and keeps the first errno, so the message can say "No space left on device".
+class CheckedFileBuffer final : public std::streambuf {
+ public:
+  explicit CheckedFileBuffer(int fd) : fd_(fd) { resetPut(); }
+  int error() const { return error_; }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (drain() != 0) return traits_type::eof();
+    if (!traits_type::eq_int_type(c, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(c);
+      pbump(1);
+    }
+    return traits_type::not_eof(c);
+  }
+  int sync() override { return drain(); }
+
+ private:
+  int drain() {
+    if (error_ != 0) return -1;
+    for (const char* p = pbase(); p < pptr();) {
+      const ssize_t n = ::write(fd_, p, static_cast<std::size_t>(pptr() - p));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        error_ = n < 0 ? errno : EIO;
+        return -1;
+      }
+      p += n;
+    }
+    resetPut();
+    return 0;
+  }
+  void resetPut() { setp(buffer_.data(), buffer_.data() + buffer_.size()); }
+
+  int fd_;
+  int error_ = 0;
+  std::array<char, 1 << 16> buffer_;
+};
+
+// The directory entry of a rename reaches the disk with an fsync of the directory itself.
+void syncDirectory(const std::filesystem::path& path) {
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) throw WriteError(path, std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  // Some filesystems cannot sync a directory (EINVAL): the rename is then as durable as they go.
+  if (rc != 0 && error != EINVAL) throw WriteError(path, std::strerror(error));
 }
 
-void writeFileAtomicallyByName(const std::filesystem::path& path,
-                               const std::function<void(const std::filesystem::path&)>& write) {
+void writeTemporary(const std::filesystem::path& path, const std::filesystem::path& temp,
+                    const std::function<void(std::ostream&)>& write, Durability durability) {
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw WriteError(path, std::strerror(errno));
+  CheckedFileBuffer buffer(fd);
+  std::ostream out(&buffer);
+  int error = 0;
+  try {
+    write(out);
+    out.flush();
+    error = buffer.error();
+    if (error == 0 && !out) error = EIO;
+    if (error == 0 && durability == Durability::Synced && ::fsync(fd) != 0) error = errno;
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  // close() can report what the kernel could not write back (NFS, some full filesystems).
+  if (::close(fd) != 0 && error == 0) error = errno;
+  if (error != 0) throw WriteError(path, std::strerror(error));
+}
+
+}  // namespace
+
+WriteError::WriteError(const std::filesystem::path& path, const std::string& reason)
+    : std::runtime_error(path.string() + ": error: cannot write (" + reason + ")"),
+      path_(path),
+      reason_(reason) {}
+
+void writeFileAtomically(const std::filesystem::path& path,
+                         const std::function<void(std::ostream&)>& write, Durability durability) {
   // The pid keeps two processes writing the same cache folder from sharing a temporary, and the
   // call count two threads of one process writing the same path.
   static std::atomic<std::uint64_t> calls{0};
   std::filesystem::path temp = path;
   temp += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(calls.fetch_add(1));
   try {
-    write(temp);
-    std::filesystem::rename(temp, path);
+    writeTemporary(path, temp, write, durability);
+    std::error_code ec;
+    std::filesystem::rename(temp, path, ec);
+    if (ec) throw WriteError(path, ec.message());
   } catch (...) {
     std::error_code ignored;
     std::filesystem::remove(temp, ignored);
     throw;
   }
+  if (durability == Durability::Synced) syncDirectory(path);
 }
 
 void requireWritable(const std::filesystem::path& path) {
-  auto fail = [&](const std::string& why) {
-    throw std::runtime_error(path.string() + ": error: cannot write (" + why + ")");
-  };
+  auto fail = [&](const std::string& why) { throw WriteError(path, why); };
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) fail("it is a directory");
   const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";

@@ -4,23 +4,48 @@
 #include <filesystem>
 #include <functional>
 #include <ostream>
+#include <stdexcept>
+#include <string>
 
 namespace tickfx::io {
 
-/// Writes `path` through `write` into a temporary file beside it, then renames it into place, so
-/// a reader (or a crash) never sees half a file. Throws std::runtime_error naming the path when
-/// anything fails; the temporary is removed and an existing `path` is left untouched.
-void writeFileAtomically(const std::filesystem::path& path,
-                         const std::function<void(std::ostream&)>& write);
+/// A file that could not be written. what() reads "PATH: error: cannot write (REASON)", REASON
+/// being the system's ("No space left on device", "Permission denied", "File too large").
+class WriteError : public std::runtime_error {
+ public:
+  WriteError(const std::filesystem::path& path, const std::string& reason);
+  /// The file as the caller named it (never the temporary beside it).
+  const std::filesystem::path& path() const { return path_; }
+  const std::string& reason() const { return reason_; }
 
-/// The same for writers that open files by name themselves (OpenVDB's io::File): `write` is
-/// given the temporary's path, beside `path`, and must leave the whole file there or throw.
-void writeFileAtomicallyByName(const std::filesystem::path& path,
-                               const std::function<void(const std::filesystem::path&)>& write);
+ private:
+  std::filesystem::path path_;
+  std::string reason_;
+};
+
+/// How far writeFileAtomically() goes before it returns.
+enum class Durability {
+  /// Renamed into place: every reader sees the whole file or the old one, and a crash of the
+  /// process cannot change that. A power loss may still lose the newest files (the kernel writes
+  /// them back later).
+  Renamed,
+  /// Also flushed to the disk (fsync of the file before the rename and of its directory after):
+  /// after a power loss the path holds the old file or the new one, whole.
+  Synced,
+};
+
+/// Writes `path` through `write` into a temporary file beside it, then renames it into place, so
+/// a reader (or a crash) never sees half a file. Every write is checked: on any failure (a full
+/// disk, a file size limit, a directory removed or made read-only meanwhile) throws WriteError
+/// naming `path` and the system's reason; the temporary is removed and an existing `path` is left
+/// untouched. Whatever `write` throws is passed on, with the same clean-up.
+void writeFileAtomically(const std::filesystem::path& path,
+                         const std::function<void(std::ostream&)>& write,
+                         Durability durability = Durability::Renamed);
 
 /// Checks, before anything is written, that `path` could be written atomically: its folder
-/// exists and takes a new file, and `path` is not a folder. Throws std::runtime_error
-/// "PATH: error: cannot write (REASON)" otherwise; leaves nothing behind.
+/// exists and takes a new file, and `path` is not a folder. Throws WriteError otherwise; leaves
+/// nothing behind.
 void requireWritable(const std::filesystem::path& path);
 
 }  // namespace tickfx::io

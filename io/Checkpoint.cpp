@@ -217,9 +217,7 @@ Parsed parsePayload(std::string_view payload) {
   if (r.remaining() != 0) {
     throw Malformed{std::to_string(r.remaining()) + " bytes follow the last spring"};
   }
-  if (p.tick < 0 || p.ticksIssued < 0 || p.ticksDropped < 0 || p.ticksDue < 0 || p.remainder < 0) {
-    throw Malformed{"negative tick count or driver state"};
-  }
+  if (p.tick < 0) throw Malformed{"negative tick count"};
   if (p.overrunPolicy > 1)
     throw Malformed{"unknown overrun policy " + std::to_string(p.overrunPolicy)};
   return p;
@@ -287,6 +285,12 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
   if (!p.springs.empty() && system.springs() == nullptr) {
     return "checkpoint has " + std::to_string(p.springs.size()) +
            " springs (expected none: this effect has no structures)";
+  }
+  if (!system.driver().canRestore(p.ticksIssued, p.ticksDropped, p.ticksDue, p.remainder)) {
+    return "checkpoint is malformed (a driver state no run reaches: ticks issued " +
+           std::to_string(p.ticksIssued) + ", dropped " + std::to_string(p.ticksDropped) +
+           ", due " + std::to_string(p.ticksDue) + ", remainder " + std::to_string(p.remainder) +
+           " flicks)";
   }
   if (p.size > pool.maxParticles()) {
     return "checkpoint is malformed (" + std::to_string(p.size) +
@@ -403,13 +407,12 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
 
   w.patchU64(kLengthOffset, w.bytes().size() + kTrailerBytes);
   w.u64(fingerprint(w.bytes()));
-  try {
-    writeFileAtomically(path, [&](std::ostream& out) {
-      out.write(w.bytes().data(), static_cast<std::streamsize>(w.bytes().size()));
-    });
-  } catch (const std::exception& e) {
-    fail(path, std::string("cannot write checkpoint (") + e.what() + ")");
-  }
+  writeFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out.write(w.bytes().data(), static_cast<std::streamsize>(w.bytes().size()));
+      },
+      Durability::Synced);
 }
 
 CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,

@@ -30,9 +30,10 @@ inline constexpr std::uint32_t kCheckpointVersion = 2;
 
 /// Writes the state of `system` (after its last completed tick) and `info` to `path`.
 ///
-/// The file appears whole or not at all (io::writeFileAtomically): when writing fails, an
-/// existing `path` is left as it was and no temporary stays behind. Throws std::runtime_error
-/// "PATH: error: cannot write checkpoint (...)".
+/// The file appears whole or not at all, and is on the disk before this returns
+/// (io::writeFileAtomically with Durability::Synced: after a crash or a power loss `path` holds
+/// the old checkpoint or this one, whole). When writing fails, an existing `path` is left as it
+/// was and no temporary stays behind; throws io::WriteError "PATH: error: cannot write (REASON)".
 ///
 /// Layout, version 2, every integer little-endian, floats as their IEEE-754 bits:
 ///

@@ -13,6 +13,7 @@
 #include <map>
 #include <numeric>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -212,20 +213,30 @@ bool isIdentity(const openvdb::math::Transform& transform) {
   return true;
 }
 
+// The bytes io::File::write() would put in a file, made in memory: File writes through its own
+// std::ofstream and ignores its failures, so a full disk left a truncated .vdb under the frame's
+// name and the run went on. Archive::write() with a seekable stream is what File::write() calls.
+class ArchiveBytes final : public openvdb::io::Archive {
+ public:
+  std::string of(const openvdb::GridCPtrVec& grids) const {
+    std::ostringstream os(std::ios::binary);
+    Archive::write(os, grids, /*seekable=*/true);
+    if (!os) throw std::runtime_error("cannot encode the VDB points grid");
+    return std::move(os).str();
+  }
+};
+
 // OpenVDB stamps every file with a random UUID (36 characters after the header's version fields),
 // so two identical runs would write different bytes. A cache's UUID is made from what the file
 // holds instead: the effect's fingerprint, its seed and the frame (an RFC 9562 version-8 UUID).
 // The header layout is checked first; a layout this build does not know is left as written.
-void stampUuid(const std::filesystem::path& file, const VdbCacheMetadata& meta,
-               std::int64_t frame) {
-  constexpr std::streamoff kUuidAt = 21;
+void stampUuid(std::string& bytes, const VdbCacheMetadata& meta, std::int64_t frame) {
+  constexpr std::size_t kUuidAt = 21;
   constexpr std::size_t kUuidLength = 36;
-  std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
-  char head[kUuidAt + kUuidLength] = {};
-  if (!io.read(head, sizeof head)) return;
-  const std::string_view uuid(head + kUuidAt, kUuidLength);
-  if (std::string_view(head, 4) != " BDV" || uuid[8] != '-' || uuid[13] != '-' || uuid[18] != '-' ||
-      uuid[23] != '-') {
+  if (bytes.size() < kUuidAt + kUuidLength) return;
+  const std::string_view uuid(bytes.data() + kUuidAt, kUuidLength);
+  if (std::string_view(bytes.data(), 4) != " BDV" || uuid[8] != '-' || uuid[13] != '-' ||
+      uuid[18] != '-' || uuid[23] != '-') {
     return;
   }
   const std::string key =
@@ -236,9 +247,7 @@ void stampUuid(const std::filesystem::path& file, const VdbCacheMetadata& meta,
                 static_cast<unsigned>((hi >> 16) & 0xffff), static_cast<unsigned>(hi & 0xfff),
                 static_cast<unsigned>(0x8000 | ((lo >> 48) & 0x3fff)),
                 static_cast<unsigned long long>(lo & 0xffffffffffffULL));
-  io.seekp(kUuidAt);
-  io.write(text, static_cast<std::streamsize>(kUuidLength));
-  if (!io.flush()) throw std::runtime_error(file.string() + ": cannot stamp the file's UUID");
+  bytes.replace(kUuidAt, kUuidLength, text, kUuidLength);
 }
 
 // What OpenVDB reads without comparing (readVdbGrid has checked every size it trusts): a leaf's
@@ -270,16 +279,10 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
                         const std::filesystem::path& path) {
   openvdb::initialize();
   const openvdb::GridCPtrVec grids{makeGrid(frame, meta)};
-  writeFileAtomicallyByName(path, [&](const std::filesystem::path& temp) {
-    try {
-      openvdb::io::File file(temp.string());
-      file.write(grids);
-      file.close();
-      stampUuid(temp, meta, frame.frame);
-    } catch (const std::exception& e) {
-      throw std::runtime_error(path.string() + ": cannot write the VDB points cache (" + e.what() +
-                               ")");
-    }
+  std::string bytes = ArchiveBytes().of(grids);
+  stampUuid(bytes, meta, frame.frame);
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   });
 }
 

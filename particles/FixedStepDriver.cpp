@@ -75,12 +75,17 @@ float FixedStepDriver::alpha() const {
   return a < 1.0f || timing_ == FrameTiming::AtFrameTime ? a : std::nextafter(1.0f, 0.0f);
 }
 
+bool FixedStepDriver::canRestore(std::int64_t ticksIssued, std::int64_t ticksDropped,
+                                 std::int64_t ticksDue, std::int64_t remainder) const {
+  const bool between = timing_ == FrameTiming::AtFrameTime && remainder > 0;
+  return ticksIssued >= 0 && ticksDropped >= 0 && ticksDue >= 0 && ticksDue < kMaxTicks &&
+         remainder >= 0 && remainder < kFlicksPerSecond &&
+         ticksIssued <= ticksDue + (between ? 1 : 0);
+}
+
 void FixedStepDriver::restore(std::int64_t ticksIssued, std::int64_t ticksDropped,
                               std::int64_t ticksDue, std::int64_t remainder) {
-  const bool between = timing_ == FrameTiming::AtFrameTime && remainder > 0;
-  if (ticksIssued < 0 || ticksDropped < 0 || ticksDue < 0 || ticksDue >= kMaxTicks ||
-      remainder < 0 || remainder >= kFlicksPerSecond ||
-      ticksIssued > ticksDue + (between ? 1 : 0)) {
+  if (!canRestore(ticksIssued, ticksDropped, ticksDue, remainder)) {
     throw std::invalid_argument("driver state out of range");
   }
   ticksIssued_ = ticksIssued;

@@ -81,7 +81,10 @@ class FixedStepDriver {
   /// α of the clock as it stands (what the last advance() returned).
   float alpha() const;
 
-  /// Restores a saved state; throws std::invalid_argument when it is not one advance() can reach.
+  /// Whether restore() takes this state: one that advance() can reach.
+  bool canRestore(std::int64_t ticksIssued, std::int64_t ticksDropped, std::int64_t ticksDue,
+                  std::int64_t remainder) const;
+  /// Restores a saved state; throws std::invalid_argument unless canRestore().
   void restore(std::int64_t ticksIssued, std::int64_t ticksDropped, std::int64_t ticksDue,
                std::int64_t remainder);
 

@@ -644,9 +644,31 @@ TEST_F(ioCheckpointRefusal, MalformedPayloadWithAGoodChecksum) {
   }
   {
     std::string bad = bytes_;
-    storeU64(bad, count - 48, 0x8000000000000000ULL);  // the tick count
+    storeU64(bad, count - 56, 0x8000000000000000ULL);  // the tick count
     reseal(bad);
-    expectRefused(bad, "checkpoint is malformed (negative tick count or driver state)");
+    expectRefused(bad, "checkpoint is malformed (negative tick count)");
+  }
+  // Found by fuzz_checkpoint: the driver refused this state only once the pool had been replaced,
+  // with an exception the reader does not promise. FixedStepDriver::canRestore() now vets it with
+  // the rest, before the system is touched.
+  const std::uint64_t dropped = loadU64(bytes_, count - 40), due = loadU64(bytes_, count - 32),
+                      remainder = loadU64(bytes_, count - 24);
+  const auto driverState = [&](const std::string& issued, std::uint64_t dueValue) {
+    return "checkpoint is malformed (a driver state no run reaches: ticks issued " + issued +
+           ", dropped " + std::to_string(dropped) + ", due " + std::to_string(dueValue) +
+           ", remainder " + std::to_string(remainder) + " flicks)";
+  };
+  {
+    std::string bad = bytes_;
+    storeU64(bad, count - 48, due + 2);  // ticks issued past the ticks due
+    reseal(bad);
+    expectRefused(bad, driverState(std::to_string(due + 2), due));
+  }
+  {
+    std::string bad = bytes_;
+    storeU64(bad, count - 48, 0x8000000000000000ULL);  // negative ticks issued
+    reseal(bad);
+    expectRefused(bad, driverState("-9223372036854775808", due));
   }
 }
 
@@ -694,8 +716,7 @@ TEST_F(ioCheckpoint, AFailedWriteLeavesTheOldCheckpointIntact) {
   ::setrlimit(RLIMIT_FSIZE, &saved);
   std::signal(SIGXFSZ, savedHandler);
 
-  const std::string prefix = path.string() + ": error: cannot write checkpoint (";
-  EXPECT_EQ(message.substr(0, prefix.size()), prefix) << message;
+  EXPECT_EQ(message, path.string() + ": error: cannot write (File too large)");
   EXPECT_EQ(entries(), std::set<std::string>{"run.ckpt"});
   EXPECT_EQ(readBytes(path), old);
   auto b = makeSystem(settings);
@@ -714,8 +735,7 @@ TEST_F(ioCheckpoint, WritingOverADirectoryFailsCleanly) {
     writeCheckpoint(path, *a, CheckpointInfo{kEffect, 0, 0});
     ADD_FAILURE() << "writing over a directory succeeded";
   } catch (const std::runtime_error& e) {
-    const std::string prefix = path.string() + ": error: cannot write checkpoint (";
-    EXPECT_EQ(std::string(e.what()).substr(0, prefix.size()), prefix) << e.what();
+    EXPECT_EQ(std::string(e.what()), path.string() + ": error: cannot write (Is a directory)");
   }
   EXPECT_EQ(entries(), std::set<std::string>{"run.ckpt"});
   EXPECT_EQ(readBytes(path / "keep"), "precious");
@@ -728,8 +748,8 @@ TEST_F(ioCheckpoint, WritingIntoAMissingFolderFails) {
     writeCheckpoint(path, *a, CheckpointInfo{kEffect, 0, 0});
     ADD_FAILURE() << "wrote into a missing folder";
   } catch (const std::runtime_error& e) {
-    const std::string prefix = path.string() + ": error: cannot write checkpoint (";
-    EXPECT_EQ(std::string(e.what()).substr(0, prefix.size()), prefix) << e.what();
+    EXPECT_EQ(std::string(e.what()),
+              path.string() + ": error: cannot write (No such file or directory)");
   }
   EXPECT_TRUE(entries().empty());
 }

@@ -441,10 +441,8 @@ TEST_F(ioVdbPoints, AFailedWriteLeavesNoFile) {
     writeVdbPointCache(frame, sampleMetadata(), nowhere);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(
-        std::string(e.what()).rfind(nowhere.string() + ": cannot write the VDB points cache (", 0),
-        0u)
-        << e.what();
+    EXPECT_EQ(std::string(e.what()),
+              nowhere.string() + ": error: cannot write (No such file or directory)");
   }
   EXPECT_FALSE(fs::exists(path("no")));
   // A custom attribute named like a standard one, or not a name OpenVDB takes: refused before
