@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "app/Commands.h"
+#include "app/Interrupt.h"
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
 #include "io/Checkpoint.h"
@@ -143,6 +144,38 @@ std::string cacheRange(const std::filesystem::path& dir, std::int64_t first, std
   return dir.string() + frames;
 }
 
+// After a stop: which cache files are there, every one whole.
+void reportWritten(std::int64_t lastWritten, std::int64_t firstFrame,
+                   const std::optional<std::filesystem::path>& out) {
+  if (out && lastWritten >= firstFrame) {
+    std::fprintf(stderr, "caches written: %s\n", cacheRange(*out, firstFrame, lastWritten).c_str());
+  }
+}
+
+void reportInterruption(const std::string& effectPath, int signal, std::int64_t lastFrame,
+                        std::int64_t firstFrame, Flicks elapsed,
+                        const std::optional<std::filesystem::path>& out,
+                        const std::optional<std::filesystem::path>& resumeFrom,
+                        bool checkpointing) {
+  if (lastFrame >= firstFrame) {
+    std::fprintf(stderr, "%s: interrupted by %s after frame %lld (%.9g s)\n", effectPath.c_str(),
+                 InterruptCatcher::name(signal), static_cast<long long>(lastFrame),
+                 secondsFromFlicks(elapsed));
+  } else {
+    std::fprintf(stderr, "%s: interrupted by %s before the first frame\n", effectPath.c_str(),
+                 InterruptCatcher::name(signal));
+  }
+  reportWritten(lastFrame, firstFrame, out);
+  if (resumeFrom) {
+    std::fprintf(stderr,
+                 "checkpoint: %s\nresume with: tickfx run %s --resume %s (and the options "
+                 "of this run)\n",
+                 resumeFrom->c_str(), effectPath.c_str(), resumeFrom->c_str());
+  } else if (!checkpointing) {
+    std::fprintf(stderr, "no checkpoint: run with --checkpoint-every N to be able to resume\n");
+  }
+}
+
 void reportNonfiniteStop(const std::string& effectPath, const NonfiniteEvent& event,
                          const std::vector<io::Diagnostic>& lint, std::int64_t lastWritten,
                          std::int64_t firstFrame, const std::optional<std::filesystem::path>& out) {
@@ -153,9 +186,7 @@ void reportNonfiniteStop(const std::string& effectPath, const NonfiniteEvent& ev
   if (const io::Diagnostic* cause = io::instabilityWarning(lint)) {
     std::fprintf(stderr, "likely cause: %s\n", cause->format().c_str());
   }
-  if (out && lastWritten >= firstFrame) {
-    std::fprintf(stderr, "caches written: %s\n", cacheRange(*out, firstFrame, lastWritten).c_str());
-  }
+  reportWritten(lastWritten, firstFrame, out);
 }
 
 std::filesystem::path checkpointPath(const std::filesystem::path& dir, std::int64_t frame) {
@@ -287,34 +318,61 @@ int runCommand(Arguments& args) {
 
   const auto wallStart = std::chrono::steady_clock::now();
   ProgressLine progress;
-  std::int64_t lastFrame = firstFrame - 1;
-  while (const std::optional<Flicks> duration = schedule.next()) {
-    const std::int64_t f = schedule.framesDone();
-    system->advance(*duration);
-    if (system->nonfiniteStop()) {
-      // The frame holding the tick is not written; those before it are, whole.
-      progress.finish();
-      reportNonfiniteStop(effectPath, *system->nonfiniteStop(), lint, f - 1, firstFrame,
-                          formats.empty() ? std::nullopt : std::optional(outDir));
-      return kExitFailure;
-    }
-    elapsed += *duration;
-    lastFrame = f;
-    if (!formats.empty()) {
-      const io::FrameData data = io::captureFrame(*system, f, secondsFromFlicks(elapsed));
-      for (io::CacheFormat fmt : formats) {
-        if (fmt == io::CacheFormat::Csv) io::writeCsvCache(data, cachePath(outDir, f, "csv"));
-        if (fmt == io::CacheFormat::Ply) io::writePlyCache(data, cachePath(outDir, f, "ply"));
-        if (fmt == io::CacheFormat::Vdb)
-          io::writeVdbPointCache(data, vdbMeta, cachePath(outDir, f, "vdb"));
+  std::int64_t lastFrame = firstFrame - 1;  // every file of frames up to this one is whole
+  const std::optional<std::filesystem::path> cacheDir =
+      formats.empty() ? std::nullopt : std::optional(outDir);
+  const InterruptCatcher interrupts;
+  try {
+    while (InterruptCatcher::caught() == 0) {
+      const std::optional<Flicks> duration = schedule.next();
+      if (!duration) break;
+      const std::int64_t f = schedule.framesDone();
+      system->advance(*duration);
+      if (system->nonfiniteStop()) {
+        // The frame holding the tick is not written; those before it are, whole.
+        progress.finish();
+        reportNonfiniteStop(effectPath, *system->nonfiniteStop(), lint, lastFrame, firstFrame,
+                            cacheDir);
+        return kExitFailure;
       }
+      elapsed += *duration;
+      if (!formats.empty()) {
+        const io::FrameData data = io::captureFrame(*system, f, secondsFromFlicks(elapsed));
+        for (io::CacheFormat fmt : formats) {
+          if (fmt == io::CacheFormat::Csv) io::writeCsvCache(data, cachePath(outDir, f, "csv"));
+          if (fmt == io::CacheFormat::Ply) io::writePlyCache(data, cachePath(outDir, f, "ply"));
+          if (fmt == io::CacheFormat::Vdb)
+            io::writeVdbPointCache(data, vdbMeta, cachePath(outDir, f, "vdb"));
+        }
+      }
+      if (every > 0 && f % every == 0) {
+        io::writeCheckpoint(checkpointPath(checkpoints, f), *system,
+                            io::CheckpointInfo{effectHash, f, elapsed});
+      }
+      lastFrame = f;
+      progress.update(f, secondsFromFlicks(elapsed), secondsFromFlicks(schedule.total()),
+                      system->pool().size());
     }
-    if (every > 0 && f % every == 0) {
-      io::writeCheckpoint(checkpointPath(checkpoints, f), *system,
-                          io::CheckpointInfo{effectHash, f, elapsed});
+    if (const int signal = InterruptCatcher::caught()) {
+      progress.finish();
+      // The state is that of the end of lastFrame: a checkpoint of it, unless one was just made.
+      std::optional<std::filesystem::path> resumeFrom;
+      if (every > 0 && lastFrame >= firstFrame) {
+        resumeFrom = checkpointPath(checkpoints, lastFrame);
+        if (lastFrame % every != 0) {
+          io::writeCheckpoint(*resumeFrom, *system,
+                              io::CheckpointInfo{effectHash, lastFrame, elapsed});
+        }
+      }
+      reportInterruption(effectPath, signal, lastFrame, firstFrame, elapsed, cacheDir, resumeFrom,
+                         every > 0);
+      return 128 + signal;
     }
-    progress.update(f, secondsFromFlicks(elapsed), secondsFromFlicks(schedule.total()),
-                    system->pool().size());
+  } catch (const io::WriteError& e) {
+    progress.finish();
+    std::fprintf(stderr, "%s\n", e.what());
+    reportWritten(lastFrame, firstFrame, cacheDir);
+    return kExitFailure;
   }
   progress.finish();
   const double wall =

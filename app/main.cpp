@@ -1,6 +1,7 @@
 // tickfx: run, check and study particle effects from the command line.
 #include <tbb/global_control.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "app/Commands.h"
+#include "io/AtomicFile.h"
 #include "io/EffectSettings.h"
 
 namespace {
@@ -45,6 +47,9 @@ int main(int argc, char** argv) {
   // run 8. Only a cap: systems of automatic concurrency still use one thread per core.
   const tbb::global_control threadLimit(tbb::global_control::max_allowed_parallelism,
                                         static_cast<std::size_t>(tickfx::io::kMaxThreads));
+  // A file size limit (ulimit -f on a farm) then fails a write with EFBIG, which the writers
+  // report by file name, instead of killing the process half-way through a file.
+  std::signal(SIGXFSZ, SIG_IGN);
   const std::string command = argv[1];
   Arguments args(command, std::vector<std::string>(argv + 2, argv + argc));
   try {
@@ -58,6 +63,9 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::fprintf(stderr, "tickfx %s\n", e.what());
     return kExitUsage;
+  } catch (const tickfx::io::WriteError& e) {
+    std::fprintf(stderr, "%s\n", e.what());  // "PATH: error: cannot write (REASON)"
+    return kExitFailure;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tickfx %s: error: %s\n", command.c_str(), e.what());
     return kExitFailure;
