@@ -296,6 +296,13 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
     return "checkpoint is malformed (" + std::to_string(p.size) +
            " particles, more than max_particles " + std::to_string(pool.maxParticles()) + ")";
   }
+  std::vector<std::uint64_t> ids(static_cast<std::size_t>(p.size));
+  std::vector<std::int64_t> births(ids.size());
+  loadLittleEndian(p.ids, ids.data(), ids.size());
+  loadLittleEndian(p.births, births.data(), births.size());
+  if (auto problem = ParticlePool::restoreProblem(ids, births, p.nextId, p.tick)) {
+    return "checkpoint is malformed (" + *problem + ")";
+  }
   return std::nullopt;
 }
 

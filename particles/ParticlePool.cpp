@@ -98,6 +98,25 @@ std::size_t ParticlePool::spawn(const ParticleInit& init, std::int64_t tick) {
   return i;
 }
 
+std::optional<std::string> ParticlePool::restoreProblem(std::span<const std::uint64_t> ids,
+                                                        std::span<const std::int64_t> births,
+                                                        std::uint64_t nextId, std::int64_t tick) {
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (ids[i] >= nextId || (i > 0 && ids[i] <= ids[i - 1])) {
+      return "row " + std::to_string(i) + " has id " + std::to_string(ids[i]) +
+             " (ids rise from row to row and stay below the next id, " + std::to_string(nextId) +
+             ")";
+    }
+  }
+  for (std::size_t i = 0; i < births.size(); ++i) {
+    if (births[i] < 0 || births[i] > tick) {
+      return "row " + std::to_string(i) + " was born at tick " + std::to_string(births[i]) +
+             " (expected 0 to " + std::to_string(tick) + ")";
+    }
+  }
+  return std::nullopt;
+}
+
 void ParticlePool::updateAges(std::int64_t tick, std::int64_t stepRateHz) {
   // A product with the reciprocal rather than a division per row, and the integer converted by
   // the exponent trick (exact for counts below 2^52) because SSE2 has no int64-to-double

@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -123,6 +125,12 @@ class ParticlePool {
   /// Sets size() directly (throws std::invalid_argument past maxParticles) and clears the dead
   /// flags; the caller then writes every column of rows [0, size) (restoring a saved state).
   void resizeForRestore(std::size_t size, std::uint64_t nextId, std::uint64_t droppedSpawns);
+  /// Why rows with these ids and birth ticks are not a state a pool reaches by tick `tick` with
+  /// `nextId` ids handed out (ids strictly rising, below nextId; births in [0, tick]), or
+  /// nothing when they are one. For saved states, before anything is restored.
+  static std::optional<std::string> restoreProblem(std::span<const std::uint64_t> ids,
+                                                   std::span<const std::int64_t> births,
+                                                   std::uint64_t nextId, std::int64_t tick);
 
  private:
   struct NamedColumn {

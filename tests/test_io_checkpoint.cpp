@@ -670,6 +670,35 @@ TEST_F(ioCheckpointRefusal, MalformedPayloadWithAGoodChecksum) {
     reseal(bad);
     expectRefused(bad, driverState("-9223372036854775808", due));
   }
+  // Found by fuzz_checkpoint: a birth tick of -2⁶³ overflowed the ages' tick − birth (undefined
+  // behaviour) on the next tick. Ids and births are vetted with the pool's own rules
+  // (ParticlePool::restoreProblem) before anything is restored.
+  const std::uint64_t rows = loadU64(bytes_, count), nextId = loadU64(bytes_, count + 8);
+  const std::int64_t tick = static_cast<std::int64_t>(loadU64(bytes_, count - 56));
+  const std::size_t idAt = count + 8 + 8 + 8 + 4 + 16 * 4 * rows, birthAt = idAt + 8 * rows;
+  ASSERT_GE(rows, 3u);
+  const std::uint64_t id1 = loadU64(bytes_, idAt + 8);
+  const std::pair<std::pair<std::size_t, std::uint64_t>, std::string> cases[] = {
+      {{birthAt + 8, 0x8000000000000000ULL},
+       "row 1 was born at tick -9223372036854775808 (expected 0 to " + std::to_string(tick) + ")"},
+      {{birthAt + 16, static_cast<std::uint64_t>(tick) + 1},
+       "row 2 was born at tick " + std::to_string(tick + 1) + " (expected 0 to " +
+           std::to_string(tick) + ")"},
+      {{idAt + 16, id1},
+       "row 2 has id " + std::to_string(id1) +
+           " (ids rise from row to row and stay below the next id, " + std::to_string(nextId) +
+           ")"},
+      {{idAt + 8 * (rows - 1), nextId},
+       "row " + std::to_string(rows - 1) + " has id " + std::to_string(nextId) +
+           " (ids rise from row to row and stay below the next id, " + std::to_string(nextId) +
+           ")"},
+  };
+  for (const auto& [edit, why] : cases) {
+    std::string bad = bytes_;
+    storeU64(bad, edit.first, edit.second);
+    reseal(bad);
+    expectRefused(bad, "checkpoint is malformed (" + why + ")");
+  }
 }
 
 // ---- writing --------------------------------------------------------------------------------
