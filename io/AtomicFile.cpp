@@ -92,10 +92,15 @@ void writeTemporary(const std::filesystem::path& path, const std::filesystem::pa
 
 }  // namespace
 
-WriteError::WriteError(const std::filesystem::path& path, const std::string& reason)
-    : std::runtime_error(path.string() + ": error: cannot write (" + reason + ")"),
+WriteError::WriteError(const std::filesystem::path& path, const std::string& reason,
+                       const std::filesystem::path& leftover, const std::string& leftoverReason)
+    : std::runtime_error(path.string() + ": error: cannot write (" + reason + ")" +
+                         (leftover.empty() ? std::string()
+                                           : "\n" + leftover.string() + ": error: cannot remove (" +
+                                                 leftoverReason + ")")),
       path_(path),
-      reason_(reason) {}
+      reason_(reason),
+      leftover_(leftover) {}
 
 void writeFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write, Durability durability) {
@@ -109,6 +114,13 @@ void writeFileAtomically(const std::filesystem::path& path,
     std::error_code ec;
     std::filesystem::rename(temp, path, ec);
     if (ec) throw WriteError(path, ec.message());
+  } catch (const WriteError& e) {
+    std::error_code removed;
+    std::filesystem::remove(temp, removed);
+    if (removed && std::filesystem::exists(temp)) {
+      throw WriteError(e.path(), e.reason(), temp, removed.message());
+    }
+    throw;
   } catch (...) {
     std::error_code ignored;
     std::filesystem::remove(temp, ignored);

@@ -11,16 +11,22 @@ namespace tickfx::io {
 
 /// A file that could not be written. what() reads "PATH: error: cannot write (REASON)", REASON
 /// being the system's ("No space left on device", "Permission denied", "File too large").
+/// When the temporary beside the file could not be removed either (its directory was made
+/// read-only meanwhile), a second line names it: "TEMP: error: cannot remove (REASON)".
 class WriteError : public std::runtime_error {
  public:
-  WriteError(const std::filesystem::path& path, const std::string& reason);
+  WriteError(const std::filesystem::path& path, const std::string& reason,
+             const std::filesystem::path& leftover = {}, const std::string& leftoverReason = {});
   /// The file as the caller named it (never the temporary beside it).
   const std::filesystem::path& path() const { return path_; }
   const std::string& reason() const { return reason_; }
+  /// The temporary left behind, or empty.
+  const std::filesystem::path& leftover() const { return leftover_; }
 
  private:
   std::filesystem::path path_;
   std::string reason_;
+  std::filesystem::path leftover_;
 };
 
 /// How far writeFileAtomically() goes before it returns.
@@ -38,7 +44,8 @@ enum class Durability {
 /// a reader (or a crash) never sees half a file. Every write is checked: on any failure (a full
 /// disk, a file size limit, a directory removed or made read-only meanwhile) throws WriteError
 /// naming `path` and the system's reason; the temporary is removed and an existing `path` is left
-/// untouched. Whatever `write` throws is passed on, with the same clean-up.
+/// untouched (if the temporary cannot be removed either, WriteError::leftover() names it).
+/// Whatever `write` throws is passed on, with the same clean-up.
 void writeFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write,
                          Durability durability = Durability::Renamed);
