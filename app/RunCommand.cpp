@@ -53,6 +53,8 @@ constexpr const char* kRunHelp =
     "  --checkpoint-dir D    ... into D/checkpoint_<frame>.tfxc (default: the cache directory)\n"
     "  --resume FILE         continue from a checkpoint of this effect (same --set and frame\n"
     "                        options as the run that wrote it); reaches the same state hash\n"
+    "  Ctrl-C (SIGINT) or SIGTERM finishes the frame in hand, writes its checkpoint (with\n"
+    "  --checkpoint-every), says how to resume and exits 130 or 143; a second one stops at once.\n"
     "Simulation:\n"
     "  --set key.path=value  override a key of the effect (repeatable), e.g. "
     "simulation.integrator=rk4\n"

@@ -2,16 +2,19 @@
 // way to run a program from the source tree with its exit code and output captured.
 #pragma once
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace tickfx::cli_test {
 
@@ -54,6 +57,47 @@ class CliFixture : public ::testing::Test {
     r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = readAll(out);
     r.err = readAll(err);
+    return r;
+  }
+
+  /// A program started by startProgram(), running beside the test.
+  struct Running {
+    pid_t pid = -1;
+  };
+
+  /// Starts `program` with `args` (one string each, no shell) from the source tree, stdin
+  /// closed, stdout and stderr into files in dir_; finish() waits for it.
+  Running startProgram(const std::string& program, const std::vector<std::string>& args) const {
+    const std::string out = (dir_ / "stdout.txt").string(), err = (dir_ / "stderr.txt").string();
+    std::vector<std::string> argv = {program};
+    argv.insert(argv.end(), args.begin(), args.end());
+    std::vector<char*> raw;
+    for (std::string& a : argv) raw.push_back(a.data());
+    raw.push_back(nullptr);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      // Only async-signal-safe calls until exec: the test process may have threads.
+      if (::chdir(TICKFX_SOURCE_DIR) != 0) ::_exit(127);
+      const int in = ::open("/dev/null", O_RDONLY),
+                o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644),
+                e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (in < 0 || o < 0 || e < 0 || ::dup2(in, 0) < 0 || ::dup2(o, 1) < 0 || ::dup2(e, 2) < 0)
+        ::_exit(127);
+      ::execv(raw[0], raw.data());
+      ::_exit(127);
+    }
+    return Running{pid};
+  }
+
+  /// Waits for `running`; exit is 128 + N when signal N ended it.
+  Result finish(Running running) const {
+    int status = 0;
+    while (::waitpid(running.pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    Result r;
+    r.exit = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = readAll(dir_ / "stdout.txt");
+    r.err = readAll(dir_ / "stderr.txt");
     return r;
   }
 
