@@ -16,8 +16,6 @@
 namespace tickfx {
 namespace {
 
-constexpr Flicks kSecond = kFlicksPerSecond;
-
 std::vector<std::int64_t> sweptRates() {
   std::vector<std::int64_t> rates;
   for (std::int64_t h = 1; h <= 2000; ++h) rates.push_back(h);

@@ -28,9 +28,19 @@ def samples():
     return _required_path("TICKFX_SAMPLES")
 
 
+def _cli_environment():
+    # The sanitizer build preloads the ASan runtime into the interpreter for the module; the CLI
+    # carries its own (clang links it statically) and refuses to start beside a second one.
+    env = dict(os.environ)
+    env.pop("LD_PRELOAD", None)
+    return env
+
+
 def run_cli(cli, *args, expect=0):
     """Runs `tickfx ARGS...`; returns (stdout, stderr) after checking the exit code."""
-    done = subprocess.run([str(cli), *map(str, args)], capture_output=True, text=True)
+    done = subprocess.run(
+        [str(cli), *map(str, args)], capture_output=True, text=True, env=_cli_environment()
+    )
     assert done.returncode == expect, (
         f"tickfx {' '.join(map(str, args))} exited {done.returncode}\n{done.stdout}{done.stderr}"
     )
