@@ -4,6 +4,7 @@
 
 # Core (tickfx::tickfx): the system, its settings, the force modules and the integrator interface.
 set(TICKFX_CORE_PUBLIC_HEADERS
+  particles/Assert.h
   particles/Clock.h
   particles/EmissionRate.h
   particles/Emitter.h

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "particles/Assert.h"
 #include "particles/ParticlePool.h"
 
 namespace tickfx {
@@ -25,6 +26,8 @@ struct Vec3Rows {
   Vec3Rows(float* px, float* py, float* pz, Eigen::Index n) : x(px, n), y(py, n), z(pz, n) {}
   /// Rows `r` of a pool-sized column.
   static Vec3Rows of(Vec3Column& c, RowRange r) {
+    TICKFX_ASSERT(r.begin <= r.end && r.end <= static_cast<std::size_t>(c.x.size()),
+                  "a row range past the end of its column");
     return {c.x.data() + r.begin, c.y.data() + r.begin, c.z.data() + r.begin, r.count()};
   }
   Eigen::Map<FloatColumn>& operator[](int c) { return c == 0 ? x : (c == 1 ? y : z); }
@@ -54,11 +57,13 @@ struct Vec3View {
   static Vec3View of(const Vec3Column& c) { return {c.x.data(), c.y.data(), c.z.data(), 0}; }
   /// The values of rows `r`.
   ConstVec3Rows rows(RowRange r) const {
+    TICKFX_ASSERT(r.begin >= base && r.begin <= r.end, "rows read below a view's base");
     const std::size_t i = r.begin - base;
     return {x + i, y + i, z + i, r.count()};
   }
   /// The value of one row (non-local modules: any row of a base-0 view).
   Eigen::Vector3f at(std::size_t row) const {
+    TICKFX_ASSERT(row >= base, "a row read below a view's base");
     const std::size_t i = row - base;
     return {x[i], y[i], z[i]};
   }

@@ -18,7 +18,10 @@ class StageScratch {
   static constexpr int kMaxColumns = 10;
   explicit StageScratch(int count);
   int count() const { return count_; }
-  Vec3Column& column(int k) { return columns_[static_cast<std::size_t>(k)]; }
+  Vec3Column& column(int k) {
+    TICKFX_ASSERT(k >= 0 && k < count_, "a stage column this integrator did not ask for");
+    return columns_[static_cast<std::size_t>(k)];
+  }
   /// Grows the pool-sized columns to `rows` (split runs only).
   void ensureRows(std::size_t rows);
 
@@ -39,11 +42,16 @@ class Tile {
   RowRange rows() const { return rows_; }
   /// Stage value `k` for this tile's rows, writable.
   Vec3Rows stage(int k) const {
+    TICKFX_ASSERT(k >= 0 && k < count_, "a stage value out of range");
+    TICKFX_ASSERT(rows_.begin >= base_, "a tile whose rows start below its stage values");
     const std::size_t i = rows_.begin - base_;
     return {stage_[k][0] + i, stage_[k][1] + i, stage_[k][2] + i, rows_.count()};
   }
   /// Stage value `k` as forces read it (ForceInput::position or velocity).
-  Vec3View view(int k) const { return {stage_[k][0], stage_[k][1], stage_[k][2], base_}; }
+  Vec3View view(int k) const {
+    TICKFX_ASSERT(k >= 0 && k < count_, "a stage value out of range");
+    return {stage_[k][0], stage_[k][1], stage_[k][2], base_};
+  }
   int count() const { return count_; }
 
  private:

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "particles/Assert.h"
 #include "particles/ParallelFor.h"
 
 namespace tickfx {
@@ -74,6 +75,7 @@ std::size_t ParticlePool::spawn(const ParticleInit& init, std::int64_t tick) {
     grow(std::min(maxParticles_, std::max<std::size_t>(1024, storageRows_ * 2)));
   }
   const std::size_t i = size_++;
+  TICKFX_ASSERT(i < storageRows_, "a spawn past the pool's storage");
   const auto r = static_cast<Eigen::Index>(i);
   position_.x[r] = init.position.x();
   position_.y[r] = init.position.y();
@@ -171,6 +173,8 @@ std::size_t ParticlePool::removeDead() {
 }
 
 void ParticlePool::applyRemovalTo(Vec3Column& column) const {
+  TICKFX_ASSERT(static_cast<std::size_t>(column.x.size()) >= size_,
+                "a column shorter than the pool it follows");
   const std::size_t first = firstDeadRow();
   if (first < size_) compact(column, dead_, first, size_);
 }
