@@ -55,6 +55,19 @@ class CliFaults : public tickfx::cli_test::CliFixture {
     }
   }
 
+  // Runs `tickfx ARGS`, sends `signal` once `file` exists, and waits for the run to end.
+  Result interruptedAt(const std::vector<std::string>& args, const fs::path& file,
+                       int signal) const {
+    const auto running = startProgram(TICKFX_CLI, args);
+    waitFor(file);
+    EXPECT_EQ(::kill(running.pid, signal), 0);
+    return finish(running);
+  }
+
+  // What the signal handler writes when the first signal arrives, as a regex.
+  static inline const std::string kStoppingNote =
+      "\ntickfx: stopping after the frame in hand \\(a second Ctrl-C stops at once\\)\n";
+
   // `dir` holds frame_0001.EXT to frame_LAST.EXT (and `extra` files), nothing else: no temporary.
   static void expectOnlyFrames(const fs::path& dir, const std::string& ext, int last,
                                std::vector<std::string> extra = {}) {
@@ -205,13 +218,10 @@ TEST_F(CliFaults, SigintFinishesTheFrameCheckpointsItAndTheResumedRunReachesTheS
   const std::string out = path("interrupted");
   std::vector<std::string> args = fountain("ply", out, "10");
   args.insert(args.end(), {"--checkpoint-every", "5"});
-  const auto running = startProgram(TICKFX_CLI, args);
-  waitFor(fs::path(out) / "checkpoint_000005.tfxc");
-  ASSERT_EQ(::kill(running.pid, SIGINT), 0);
-  const Result r = finish(running);
+  const Result r = interruptedAt(args, fs::path(out) / "checkpoint_000005.tfxc", SIGINT);
   EXPECT_EQ(r.exit, 130) << r.err;
   const std::regex message(
-      "\ntickfx: stopping after the frame in hand \\(a second Ctrl-C stops at once\\)\n"
+      kStoppingNote +
       "samples/fountain.toml: interrupted by SIGINT after frame ([0-9]+) \\(([0-9.]+) s\\)\n"
       "caches written: (.*) \\(frame_0001 to frame_([0-9]{4})\\)\n"
       "checkpoint: (.*)/checkpoint_([0-9]{6})\\.tfxc\n"
@@ -258,13 +268,11 @@ TEST_F(CliFaults, SigintFinishesTheFrameCheckpointsItAndTheResumedRunReachesTheS
 // kill: the same, and a run without checkpoints says it cannot be resumed.
 TEST_F(CliFaults, SigtermWithoutCheckpointsStopsAfterTheFrameAndSaysItCannotResume) {
   const std::string out = path("terminated");
-  const auto running = startProgram(TICKFX_CLI, fountain("csv", out, "60"));
-  waitFor(fs::path(out) / "frame_0003.csv");
-  ASSERT_EQ(::kill(running.pid, SIGTERM), 0);
-  const Result r = finish(running);
+  const Result r =
+      interruptedAt(fountain("csv", out, "60"), fs::path(out) / "frame_0003.csv", SIGTERM);
   EXPECT_EQ(r.exit, 143) << r.err;
   const std::regex message(
-      "\ntickfx: stopping after the frame in hand \\(a second Ctrl-C stops at once\\)\n"
+      kStoppingNote +
       "samples/fountain.toml: interrupted by SIGTERM after frame ([0-9]+) \\([0-9.]+ s\\)\n"
       "caches written: .* \\(frame_0001 to frame_([0-9]{4})\\)\n"
       "no checkpoint: run with --checkpoint-every N to be able to resume\n");
