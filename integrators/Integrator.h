@@ -62,6 +62,9 @@ class Integrator {
   virtual void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) = 0;
   /// What integrate() hands runPasses() as its afterEachTile: the step's NonfiniteCheck, if any.
   RowPass afterEachTile(ParticlePool& pool) const;
+  /// The step's NonfiniteCheck, for a scheme that does the check inside its own update loop
+  /// instead of handing runPasses() afterEachTile(); null when nothing is checked.
+  NonfiniteCheck* nonfiniteCheck() const { return check_; }
 
  private:
   std::unique_ptr<Advection> advection_;  // made on the first advected step
