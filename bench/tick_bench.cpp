@@ -6,6 +6,8 @@
 //   tick_bench --quick            smoke run: sizes 10⁴ and 10⁵, short timings
 //   tick_bench --sizes=1e4,1e6    only these particle counts
 //   tick_bench --min-time=0.5 --reps=9
+//   tick_bench --check-cost       what the per-tick non-finite check ([simulation] nonfinite =
+//                                 "stop" or "kill") costs each integrator's step(), 1 thread
 //
 // Cases, each starting from the same N particles (varied positions and velocities, infinite
 // lifetime, so the count never changes):
@@ -138,11 +140,12 @@ class HandWrittenLoop {
 // ---- tickfx side -----------------------------------------------------------------------------
 
 std::unique_ptr<tickfx::ParticleSystem> makeSystem(
-    std::size_t n, int threads, tickfx::NonfinitePolicy nonfinite = tickfx::NonfinitePolicy::Stop) {
+    std::size_t n, int threads, tickfx::NonfinitePolicy nonfinite = tickfx::NonfinitePolicy::Stop,
+    const std::string& integrator = "semi_implicit_euler") {
   tickfx::SystemSettings settings;
   settings.nonfinite = nonfinite;
   settings.stepRateHz = kStepRateHz;
-  settings.integrator = "semi_implicit_euler";
+  settings.integrator = integrator;
   settings.maxParticles = n;
   settings.threads = threads;
   auto system = std::make_unique<tickfx::ParticleSystem>(
@@ -297,13 +300,43 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   return d.withinRoundOff;
 }
 
+// Per integrator, step() on 1 thread with the non-finite check (NonfinitePolicy::Stop) and
+// without (Keep), the two systems taking turns batch by batch. The check is folded into a pass
+// that reads the tile anyway, so what is left is near the run-to-run spread of where code and
+// columns happen to sit in memory (a few per cent either way at 10⁴): read the figure with that.
+void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& timing) {
+  std::printf("\nnon-finite check, step() on 1 thread: checked against unchecked\n");
+  std::printf("%10s  %-22s %14s %14s %10s\n", "N", "integrator", "checked ms", "unchecked ms",
+              "cost");
+  for (const std::size_t n : sizes) {
+    for (const std::string& name : tickfx::integratorNames()) {
+      auto checked = makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name);
+      auto unchecked = makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name);
+      std::vector<bench::Case> cases;
+      cases.emplace_back("checked", [&](std::int64_t ticks) {
+        for (std::int64_t i = 0; i < ticks; ++i) checked->step();
+      });
+      cases.emplace_back("unchecked", [&](std::int64_t ticks) {
+        for (std::int64_t i = 0; i < ticks; ++i) unchecked->step();
+      });
+      bench::timeCases(cases, timing);
+      const double with = bench::median(cases[0].secondsPerTick);
+      const double without = bench::median(cases[1].secondsPerTick);
+      std::printf("%10zu  %-22s %14.4f %14.4f %+9.1f %%\n", n, name.c_str(), 1e3 * with,
+                  1e3 * without, 100.0 * (with / without - 1.0));
+      std::fflush(stdout);
+    }
+  }
+}
+
 void usage(const char* argv0) {
   std::printf(
-      "usage: %s [--quick] [--sizes=N[,N...]] [--min-time=SECONDS] [--reps=COUNT]\n"
+      "usage: %s [--quick] [--sizes=N[,N...]] [--min-time=SECONDS] [--reps=COUNT] [--check-cost]\n"
       "  --quick            smoke run: sizes 1e4,1e5 and --min-time=0.02\n"
       "  --sizes=1e4,1e6    particle counts (default 1e4,1e6,1e7)\n"
       "  --min-time=0.3     seconds each case is timed, per size\n"
-      "  --reps=5           minimum number of timed batches per case (the median is reported)\n",
+      "  --reps=5           minimum number of timed batches per case (the median is reported)\n"
+      "  --check-cost       only the non-finite check's cost, per integrator (sizes 1e4,1e6)\n",
       argv0);
 }
 
@@ -328,8 +361,13 @@ std::optional<std::vector<std::size_t>> parseSizes(std::string_view list) {
 
 int main(int argc, char** argv) {
   std::optional<std::vector<std::size_t>> sizes;
+  bool checkCost = false;
   bench::CommandLine cl;
   const auto own = [&](std::string_view arg) {
+    if (arg == "--check-cost") {
+      checkCost = true;
+      return bench::Arg::kTaken;
+    }
     const std::optional<std::string> v = bench::valueOf(arg, "--sizes=");
     if (!v) return bench::Arg::kNotMine;
     sizes = parseSizes(*v);
@@ -347,6 +385,10 @@ int main(int argc, char** argv) {
   if (cl.quick) o.sizes = {10'000, 100'000};
   if (sizes) o.sizes = *sizes;
 
+  if (checkCost) {
+    runCheckCosts(sizes ? *sizes : std::vector<std::size_t>{10'000, 1'000'000}, o.timing);
+    return 0;
+  }
   const int allThreads = tbb::info::default_concurrency();
   std::printf("tick_bench: one tick of gravity + wind + drag, semi-implicit Euler, %lld Hz\n",
               static_cast<long long>(kStepRateHz));

@@ -1,5 +1,7 @@
 #include "integrators/ExplicitEuler.h"
 
+#include "integrators/CheckedRows.h"
+
 namespace tickfx {
 
 void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
@@ -8,18 +10,29 @@ void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const 
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0);
+  NonfiniteCheck* const check = nonfiniteCheck();
   runPasses(pool.size(), forces.isLocal(), scratch_,
-            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0),
-             [&](const Tile& tile) {
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                         old = rowsOf(prev, tile.rows());
+               bool suspect = false;
+               const auto update = [dt](Eigen::Index i, float* pos, float* vel, float* last,
+                                        const float* acc) {
+                 const float position = pos[i];
+                 const float velocity = vel[i];
+                 const float nextP = position + velocity * dt;
+                 const float nextV = velocity + acc[i] * dt;
+                 last[i] = position;
+                 pos[i] = nextP;
+                 vel[i] = nextV;
+                 return nextP + nextV;  // the new velocity is not in the new position
+               };
                for (int c = 0; c < 3; ++c) {
-                 old[c] = pr[c];
-                 pr[c] += vr[c] * dt;
-                 vr[c] += a[c] * dt;
+                 suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
+                                       old[c].data(), a[c].data());
                }
-             }},
-            afterEachTile(pool));
+               if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+             }});
 }
 
 }  // namespace tickfx

@@ -60,13 +60,15 @@ class Integrator {
  protected:
   /// The scheme itself, under forces that add acceleration.
   virtual void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) = 0;
-  /// What integrate() hands runPasses() as its afterEachTile: the step's NonfiniteCheck, if any.
-  RowPass afterEachTile(ParticlePool& pool) const;
-  /// The step's NonfiniteCheck, for a scheme that does the check inside its own update loop
-  /// instead of handing runPasses() afterEachTile(); null when nothing is checked.
+  /// The step's NonfiniteCheck, null when nothing is checked. integrate() checks the values its
+  /// last update loop writes, in that loop (updateRows(), integrators/CheckedRows.h).
   NonfiniteCheck* nonfiniteCheck() const { return check_; }
 
  private:
+  /// What the advection schemes hand runPasses() as its afterEachTile: a scan of each tile once
+  /// its passes are done, when the step checks.
+  RowPass afterEachTile(ParticlePool& pool) const;
+
   std::unique_ptr<Advection> advection_;  // made on the first advected step
   NonfiniteCheck* check_ = nullptr;       // during step() only
 };

@@ -1,5 +1,7 @@
 #include "integrators/PositionVerlet.h"
 
+#include "integrators/CheckedRows.h"
+
 namespace tickfx {
 
 void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
@@ -13,32 +15,41 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   const std::size_t fresh = pool.firstUnstepped();
   const std::size_t n = pool.size();
   const TickInstant t0 = time.stage(0);
-  runPasses(n, forces.isLocal(), scratch_,
-            {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0),
-             [&](const Tile& tile) {
-               const RowRange r = tile.rows();
-               // A new particle has no history: give it the position it would have had a step ago.
-               const RowRange started = intersect(r, fresh, n);
-               if (started.count() > 0) {
-                 const std::size_t i = started.begin - r.begin;
-                 Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started),
-                          vr = rowsOf(v, started);
-                 Vec3Rows a = tile.stage(0);
-                 for (int c = 0; c < 3; ++c) {
-                   old[c] = pr[c] - vr[c] * dt +
-                            a[c].segment(static_cast<Eigen::Index>(i), started.count()) * halfDt2;
-                 }
-               }
-               Vec3Rows a = tile.stage(0), next = tile.stage(1), pr = rowsOf(p, r),
-                        vr = rowsOf(v, r), old = rowsOf(prev, r);
-               for (int c = 0; c < 3; ++c) {
-                 next[c] = (pr[c] * 2.0f - old[c]) + a[c] * dt2;
-                 old[c] = pr[c];
-                 pr[c] = next[c];
-                 vr[c] = (pr[c] - old[c]) * invDt;
-               }
-             }},
-            afterEachTile(pool));
+  NonfiniteCheck* const check = nonfiniteCheck();
+  runPasses(
+      n, forces.isLocal(), scratch_,
+      {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
+         const RowRange r = tile.rows();
+         // A new particle has no history: give it the position it would have had a step ago.
+         const RowRange started = intersect(r, fresh, n);
+         if (started.count() > 0) {
+           const std::size_t i = started.begin - r.begin;
+           Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started), vr = rowsOf(v, started);
+           Vec3Rows a = tile.stage(0);
+           for (int c = 0; c < 3; ++c) {
+             old[c] = pr[c] - vr[c] * dt +
+                      a[c].segment(static_cast<Eigen::Index>(i), started.count()) * halfDt2;
+           }
+         }
+         Vec3Rows a = tile.stage(0), pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
+         bool suspect = false;
+         const auto update = [dt2, invDt](Eigen::Index i, float* pos, float* vel, float* last,
+                                          const float* acc) {
+           const float position = pos[i];
+           const float next = (position * 2.0f - last[i]) + acc[i] * dt2;
+           const float velocity = (next - position) * invDt;
+           last[i] = position;
+           pos[i] = next;
+           vel[i] = velocity;
+           // A difference of finite positions can overflow: the velocity is checked too.
+           return next + velocity;
+         };
+         for (int c = 0; c < 3; ++c) {
+           suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
+                                 old[c].data(), static_cast<const float*>(a[c].data()));
+         }
+         if (suspect) check->scan(pool, r.begin, r.end);
+       }});
 }
 
 }  // namespace tickfx

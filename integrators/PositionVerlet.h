@@ -26,7 +26,7 @@ class PositionVerlet final : public Integrator {
   void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
 
  private:
-  StageScratch scratch_{2};  // acceleration, new position
+  StageScratch scratch_{1};  // acceleration
 };
 
 }  // namespace tickfx

@@ -1,5 +1,7 @@
 #include "integrators/RungeKutta4.h"
 
+#include "integrators/CheckedRows.h"
+
 namespace tickfx {
 namespace {
 
@@ -16,6 +18,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
+  NonfiniteCheck* const check = nonfiniteCheck();
 
   auto velocityRows = [&](const Tile& tile, int slot) {
     return slot == kState ? rowsOf(v, tile.rows()) : tile.stage(slot);
@@ -35,23 +38,43 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
       }
     };
   };
-  runPasses(pool.size(), forces.isLocal(), scratch_,
-            {evaluate(kState, kState, t0, K1), advance(kState, K1, P2, V2, halfH),
-             evaluate(P2, V2, tHalf, K2), advance(V2, K2, P3, V3, halfH),
-             evaluate(P3, V3, tHalf, K3), advance(V3, K3, P4, V4, h), evaluate(P4, V4, t1, K4),
-             [&](const Tile& tile) {
-               Vec3Rows k1 = tile.stage(K1), k2 = tile.stage(K2), k3 = tile.stage(K3),
-                        k4 = tile.stage(K4);
-               Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
-               Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                        old = rowsOf(prev, tile.rows());
-               for (int c = 0; c < 3; ++c) {
-                 old[c] = pr[c];
-                 pr[c] += ((vr[c] + v2[c] * 2.0f) + (v3[c] * 2.0f + v4[c])) * sixthH;
-                 vr[c] += ((k1[c] + k2[c] * 2.0f) + (k3[c] * 2.0f + k4[c])) * sixthH;
-               }
-             }},
-            afterEachTile(pool));
+  runPasses(
+      pool.size(), forces.isLocal(), scratch_,
+      {evaluate(kState, kState, t0, K1), advance(kState, K1, P2, V2, halfH),
+       evaluate(P2, V2, tHalf, K2), advance(V2, K2, P3, V3, halfH), evaluate(P3, V3, tHalf, K3),
+       advance(V3, K3, P4, V4, h), evaluate(P4, V4, t1, K4), [&](const Tile& tile) {
+         Vec3Rows k1 = tile.stage(K1), k2 = tile.stage(K2), k3 = tile.stage(K3),
+                  k4 = tile.stage(K4);
+         Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
+         Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                  old = rowsOf(prev, tile.rows());
+         bool suspect = false;
+         // s1..s4: the four slopes of the velocity (k1..k4); u2..u4: the stage velocities.
+         const auto update = [sixthH](Eigen::Index i, float* pos, float* vel, float* last,
+                                      const float* s1, const float* s2, const float* s3,
+                                      const float* s4, const float* u2, const float* u3,
+                                      const float* u4) {
+           const float position = pos[i];
+           const float velocity = vel[i];
+           const float nextP =
+               position + ((velocity + u2[i] * 2.0f) + (u3[i] * 2.0f + u4[i])) * sixthH;
+           const float nextV =
+               velocity + ((s1[i] + s2[i] * 2.0f) + (s3[i] * 2.0f + s4[i])) * sixthH;
+           last[i] = position;
+           pos[i] = nextP;
+           vel[i] = nextV;
+           return nextP + nextV;
+         };
+         const auto in = [](Eigen::Map<FloatColumn>& column) {
+           return static_cast<const float*>(column.data());
+         };
+         for (int c = 0; c < 3; ++c) {
+           suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
+                                 old[c].data(), in(k1[c]), in(k2[c]), in(k3[c]), in(k4[c]),
+                                 in(v2[c]), in(v3[c]), in(v4[c]));
+         }
+         if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+       }});
 }
 
 }  // namespace tickfx

@@ -48,11 +48,13 @@ struct NonfiniteEvent {
   std::string describe() const;
 };
 
-/// Finds non-finite positions and velocities inside the integrator's own pass over each tile,
-/// while the values it just wrote are in cache: a packet sum of the tile's six columns (one add
-/// per value) that is finite unless a value is not (or the sum overflows), and a per-row test only
-/// then. Rows found get kFlag in the pool's dead flags. scan() may run on disjoint rows from
-/// several threads; what it flags does not depend on how rows are split.
+/// Finds non-finite positions and velocities. An integrator's last update loop over a tile sums
+/// the values it writes as it writes them (integrators/CheckedRows.h) and calls scan() only for a
+/// tile whose sum is not finite; the advection schemes call it for every tile once their passes
+/// are done with it, while the tile is in cache. scan() sums the tile's six columns (one add per
+/// value), finite unless a value is not (or the sum overflows), and tests each row only then.
+/// Rows found get kFlag in the pool's dead flags. scan() may run on disjoint rows from several
+/// threads; what it flags does not depend on how rows are split.
 class NonfiniteCheck {
  public:
   /// The bit of ParticlePool::dead() that marks a non-finite row (1 is an ordinary death).
