@@ -302,16 +302,18 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 
 // Per integrator, step() on 1 thread with the non-finite check (NonfinitePolicy::Stop) and
 // without (Keep), the two systems taking turns batch by batch. The check is folded into a pass
-// that reads the tile anyway, so what is left is near the run-to-run spread of where code and
-// columns happen to sit in memory (a few per cent either way at 10⁴): read the figure with that.
+// that reads the tile anyway, so what is left is near the spread of where code and columns happen
+// to sit in memory: a second unchecked system, timed alongside, shows that spread (A/A).
 void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& timing) {
   std::printf("\nnon-finite check, step() on 1 thread: checked against unchecked\n");
-  std::printf("%10s  %-22s %14s %14s %10s\n", "N", "integrator", "checked ms", "unchecked ms",
-              "cost");
+  std::printf("%10s  %-22s %14s %14s %10s %12s\n", "N", "integrator", "checked ms", "unchecked ms",
+              "cost", "A/A spread");
   for (const std::size_t n : sizes) {
     for (const std::string& name : tickfx::integratorNames()) {
       auto checked = makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name);
       auto unchecked = makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name);
+      // A second unchecked copy: how far two identical systems differ is the noise floor.
+      auto control = makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name);
       std::vector<bench::Case> cases;
       cases.emplace_back("checked", [&](std::int64_t ticks) {
         for (std::int64_t i = 0; i < ticks; ++i) checked->step();
@@ -319,11 +321,15 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
       cases.emplace_back("unchecked", [&](std::int64_t ticks) {
         for (std::int64_t i = 0; i < ticks; ++i) unchecked->step();
       });
+      cases.emplace_back("unchecked copy", [&](std::int64_t ticks) {
+        for (std::int64_t i = 0; i < ticks; ++i) control->step();
+      });
       bench::timeCases(cases, timing);
       const double with = bench::median(cases[0].secondsPerTick);
       const double without = bench::median(cases[1].secondsPerTick);
-      std::printf("%10zu  %-22s %14.4f %14.4f %+9.1f %%\n", n, name.c_str(), 1e3 * with,
-                  1e3 * without, 100.0 * (with / without - 1.0));
+      const double copy = bench::median(cases[2].secondsPerTick);
+      std::printf("%10zu  %-22s %14.4f %14.4f %+9.1f %% %+10.1f %%\n", n, name.c_str(), 1e3 * with,
+                  1e3 * without, 100.0 * (with / without - 1.0), 100.0 * (copy / without - 1.0));
       std::fflush(stdout);
     }
   }

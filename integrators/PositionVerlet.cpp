@@ -41,8 +41,9 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            last[i] = position;
            pos[i] = next;
            vel[i] = velocity;
-           // A difference of finite positions can overflow: the velocity is checked too.
-           return next + velocity;
+           // The velocity alone tells: it is not finite when the new position is not (the old one
+           // passed last tick's check), and it can overflow where both positions are finite.
+           return velocity;
          };
          for (int c = 0; c < 3; ++c) {
            suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
