@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "app/Commands.h"
-#include "io/EditDistance.h"
-#include "io/VectorFieldSource.h"
+#include "io/effect/EditDistance.h"
+#include "io/effect/VectorFieldSource.h"
 
 namespace tickfx::app {
 namespace {

@@ -2,8 +2,8 @@
 #include <cstdio>
 
 #include "app/Commands.h"
-#include "io/EffectLint.h"
-#include "io/EffectParser.h"
+#include "io/effect/EffectLint.h"
+#include "io/effect/EffectParser.h"
 
 namespace tickfx::app {
 

@@ -4,8 +4,8 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "io/EffectBuilder.h"
 #include "io/FrameTimes.h"
+#include "io/effect/EffectBuilder.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "io/EffectSettings.h"
+#include "io/effect/EffectSettings.h"
 #include "particles/Clock.h"
 
 namespace tickfx::app {

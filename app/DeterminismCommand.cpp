@@ -11,9 +11,9 @@
 #include "app/DeterminismCheck.h"
 #include "app/HashLogRun.h"
 #include "io/AtomicFile.h"
-#include "io/EffectBuilder.h"
-#include "io/EffectParser.h"
 #include "io/FrameTimes.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <fstream>
 
-#include "io/EffectBuilder.h"
-#include "io/FrameData.h"
 #include "io/FrameTimes.h"
+#include "io/cache/FrameData.h"
+#include "io/effect/EffectBuilder.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "io/EffectSettings.h"
-#include "io/HashLog.h"
+#include "io/cache/HashLog.h"
+#include "io/effect/EffectSettings.h"
 
 namespace tickfx::app {
 

@@ -14,16 +14,18 @@
 #include "app/Interrupt.h"
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
-#include "io/Checkpoint.h"
-#include "io/CsvCache.h"
-#include "io/EffectBuilder.h"
-#include "io/EffectLint.h"
-#include "io/EffectParser.h"
-#include "io/FrameData.h"
 #include "io/FrameTimes.h"
-#include "io/PlyCache.h"
-#include "io/StateDump.h"
-#include "io/VdbPointCache.h"
+#include "io/cache/BackgroundWriter.h"
+#include "io/cache/Checkpoint.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/FrameCaches.h"
+#include "io/cache/FrameData.h"
+#include "io/cache/PlyCache.h"
+#include "io/cache/StateDump.h"
+#include "io/cache/VdbPointCache.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectLint.h"
+#include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {
@@ -48,6 +50,11 @@ constexpr const char* kRunHelp =
     "  --dump FILE           write the last tick's state as CSV: id,px,py,pz,vx,vy,vz,age\n"
     "  --trace FILE          write the state hash after every tick (tick,state_hash): diff two\n"
     "                        traces to find the first tick where two runs part\n"
+    "  --vdb-compression C   none (default) or blosc: lossless, smaller, slower to write\n"
+    "  --vdb-positions P     exact (default, every bit) or fixed16 (16-bit, to 1/65535 m)\n"
+    "  --durable             flush each cache to the disk (fsync) before counting it written\n"
+    "  --no-overlap          write each frame before simulating the next (by default frame f is\n"
+    "                        written on a thread of its own while frame f + 1 simulates)\n"
     "Checkpoints:\n"
     "  --checkpoint-every N  write the whole state after every N-th frame ...\n"
     "  --checkpoint-dir D    ... into D/checkpoint_<frame>.tfxc (default: the cache directory)\n"
@@ -131,11 +138,18 @@ FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::
   return {io::FrameSchedule::fixedRate(rate, total), "at " + rateText + " fps"};
 }
 
-std::filesystem::path cachePath(const std::filesystem::path& dir, std::int64_t frame,
-                                const char* extension) {
-  char name[64];
-  std::snprintf(name, sizeof name, "frame_%04" PRId64 ".%s", frame, extension);
-  return dir / name;
+// A --vdb-* option's value, by the names VdbCacheOptions gives.
+template <typename Named>
+auto parseVdbChoice(const std::string& option, const std::string& value,
+                    const std::vector<std::string>& names, Named named) {
+  const auto choice = named(value);
+  if (!choice) {
+    std::string expected;
+    for (const std::string& name : names) expected += (expected.empty() ? "" : " or ") + name;
+    throw UsageError("run: " + option + ": unknown value '" + value + "' (expected " + expected +
+                     ")");
+  }
+  return *choice;
 }
 
 // "DIR (frame_0001 to frame_0036)": where a run's caches are, as its messages name them.
@@ -218,6 +232,10 @@ int runCommand(Arguments& args) {
   const auto checkpointDir = args.value("--checkpoint-dir");
   const auto resume = args.value("--resume");
   const auto threads = args.value("--threads");
+  const auto vdbCompression = args.value("--vdb-compression");
+  const auto vdbPositions = args.value("--vdb-positions");
+  const bool durable = args.flag("--durable");
+  const bool overlap = !args.flag("--no-overlap");
   const bool printHash = args.flag("--hash");
   const bool quiet = args.flag("--quiet");
   const std::string effectPath = args.positionals(1, "one effect file: tickfx run EFFECT.toml")[0];
@@ -253,10 +271,23 @@ int runCommand(Arguments& args) {
   const std::filesystem::path checkpoints =
       checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
   const std::uint64_t effectHash = load.fingerprint;
+  io::CacheTargets targets;
+  targets.directory = outDir;
+  targets.formats = formats;
   // What a VDB cache records of the run, for the pipeline that reads it.
-  const io::VdbCacheMetadata vdbMeta{hashToHex(effectHash), effect.simulation.seed,
-                                     effect.simulation.stepRateHz, effect.simulation.integrator,
-                                     TICKFX_VERSION};
+  targets.vdbMetadata = io::VdbCacheMetadata{hashToHex(effectHash), effect.simulation.seed,
+                                             effect.simulation.stepRateHz,
+                                             effect.simulation.integrator, TICKFX_VERSION};
+  targets.vdbOptions = effect.output.vdb;
+  if (vdbCompression) {
+    targets.vdbOptions.compression = parseVdbChoice(
+        "--vdb-compression", *vdbCompression, io::vdbCompressionNames(), io::vdbCompressionNamed);
+  }
+  if (vdbPositions) {
+    targets.vdbOptions.positions = parseVdbChoice("--vdb-positions", *vdbPositions,
+                                                  io::vdbPositionsNames(), io::vdbPositionsNamed);
+  }
+  targets.durability = durable ? io::Durability::Synced : io::Durability::Renamed;
 
   // Building loads the effect's vector fields: a file that does not load is bad input, reported
   // like an effect error, before anything is written. The lint comes after, so that such a file
@@ -303,7 +334,7 @@ int runCommand(Arguments& args) {
   try {
     if (!formats.empty()) std::filesystem::create_directories(outDir);
     if (every > 0) std::filesystem::create_directories(checkpoints);
-    if (!formats.empty()) io::requireWritable(cachePath(outDir, firstFrame, "tmp"));
+    if (!formats.empty()) io::requireWritable(io::cacheFilePath(outDir, firstFrame, "tmp"));
     if (every > 0) io::requireWritable(checkpointPath(checkpoints, firstFrame));
     if (dump) io::requireWritable(*dump);
     if (trace) io::requireWritable(*trace);
@@ -320,34 +351,44 @@ int runCommand(Arguments& args) {
 
   const auto wallStart = std::chrono::steady_clock::now();
   ProgressLine progress;
-  std::int64_t lastFrame = firstFrame - 1;  // every file of frames up to this one is whole
+  std::int64_t lastFrame = firstFrame - 1;  // the last frame simulated
   const std::optional<std::filesystem::path> cacheDir =
       formats.empty() ? std::nullopt : std::optional(outDir);
+  // Frame f's files are written while frame f + 1 simulates; the writer holds at most one frame.
+  io::BackgroundWriter writer(
+      [&targets](const io::FrameData& d) { io::writeFrameCaches(d, targets); },
+      overlap && !formats.empty());
+  // Every file of frames up to this one is whole (once the writer is idle).
+  const auto writtenThrough = [&] {
+    return formats.empty() ? lastFrame : writer.lastWritten().value_or(firstFrame - 1);
+  };
+  double simulationSeconds = 0.0;
   const InterruptCatcher interrupts;
   try {
     while (InterruptCatcher::caught() == 0) {
       const std::optional<Flicks> duration = schedule.next();
       if (!duration) break;
       const std::int64_t f = schedule.framesDone();
+      const auto simulationStart = std::chrono::steady_clock::now();
       system->advance(*duration);
       if (system->nonfiniteStop()) {
         // The frame holding the tick is not written; those before it are, whole.
+        writer.finish();
         progress.finish();
-        reportNonfiniteStop(effectPath, *system->nonfiniteStop(), lint, lastFrame, firstFrame,
-                            cacheDir);
+        reportNonfiniteStop(effectPath, *system->nonfiniteStop(), lint, writtenThrough(),
+                            firstFrame, cacheDir);
         return kExitFailure;
       }
       elapsed += *duration;
-      if (!formats.empty()) {
-        const io::FrameData data = io::captureFrame(*system, f, secondsFromFlicks(elapsed));
-        for (io::CacheFormat fmt : formats) {
-          if (fmt == io::CacheFormat::Csv) io::writeCsvCache(data, cachePath(outDir, f, "csv"));
-          if (fmt == io::CacheFormat::Ply) io::writePlyCache(data, cachePath(outDir, f, "ply"));
-          if (fmt == io::CacheFormat::Vdb)
-            io::writeVdbPointCache(data, vdbMeta, cachePath(outDir, f, "vdb"));
-        }
-      }
+      std::optional<io::FrameData> data;
+      if (!formats.empty()) data = io::captureFrame(*system, f, secondsFromFlicks(elapsed));
+      simulationSeconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - simulationStart).count();
+      if (data) writer.submit(std::move(*data));
       if (every > 0 && f % every == 0) {
+        // A checkpoint at frame f promises the caches through f: a run resumed from it writes
+        // from f + 1 on.
+        writer.finish();
         io::writeCheckpoint(checkpointPath(checkpoints, f), *system,
                             io::CheckpointInfo{effectHash, f, elapsed});
       }
@@ -355,6 +396,7 @@ int runCommand(Arguments& args) {
       progress.update(f, secondsFromFlicks(elapsed), secondsFromFlicks(schedule.total()),
                       system->pool().size());
     }
+    writer.finish();
     if (const int signal = InterruptCatcher::caught()) {
       progress.finish();
       // The state is that of the end of lastFrame: a checkpoint of it, unless one was just made.
@@ -371,9 +413,10 @@ int runCommand(Arguments& args) {
       return 128 + signal;
     }
   } catch (const io::WriteError& e) {
+    writer.drain();
     progress.finish();
     std::fprintf(stderr, "%s\n", e.what());
-    reportWritten(lastFrame, firstFrame, cacheDir);
+    reportWritten(writtenThrough(), firstFrame, cacheDir);
     return kExitFailure;
   }
   progress.finish();
@@ -403,7 +446,16 @@ int runCommand(Arguments& args) {
       std::printf("removed for a non-finite position or velocity: %llu\n",
                   static_cast<unsigned long long>(system->nonfiniteKilled()));
     }
-    std::printf("wall time: %.3f s\n", wall);
+    if (formats.empty()) {
+      std::printf("wall time: %.3f s\n", wall);
+    } else {
+      // What writing cost on top of simulating: the overlap is the time both went on at once.
+      const double writing = writer.writeSeconds();
+      std::printf("wall time: %.3f s (simulating %.3f s, writing caches %.3f s, %s %.3f s)\n", wall,
+                  simulationSeconds, writing,
+                  overlap ? "overlapped" : "not overlapped (--no-overlap):",
+                  std::max(0.0, simulationSeconds + writing - wall));
+    }
     if (!formats.empty() && lastFrame >= firstFrame) {
       std::printf("caches: %s\n", cacheRange(outDir, firstFrame, lastFrame).c_str());
     }

@@ -10,7 +10,7 @@
 
 #include "app/Commands.h"
 #include "io/AtomicFile.h"
-#include "io/EffectSettings.h"
+#include "io/effect/EffectSettings.h"
 
 namespace {
 

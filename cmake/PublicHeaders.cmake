@@ -39,15 +39,20 @@ set(TICKFX_VDB_PUBLIC_HEADERS
 
 # COMPONENTS effects (tickfx::effects): effect files, loadEffect(), caches.
 set(TICKFX_EFFECTS_PUBLIC_HEADERS
-  io/CsvCache.h
-  io/Diagnostics.h
-  io/EffectLint.h
-  io/EffectLoader.h
-  io/EffectParser.h
-  io/EffectSettings.h
+  io/AtomicFile.h
   io/Fingerprint.h
-  io/FrameData.h
-  io/PlyCache.h
-  io/SourceMap.h
-  io/VdbPointCache.h
+  io/cache/BackgroundWriter.h
+  io/cache/CacheFormat.h
+  io/cache/CsvCache.h
+  io/cache/FrameCaches.h
+  io/cache/FrameData.h
+  io/cache/PlyCache.h
+  io/cache/VdbCacheOptions.h
+  io/cache/VdbPointCache.h
+  io/effect/Diagnostics.h
+  io/effect/EffectLint.h
+  io/effect/EffectLoader.h
+  io/effect/EffectParser.h
+  io/effect/EffectSettings.h
+  io/effect/SourceMap.h
 )

@@ -33,12 +33,19 @@ class CheckedFileBuffer final : public std::streambuf {
     return traits_type::not_eof(c);
   }
   int sync() override { return drain(); }
+  // A block as large as the buffer goes to the file as it is: copying megabytes of a cache
+  // through 64 KiB would cost a pass over them for nothing.
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    if (n < static_cast<std::streamsize>(buffer_.size())) return std::streambuf::xsputn(s, n);
+    if (drain() != 0 || writeAll(s, s + n) != 0) return 0;
+    return n;
+  }
 
  private:
-  int drain() {
+  int writeAll(const char* p, const char* end) {
     if (error_ != 0) return -1;
-    for (const char* p = pbase(); p < pptr();) {
-      const ssize_t n = ::write(fd_, p, static_cast<std::size_t>(pptr() - p));
+    while (p < end) {
+      const ssize_t n = ::write(fd_, p, static_cast<std::size_t>(end - p));
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) {
         error_ = n < 0 ? errno : EIO;
@@ -46,6 +53,10 @@ class CheckedFileBuffer final : public std::streambuf {
       }
       p += n;
     }
+    return 0;
+  }
+  int drain() {
+    if (writeAll(pbase(), pptr()) != 0) return -1;
     resetPut();
     return 0;
   }

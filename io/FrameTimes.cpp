@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/EffectSettings.h"
+#include "io/effect/EffectSettings.h"
 #include "particles/Random.h"
 
 namespace tickfx::io {

@@ -49,7 +49,7 @@ class FrameSchedule {
 };
 
 /// The length of `count` frames at `rate`, in flicks. Throws std::runtime_error "WHAT: ..." when
-/// it is longer than kMaxRunSeconds (io/EffectSettings.h).
+/// it is longer than kMaxRunSeconds (io/effect/EffectSettings.h).
 Flicks lengthOfFrames(FrameRate rate, std::int64_t count, const std::string& what);
 
 /// Frames of one `rate` covering exactly `total` flicks: whole frames, then one shorter last frame

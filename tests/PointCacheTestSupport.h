@@ -1,5 +1,5 @@
-// What the tests of VDB point caches (io/VdbPointCache) share: the smallest cache, and the one
-// damage to it that OpenVDB 10 asserted on.
+// What the tests of VDB point caches (io/cache/VdbPointCache) share: the smallest cache, and the
+// one damage to it that OpenVDB 10 asserted on.
 #pragma once
 
 #include <cstddef>
@@ -8,7 +8,8 @@
 #include <iterator>
 #include <string>
 
-#include "io/FrameData.h"
+#include "io/cache/FrameData.h"
+#include "io/cache/VdbCacheOptions.h"
 
 namespace tickfx::test {
 
@@ -28,11 +29,16 @@ inline io::FrameData onePointFrame() {
   return one;
 }
 
-/// In the cache `file` of onePointFrame(), adds one to the byte count of its first attribute
-/// array (P: 6 + 12 bytes, a little-endian uint64, the first 8 bytes of the file that read 18),
-/// so that the array claims 13 bytes of data where 12 are there: OpenVDB 10's paged stream
-/// asserted on it (mByteIndex <= mUncompressedBytes). Returns the count's offset in the file,
-/// the byte a refusal names, or std::string::npos (and leaves the file alone) without one.
+/// OpenVDB writes attribute arrays in pages (a page header, then each array's bytes) only when it
+/// compresses them: the one layout whose damage OpenVDB 10 asserted on.
+inline constexpr io::VdbCacheOptions kPagedArrays{io::VdbCacheOptions::Compression::Blosc};
+
+/// In the cache `file` of onePointFrame() written with kPagedArrays, adds one to the byte count of
+/// its first attribute array (P: 6 + 12 bytes, a little-endian uint64, the first 8 bytes of the
+/// file that read 18), so that the array claims 13 bytes of data where 12 are there: OpenVDB 10's
+/// paged stream asserted on it (mByteIndex <= mUncompressedBytes). Returns the count's offset in
+/// the file, the byte a refusal names, or std::string::npos (and leaves the file alone) without
+/// one.
 inline std::size_t overstateFirstAttributeArray(const std::filesystem::path& file) {
   std::string bytes;
   {

@@ -1,4 +1,4 @@
-# VDB point caches (io/VdbPointCache) and the file emitter ([[emitters]] type = "file"): the
+# VDB point caches (io/cache/VdbPointCache) and the file emitter ([[emitters]] type = "file"): the
 # cache read back through OpenVDB itself, the emitter fed from CSV and VDB files with its
 # effect-file messages, and `tickfx run --format vdb` as a user runs it, checked with vdb_print
 # when it is installed. The io/ suites are named io* so that `ctest -R io` selects them. Every

@@ -13,8 +13,8 @@
 #include <string>
 
 #include "CliTestSupport.h"
-#include "io/CsvCache.h"
-#include "io/PlyCache.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/PlyCache.h"
 
 namespace fs = std::filesystem;
 

@@ -14,10 +14,10 @@
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
-#include "io/EffectBuilder.h"
-#include "io/EffectParser.h"
-#include "io/FrameData.h"
 #include "io/FrameTimes.h"
+#include "io/cache/FrameData.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectParser.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
 

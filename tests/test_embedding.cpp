@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "io/Checkpoint.h"
-#include "io/EffectLoader.h"
+#include "io/cache/Checkpoint.h"
+#include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"
 #include "tests/WorkerPool.h"

@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "VdbTestData.h"
-#include "io/CsvCache.h"
-#include "io/EffectBuilder.h"
-#include "io/EffectParser.h"
-#include "io/VdbPointCache.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/VdbPointCache.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectParser.h"
 #include "particles/Emitter.h"
 #include "particles/ParticleSystem.h"
 

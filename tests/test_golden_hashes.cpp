@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "io/EffectBuilder.h"
-#include "io/EffectParser.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"
 #include "tests/WorkerPool.h"

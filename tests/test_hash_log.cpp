@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "CliTestSupport.h"
-#include "io/Checkpoint.h"
+#include "io/cache/Checkpoint.h"
 #include "particles/StateHash.h"
 
 namespace {

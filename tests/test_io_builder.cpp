@@ -10,8 +10,8 @@
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
-#include "io/EffectBuilder.h"
-#include "io/EffectParser.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::io {

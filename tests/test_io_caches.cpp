@@ -13,10 +13,10 @@
 #include <utility>
 
 #include "fields/Gravity.h"
-#include "io/CsvCache.h"
-#include "io/FrameData.h"
 #include "io/FrameTimes.h"
-#include "io/PlyCache.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/FrameData.h"
+#include "io/cache/PlyCache.h"
 #include "particles/ParticleSystem.h"
 
 namespace fs = std::filesystem;

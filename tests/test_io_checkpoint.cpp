@@ -20,8 +20,8 @@
 
 #include "CoreTestSupport.h"
 #include "fields/Gravity.h"
-#include "io/Checkpoint.h"
-#include "io/EffectParser.h"
+#include "io/cache/Checkpoint.h"
+#include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 
 namespace fs = std::filesystem;

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "io/EffectBuilder.h"
-#include "io/EffectLint.h"
-#include "io/EffectParser.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectLint.h"
+#include "io/effect/EffectParser.h"
 
 namespace tickfx::io {
 namespace {

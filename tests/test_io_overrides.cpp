@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "io/EffectParser.h"
-#include "io/SettingOverrides.h"
+#include "io/effect/EffectParser.h"
+#include "io/effect/SettingOverrides.h"
 
 namespace tickfx::io {
 namespace {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "io/EffectParser.h"
+#include "io/effect/EffectParser.h"
 
 namespace tickfx::io {
 namespace {

@@ -13,9 +13,9 @@
 
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
-#include "io/EffectBuilder.h"
-#include "io/EffectLint.h"
-#include "io/EffectParser.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectLint.h"
+#include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::io {

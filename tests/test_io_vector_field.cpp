@@ -17,10 +17,10 @@
 #include <vector>
 
 #include "fields/AnalyticField.h"
-#include "io/EffectBuilder.h"
-#include "io/EffectLint.h"
-#include "io/EffectParser.h"
-#include "io/VectorFieldSource.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectLint.h"
+#include "io/effect/EffectParser.h"
+#include "io/effect/VectorFieldSource.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::io {

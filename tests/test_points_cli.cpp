@@ -14,8 +14,8 @@
 
 #include "CliTestSupport.h"
 #include "PointCacheTestSupport.h"
-#include "io/CsvCache.h"
-#include "io/VdbPointCache.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/VdbPointCache.h"
 
 namespace fs = std::filesystem;
 
@@ -157,7 +157,7 @@ TEST_F(CliPoints, ACorruptPointsFileIsAnEffectErrorNotACrash) {
   // A one-point cache whose first attribute array (P) says it holds 13 bytes, one too many: the
   // paged stream of OpenVDB 10 asserted on it, so `check` and `run` died of SIGABRT (exit 134).
   tickfx::io::writeVdbPointCache(tickfx::test::onePointFrame(), tickfx::io::VdbCacheMetadata{},
-                                 path("pts.vdb"));
+                                 path("pts.vdb"), tickfx::test::kPagedArrays);
   const std::size_t at = tickfx::test::overstateFirstAttributeArray(path("pts.vdb"));
   ASSERT_NE(at, std::string::npos);
   std::ofstream(path("fx.toml")) << "format_version = 1\n[simulation]\nstep_rate = 60\n"

@@ -1,4 +1,4 @@
-// VDB point caches (io/VdbPointCache): a frame read back through OpenVDB itself has every
+// VDB point caches (io/cache/VdbPointCache): a frame read back through OpenVDB itself has every
 // attribute's bits and the run's metadata; broken files fail with the file and grid named.
 // Every file is written into a temporary directory of the test and removed afterwards.
 #include <gtest/gtest.h>
@@ -18,8 +18,8 @@
 #include "FlippedBitTestSupport.h"
 #include "PointCacheTestSupport.h"
 #include "VdbTestData.h"
-#include "io/FrameData.h"
-#include "io/VdbPointCache.h"
+#include "io/cache/FrameData.h"
+#include "io/cache/VdbPointCache.h"
 
 namespace tickfx::io {
 namespace {
@@ -393,36 +393,44 @@ TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
     }
     frame.attributes[0][i] = static_cast<float>(i);
   }
-  writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
-  const std::string bytes = fileBytes(path("f.vdb"));
-  ASSERT_GT(bytes.size(), 10000u);  // the root's child alone has two 4 KB masks
+  // Every layout a cache can have: arrays whole, in blosc pages, positions in fixed point.
+  using Options = VdbCacheOptions;
+  const std::pair<const char*, Options> layouts[] = {
+      {"the default", Options{}},
+      {"blosc", Options{Options::Compression::Blosc, Options::Positions::Exact}},
+      {"fixed16", Options{Options::Compression::None, Options::Positions::Fixed16}}};
+  for (const auto& [label, options] : layouts) {
+    writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"), options);
+    const std::string bytes = fileBytes(path("f.vdb"));
+    ASSERT_GT(bytes.size(), 10000u);  // the root's child alone has two 4 KB masks
 
-  // Bit i mod 8 of byte i flipped, each its own file. OpenVDB 10 trusts the sizes, counts and
-  // flags it reads: on hundreds of these files it aborted on an assertion (its paged streams,
-  // blosc pages), crashed, or allocated gigabytes. Each now reads, or is refused naming the file.
-  const test::FlippedBits flips = test::loadEveryFlippedBit(
-      bytes, [&](std::size_t i) { return path("flip" + std::to_string(i) + ".vdb").string(); },
-      "points",
-      [&](const std::string& file, std::size_t i) {
-        const FrameData back = readVdbPointCache(file);
-        // What was read is a frame of the cache's size, whatever values the flip changed.
-        EXPECT_EQ(back.size(), frame.size()) << "byte " << i;
-      });
-  const std::size_t read = flips.loaded, refused = flips.refusals.size();
-  std::size_t corrupt = 0;
-  for (const std::string& what : flips.refusals) {
-    if (what.find("the file is corrupt at byte ") != std::string::npos) ++corrupt;
+    // Bit i mod 8 of byte i flipped, each its own file. OpenVDB 10 trusts the sizes, counts and
+    // flags it reads: on hundreds of these files it aborted on an assertion (its paged streams,
+    // blosc pages), crashed, or allocated gigabytes. Each now reads, or is refused naming the file.
+    const test::FlippedBits flips = test::loadEveryFlippedBit(
+        bytes, [&](std::size_t i) { return path("flip" + std::to_string(i) + ".vdb").string(); },
+        "points",
+        [&](const std::string& file, std::size_t i) {
+          const FrameData back = readVdbPointCache(file);
+          // What was read is a frame of the cache's size, whatever values the flip changed.
+          EXPECT_EQ(back.size(), frame.size()) << "byte " << i << " of " << label;
+        });
+    const std::size_t read = flips.loaded, refused = flips.refusals.size();
+    std::size_t corrupt = 0;
+    for (const std::string& what : flips.refusals) {
+      if (what.find("the file is corrupt at byte ") != std::string::npos) ++corrupt;
+    }
+    EXPECT_EQ(read + refused, bytes.size()) << label;
+    // Values (positions, velocities, metadata values, unused bits) still read; most of the bytes
+    // are structure, and most refusals name the byte where the file stops making sense.
+    EXPECT_GT(read, 300u) << label;
+    EXPECT_GT(refused, bytes.size() / 2) << label;
+    EXPECT_GT(corrupt, refused / 2) << label;
   }
-  EXPECT_EQ(read + refused, bytes.size());
-  // Values (positions, velocities, metadata values, unused bits) still read; most of the bytes are
-  // structure, and most refusals name the byte where the file stops making sense.
-  EXPECT_GT(read, 300u);
-  EXPECT_GT(refused, bytes.size() / 2);
-  EXPECT_GT(corrupt, refused / 2);
 
   // The first attribute array's byte count (a uint64, 6 + 12 bytes for one point's P) one too
   // many: OpenVDB's paged stream asserted (mByteIndex <= mUncompressedBytes).
-  writeVdbPointCache(test::onePointFrame(), sampleMetadata(), path("one.vdb"));
+  writeVdbPointCache(test::onePointFrame(), sampleMetadata(), path("one.vdb"), test::kPagedArrays);
   const std::size_t at = test::overstateFirstAttributeArray(path("one.vdb"));
   ASSERT_NE(at, std::string::npos);
   EXPECT_EQ(errorOf(path("one.vdb")), path("one.vdb").string() +

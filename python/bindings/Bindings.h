@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/FrameData.h"
+#include "io/cache/FrameData.h"
 
 namespace tickfx::python {
 

@@ -17,9 +17,9 @@
 #include <tuple>
 #include <vector>
 
-#include "io/CsvCache.h"
-#include "io/PlyCache.h"
-#include "io/VdbPointCache.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/PlyCache.h"
+#include "io/cache/VdbPointCache.h"
 #include "python/bindings/Bindings.h"
 
 namespace tickfx::python {

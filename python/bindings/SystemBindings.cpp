@@ -14,8 +14,8 @@
 #include <utility>
 #include <vector>
 
-#include "io/EffectLoader.h"
-#include "io/FrameData.h"
+#include "io/cache/FrameData.h"
+#include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 #include "python/bindings/Bindings.h"
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <vector>
 
-#include <tickfx/io/EffectLoader.h>
+#include <tickfx/io/effect/EffectLoader.h>
 #include <tickfx/particles/StateHash.h>
 
 int main(int argc, char** argv) {

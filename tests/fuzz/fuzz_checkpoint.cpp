@@ -18,9 +18,9 @@
 #include <string>
 
 #include "FuzzScratch.h"
-#include "io/Checkpoint.h"
-#include "io/EffectLoader.h"
 #include "io/Fingerprint.h"
+#include "io/cache/Checkpoint.h"
+#include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 
 namespace {

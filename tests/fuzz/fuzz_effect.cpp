@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "FuzzScratch.h"
-#include "io/EffectLoader.h"
-#include "io/EffectParser.h"
-#include "io/VectorFieldSource.h"
+#include "io/effect/EffectLoader.h"
+#include "io/effect/EffectParser.h"
+#include "io/effect/VectorFieldSource.h"
 
 namespace {
 

@@ -6,9 +6,9 @@
 #include <stdexcept>
 
 #include "FuzzScratch.h"
-#include "io/CsvCache.h"
-#include "io/PlyCache.h"
-#include "io/VdbPointCache.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/PlyCache.h"
+#include "io/cache/VdbPointCache.h"
 
 namespace {
 

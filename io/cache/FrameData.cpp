@@ -1,0 +1,59 @@
+#include "io/cache/FrameData.h"
+
+#include "io/Fingerprint.h"
+#include "particles/ParticleSystem.h"
+
+namespace tickfx::io {
+
+void FrameData::resize(std::size_t rows, std::vector<std::string> names) {
+  const auto n = static_cast<Eigen::Index>(rows);
+  id.resize(rows);
+  position.resize(n);
+  velocity.resize(n);
+  age.resize(n);
+  life.resize(n);
+  mass.resize(n);
+  attributeNames = std::move(names);
+  attributes.assign(attributeNames.size(), FloatColumn(n));
+}
+
+FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double timeSeconds) {
+  const ParticlePool& pool = system.pool();
+  const auto n = static_cast<Eigen::Index>(pool.size());
+  FrameData data;
+  data.frame = frame;
+  data.timeSeconds = timeSeconds;
+  data.id.assign(pool.id().begin(), pool.id().begin() + n);
+  system.renderPositions(data.position);
+  system.renderVelocities(data.velocity);
+  system.renderAges(data.age);
+  data.life = pool.lifetime().head(n);
+  data.mass = pool.mass().head(n);
+  for (std::size_t a = 0; a < pool.attributeCount(); ++a) {
+    data.attributeNames.push_back(pool.attributeName(a));
+    data.attributes.emplace_back(pool.attribute(a).head(n));
+  }
+  return data;
+}
+
+std::uint64_t frameHash(const FrameData& data) {
+  const std::size_t n = data.size();
+  std::string bytes;
+  auto append = [&](const void* p, std::size_t size) {
+    bytes.append(static_cast<const char*>(p), size);
+  };
+  auto appendFloats = [&](const FloatColumn& c) { append(c.data(), n * sizeof(float)); };
+  append(&n, sizeof n);
+  append(data.id.data(), n * sizeof(std::uint64_t));
+  for (const Vec3Column* v : {&data.position, &data.velocity}) {
+    for (int k = 0; k < 3; ++k) appendFloats((*v)[k]);
+  }
+  for (const FloatColumn* c : {&data.age, &data.life, &data.mass}) appendFloats(*c);
+  for (std::size_t a = 0; a < data.attributes.size(); ++a) {
+    bytes += data.attributeNames[a] + '\0';
+    appendFloats(data.attributes[a]);
+  }
+  return fingerprint(bytes);
+}
+
+}  // namespace tickfx::io

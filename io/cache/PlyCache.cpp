@@ -1,0 +1,154 @@
+#include "io/cache/PlyCache.h"
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "io/AtomicFile.h"
+#include "io/cache/RowBlocks.h"
+
+namespace tickfx::io {
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "PLY caches are written little-endian by copying memory");
+
+constexpr std::size_t kPlyRowsPerBlock = 32768;
+
+const char* const kFixedFloats[] = {"x", "y", "z", "vx", "vy", "vz", "age", "life", "mass"};
+
+std::vector<const FloatColumn*> floatColumns(const FrameData& f) {
+  std::vector<const FloatColumn*> cols = {&f.position.x, &f.position.y, &f.position.z,
+                                          &f.velocity.x, &f.velocity.y, &f.velocity.z,
+                                          &f.age,        &f.life,       &f.mass};
+  for (const FloatColumn& a : f.attributes) cols.push_back(&a);
+  return cols;
+}
+
+}  // namespace
+
+void writePlyCache(const FrameData& frame, const std::filesystem::path& path,
+                   Durability durability) {
+  writeFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out << "ply\nformat binary_little_endian 1.0\n";
+        out << "comment tickfx frame " << frame.frame << "\n";
+        char time[64];
+        std::snprintf(time, sizeof time, "%.17g", frame.timeSeconds);
+        out << "comment time " << time << "\n";
+        out << "element vertex " << frame.size() << "\n";
+        out << "property double id\n";
+        for (const char* name : kFixedFloats) out << "property float " << name << "\n";
+        for (const std::string& name : frame.attributeNames)
+          out << "property float " << name << "\n";
+        out << "end_header\n";
+        const std::vector<const FloatColumn*> cols = floatColumns(frame);
+        const std::size_t rowBytes = sizeof(double) + cols.size() * sizeof(float);
+        // Column by column into each block's interleaved rows: every pass reads one column in
+        // order.
+        writeRowsInBlocks(out, frame.size(), kPlyRowsPerBlock, rowBytes,
+                          [&](std::size_t begin, std::size_t end, char* bytes) {
+                            for (std::size_t i = begin; i < end; ++i) {
+                              const double id = static_cast<double>(frame.id[i]);
+                              std::memcpy(bytes + (i - begin) * rowBytes, &id, sizeof id);
+                            }
+                            for (std::size_t c = 0; c < cols.size(); ++c) {
+                              const float* const column = cols[c]->data();
+                              char* at = bytes + sizeof(double) + c * sizeof(float);
+                              for (std::size_t i = begin; i < end; ++i, at += rowBytes)
+                                std::memcpy(at, column + i, sizeof(float));
+                            }
+                            return (end - begin) * rowBytes;
+                          });
+      },
+      durability);
+}
+
+FrameData readPlyCache(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open");
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(path.string() + ": " + what);
+  };
+  std::string line;
+  if (!std::getline(in, line) || line != "ply") fail("not a PLY file");
+  if (!std::getline(in, line) || line != "format binary_little_endian 1.0")
+    fail("not binary little-endian PLY");
+  FrameData frame;
+  std::size_t count = 0;
+  std::vector<std::string> floats;
+  bool sawId = false;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream words(line);
+    std::string word, type, name;
+    words >> word;
+    if (word == "comment") {
+      words >> name;
+      if (name == "tickfx") words >> name;  // "comment tickfx frame N"
+      if (name == "frame") words >> frame.frame;
+      if (name == "time") words >> frame.timeSeconds;
+    } else if (word == "element") {
+      words >> name >> count;
+      if (name != "vertex") fail("unexpected element '" + name + "'");
+    } else if (word == "property") {
+      words >> type >> name;
+      if (type == "double" && name == "id" && floats.empty()) {
+        sawId = true;
+      } else if (type == "float") {
+        floats.push_back(name);
+      } else {
+        fail("unexpected property '" + line + "'");
+      }
+    } else {
+      fail("unexpected header line '" + line + "'");
+    }
+  }
+  if (line != "end_header" || !sawId || floats.size() < 9) fail("incomplete header");
+  for (std::size_t k = 0; k < 9; ++k) {
+    if (floats[k] != kFixedFloats[k]) fail("unexpected property order at '" + floats[k] + "'");
+  }
+  // The body's size is known from the header: checked against the file before any row is
+  // allocated, so a damaged count is a message, not an allocation of its size.
+  const std::size_t rowBytes = sizeof(double) + floats.size() * sizeof(float);
+  const std::streamoff bodyStart = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff fileEnd = in.tellg();
+  in.seekg(bodyStart);
+  const auto bodyBytes = static_cast<std::uint64_t>(fileEnd - bodyStart);
+  if (count > bodyBytes / rowBytes) {
+    fail("truncated body (" + std::to_string(count) + " vertices of " + std::to_string(rowBytes) +
+         " bytes, " + std::to_string(bodyBytes) + " bytes after the header)");
+  }
+  frame.resize(count, std::vector<std::string>(floats.begin() + 9, floats.end()));
+  std::vector<FloatColumn*> cols = {&frame.position.x, &frame.position.y, &frame.position.z,
+                                    &frame.velocity.x, &frame.velocity.y, &frame.velocity.z,
+                                    &frame.age,        &frame.life,       &frame.mass};
+  for (FloatColumn& a : frame.attributes) cols.push_back(&a);
+  std::vector<char> row(rowBytes);
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!in.read(row.data(), static_cast<std::streamsize>(row.size()))) fail("truncated body");
+    double id = 0;
+    std::memcpy(&id, row.data(), sizeof id);
+    // Ids are written as doubles (exact below 2⁵³); anything else is not an id.
+    if (!(id >= 0.0 && id < 0x1p64 && id == std::floor(id))) {
+      char text[40];
+      std::snprintf(text, sizeof text, "%.17g", id);
+      fail("vertex " + std::to_string(i) + ": id " + text + " is not a whole number in [0, 2^64)");
+    }
+    frame.id[i] = static_cast<std::uint64_t>(id);
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      std::memcpy(&(*cols[c])[static_cast<Eigen::Index>(i)],
+                  row.data() + sizeof(double) + c * sizeof(float), sizeof(float));
+    }
+  }
+  return frame;
+}
+
+}  // namespace tickfx::io

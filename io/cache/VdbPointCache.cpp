@@ -1,0 +1,521 @@
+#include "io/cache/VdbPointCache.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointDataGrid.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <type_traits>
+#include <vector>
+
+#include "fields/VdbGridFile.h"
+#include "io/AtomicFile.h"
+#include "io/Fingerprint.h"
+
+namespace tickfx::io {
+namespace {
+
+namespace vdbp = openvdb::points;
+
+const std::string kGridName = "points";
+// Points whose coordinates are within this bound sit in their nearest voxel; beyond it (or not
+// finite) in voxel 0 of that axis. Far inside the 32-bit voxel indices, with room for a tree's
+// nodes around them.
+constexpr double kLargestIndex = 1073741824.0;  // 2³⁰
+
+const char* const kMetaEffectHash = "tickfx_effect_hash";
+const char* const kMetaSeed = "tickfx_seed";
+const char* const kMetaStepRate = "tickfx_step_rate";
+const char* const kMetaIntegrator = "tickfx_integrator";
+const char* const kMetaFrame = "tickfx_frame";
+const char* const kMetaTime = "tickfx_time";
+const char* const kMetaVersion = "tickfx_version";
+const char* const kMetaPointCount = "tickfx_point_count";
+
+using PositionArray = vdbp::TypedAttributeArray<openvdb::Vec3f, vdbp::NullCodec>;
+using QuantisedPositionArray =
+    vdbp::TypedAttributeArray<openvdb::Vec3f, vdbp::FixedPointCodec<false, vdbp::PositionRange>>;
+using VectorArray = vdbp::TypedAttributeArray<openvdb::Vec3f, vdbp::NullCodec>;
+using IdArray = vdbp::TypedAttributeArray<std::int64_t, vdbp::NullCodec>;
+using FloatArray = vdbp::TypedAttributeArray<float, vdbp::NullCodec>;
+
+std::string where(const std::string& path) { return vdbGridLabel(path, kGridName); }
+
+// ---- writing ---------------------------------------------------------------------------------
+
+// One coordinate x as OpenVDB stores it: voxel index n and offset o with float(n + o) == x
+// bitwise (the voxel size is 1), |o| <= 0.5 in the voxel nearest to x. When that is not exact
+// (x beyond the bound, inf, nan; −0.0, whose sign no sum with n = 0 keeps) the coordinate goes
+// whole into voxel 0.
+std::pair<openvdb::Int32, float> place(float x) {
+  if (std::isfinite(x) && std::abs(x) < kLargestIndex) {
+    // Coord::round's rule (floor(x + 0.5)); x − n is exact in float for |x − n| <= 1.
+    const double n = std::floor(static_cast<double>(x) + 0.5);
+    const auto offset = static_cast<float>(static_cast<double>(x) - n);
+    const auto back = static_cast<float>(n + static_cast<double>(offset));
+    if (std::bit_cast<std::uint32_t>(back) == std::bit_cast<std::uint32_t>(x)) {
+      return {static_cast<openvdb::Int32>(n), offset};
+    }
+  }
+  return {0, x};
+}
+
+// The attributes every cache has, in the order they are written; custom ones follow.
+const std::vector<std::string>& standardAttributes() {
+  static const std::vector<std::string> names = {"P", "v", "id", "age", "life", "mass"};
+  return names;
+}
+
+bool isStandard(const std::string& name) {
+  const std::vector<std::string>& names = standardAttributes();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void checkAttributeName(const std::string& name) {
+  if (isStandard(name)) {
+    throw std::invalid_argument("custom attribute '" + name +
+                                "' has the name of a standard attribute of a VDB points cache");
+  }
+  if (!vdbp::AttributeSet::Descriptor::validName(name)) {
+    throw std::invalid_argument("custom attribute '" + name +
+                                "' is not a valid OpenVDB attribute name (letters, digits, '_', "
+                                "'|' and ':')");
+  }
+}
+
+void checkColumns(const FrameData& frame) {
+  const auto rows = static_cast<Eigen::Index>(frame.size());
+  auto sized = [&](const FloatColumn& c) { return c.size() == rows; };
+  bool ok = sized(frame.age) && sized(frame.life) && sized(frame.mass) &&
+            frame.attributes.size() == frame.attributeNames.size();
+  for (int c = 0; c < 3; ++c) ok = ok && sized(frame.position[c]) && sized(frame.velocity[c]);
+  for (const FloatColumn& a : frame.attributes) ok = ok && sized(a);
+  if (!ok) throw std::invalid_argument("frame columns of different lengths");
+  for (const std::string& name : frame.attributeNames) checkAttributeName(name);
+}
+
+using Leaf = vdbp::PointDataTree::LeafNodeType;
+constexpr std::size_t kPlacementGrain = 16384;
+
+// Where a point goes: its leaf, its voxel in the leaf, and its row (which orders the points of a
+// voxel, so the order is total and a parallel sort gives one answer).
+struct PointSlot {
+  openvdb::Coord leaf;
+  openvdb::Index32 voxel = 0;
+  std::size_t row = 0;
+  bool operator<(const PointSlot& o) const {
+    if (leaf != o.leaf) return leaf < o.leaf;
+    if (voxel != o.voxel) return voxel < o.voxel;
+    return row < o.row;
+  }
+};
+
+// A 16-bit fixed-point coordinate needs only its voxel and an offset within ±0.5, not the exact
+// bits: the codec quantises the offset anyway (and turns a NaN into undefined behaviour).
+std::pair<openvdb::Int32, float> placeQuantised(float x) {
+  if (std::isnan(x)) return {0, 0.0f};
+  if (!(std::abs(x) < kLargestIndex)) return {0, x > 0 ? 0.5f : -0.5f};
+  const double n = std::floor(static_cast<double>(x) + 0.5);
+  return {static_cast<openvdb::Int32>(n), static_cast<float>(static_cast<double>(x) - n)};
+}
+
+// The points' slots in leaf, voxel and row order, and each row's offset in its voxel.
+std::vector<PointSlot> placePoints(const FrameData& frame, bool quantised,
+                                   std::vector<openvdb::Vec3f>& offset) {
+  const std::size_t n = frame.size();
+  std::vector<PointSlot> slots(n);
+  offset.resize(n);
+  const auto leafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        openvdb::Coord voxel;
+                        for (int c = 0; c < 3; ++c) {
+                          const float x = frame.position[c][static_cast<Eigen::Index>(i)];
+                          const auto [index, o] = quantised ? placeQuantised(x) : place(x);
+                          voxel[c] = index;
+                          offset[i][c] = o;
+                        }
+                        slots[i] =
+                            PointSlot{voxel & leafMask,
+                                      static_cast<openvdb::Index32>(Leaf::coordToOffset(voxel)), i};
+                      }
+                    });
+  tbb::parallel_sort(slots.begin(), slots.end());
+  return slots;
+}
+
+// One leaf holding slots [begin, end), every attribute filled.
+template <typename PositionArray>
+std::unique_ptr<Leaf> makeLeaf(const FrameData& frame, const std::vector<PointSlot>& slots,
+                               std::size_t begin, std::size_t end,
+                               const std::vector<openvdb::Vec3f>& offset,
+                               const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
+  auto leaf = std::make_unique<Leaf>(slots[begin].leaf);
+  // Each voxel's value is the end of its points in the leaf's arrays.
+  std::vector<openvdb::Index32> counts(Leaf::SIZE, 0);
+  for (std::size_t k = begin; k < end; ++k) ++counts[slots[k].voxel];
+  std::vector<openvdb::PointDataIndex32> offsets(Leaf::SIZE);
+  openvdb::Index32 sum = 0;
+  for (std::size_t v = 0; v < counts.size(); ++v) offsets[v] = sum += counts[v];
+  const auto count = static_cast<openvdb::Index>(end - begin);
+  // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
+  leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, count),
+                            /*allowMismatchingDescriptors=*/true);
+  leaf->setOffsets(offsets);
+
+  vdbp::AttributeWriteHandle<openvdb::Vec3f, typename PositionArray::Codec> p(
+      leaf->attributeArray(0));
+  vdbp::AttributeWriteHandle<openvdb::Vec3f> v(leaf->attributeArray(1));
+  vdbp::AttributeWriteHandle<std::int64_t> id(leaf->attributeArray(2));
+  vdbp::AttributeWriteHandle<float> age(leaf->attributeArray(3));
+  vdbp::AttributeWriteHandle<float> life(leaf->attributeArray(4));
+  vdbp::AttributeWriteHandle<float> mass(leaf->attributeArray(5));
+  std::vector<vdbp::AttributeWriteHandle<float>> custom;
+  const std::size_t firstCustom = standardAttributes().size();
+  for (std::size_t a = 0; a < frame.attributes.size(); ++a)
+    custom.emplace_back(leaf->attributeArray(firstCustom + a));
+  for (openvdb::Index k = 0; k < count; ++k) {
+    const std::size_t i = slots[begin + k].row;
+    const auto r = static_cast<Eigen::Index>(i);
+    p.set(k, offset[i]);
+    v.set(k, openvdb::Vec3f(frame.velocity[0][r], frame.velocity[1][r], frame.velocity[2][r]));
+    id.set(k, static_cast<std::int64_t>(frame.id[i]));
+    age.set(k, frame.age[r]);
+    life.set(k, frame.life[r]);
+    mass.set(k, frame.mass[r]);
+    for (std::size_t a = 0; a < custom.size(); ++a) custom[a].set(k, frame.attributes[a][r]);
+  }
+  return leaf;
+}
+
+template <typename PositionArray>
+vdbp::PointDataTree::Ptr makeTree(const FrameData& frame) {
+  std::vector<openvdb::Vec3f> offset;
+  const std::vector<PointSlot> slots =
+      placePoints(frame, !std::is_same_v<typename PositionArray::Codec, vdbp::NullCodec>, offset);
+  // Each leaf's first slot, and the end.
+  std::vector<std::size_t> starts;
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    if (k == 0 || slots[k].leaf != slots[k - 1].leaf) starts.push_back(k);
+  }
+  starts.push_back(slots.size());
+
+  auto descriptor = vdbp::AttributeSet::Descriptor::create(PositionArray::attributeType());
+  descriptor = descriptor->duplicateAppend("v", VectorArray::attributeType());
+  descriptor = descriptor->duplicateAppend("id", IdArray::attributeType());
+  for (const char* name : {"age", "life", "mass"})
+    descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
+  for (const std::string& name : frame.attributeNames)
+    descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
+
+  // Leaves are independent: filled in parallel (as OpenVDB's point conversion does), then
+  // handed to the tree in order.
+  std::vector<std::unique_ptr<Leaf>> leaves(starts.size() - 1);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t l = range.begin(); l < range.end(); ++l) {
+                        leaves[l] = makeLeaf<PositionArray>(frame, slots, starts[l], starts[l + 1],
+                                                            offset, descriptor);
+                      }
+                    });
+  auto tree = std::make_shared<vdbp::PointDataTree>();
+  for (std::unique_ptr<Leaf>& leaf : leaves) tree->addLeaf(leaf.release());
+  return tree;
+}
+
+openvdb::points::PointDataGrid::Ptr makeGrid(const FrameData& frame, const VdbCacheMetadata& meta,
+                                             const VdbCacheOptions& options) {
+  checkColumns(frame);
+  const std::size_t n = frame.size();
+  const vdbp::PointDataTree::Ptr tree = options.positions == VdbCacheOptions::Positions::Fixed16
+                                            ? makeTree<QuantisedPositionArray>(frame)
+                                            : makeTree<PositionArray>(frame);
+  auto grid = vdbp::PointDataGrid::create(tree);
+  grid->setName(kGridName);
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
+  grid->insertMeta(kMetaEffectHash, openvdb::StringMetadata(meta.effectHash));
+  grid->insertMeta(kMetaSeed, openvdb::Int64Metadata(static_cast<std::int64_t>(meta.seed)));
+  grid->insertMeta(kMetaStepRate, openvdb::Int64Metadata(meta.stepRateHz));
+  grid->insertMeta(kMetaIntegrator, openvdb::StringMetadata(meta.integrator));
+  grid->insertMeta(kMetaFrame, openvdb::Int64Metadata(frame.frame));
+  grid->insertMeta(kMetaTime, openvdb::DoubleMetadata(frame.timeSeconds));
+  grid->insertMeta(kMetaVersion, openvdb::StringMetadata(meta.tickfxVersion));
+  grid->insertMeta(kMetaPointCount, openvdb::Int64Metadata(static_cast<std::int64_t>(n)));
+  return grid;
+}
+
+// ---- reading ---------------------------------------------------------------------------------
+
+template <typename T>
+std::optional<T> metaValue(const openvdb::GridBase& grid, const char* name) {
+  using Meta = openvdb::TypedMetadata<T>;
+  if (const auto m = grid.getMetadata<Meta>(name)) return m->value();
+  return std::nullopt;
+}
+
+// True when `transform` maps every index to the same world coordinates, exactly.
+bool isIdentity(const openvdb::math::Transform& transform) {
+  if (!transform.isLinear()) return false;
+  for (const openvdb::Vec3d& x :
+       {openvdb::Vec3d(0, 0, 0), openvdb::Vec3d(1, 0, 0), openvdb::Vec3d(0, 1, 0),
+        openvdb::Vec3d(0, 0, 1), openvdb::Vec3d(-3, 5, 7)}) {
+    if (transform.indexToWorld(x) != x) return false;
+  }
+  return true;
+}
+
+// The bytes io::File::write() would put in a file, made in memory: File writes through its own
+// std::ofstream and ignores its failures, so a full disk left a truncated .vdb under the frame's
+// name and the run went on. Archive::write() with a seekable stream is what File::write() calls.
+class ArchiveBytes final : public openvdb::io::Archive {
+ public:
+  std::string of(const openvdb::GridCPtrVec& grids) const {
+    std::ostringstream os(std::ios::binary);
+    Archive::write(os, grids, /*seekable=*/true);
+    if (!os) throw std::runtime_error("cannot encode the VDB points grid");
+    return std::move(os).str();
+  }
+};
+
+// OpenVDB stamps every file with a random UUID (36 characters after the header's version fields),
+// so two identical runs would write different bytes. A cache's UUID is made from what the file
+// holds instead: the effect's fingerprint, its seed and the frame (an RFC 9562 version-8 UUID).
+// The header layout is checked first; a layout this build does not know is left as written.
+void stampUuid(std::string& bytes, const VdbCacheMetadata& meta, std::int64_t frame) {
+  constexpr std::size_t kUuidAt = 21;
+  constexpr std::size_t kUuidLength = 36;
+  if (bytes.size() < kUuidAt + kUuidLength) return;
+  const std::string_view uuid(bytes.data() + kUuidAt, kUuidLength);
+  if (std::string_view(bytes.data(), 4) != " BDV" || uuid[8] != '-' || uuid[13] != '-' ||
+      uuid[18] != '-' || uuid[23] != '-') {
+    return;
+  }
+  const std::string key =
+      meta.effectHash + '/' + std::to_string(meta.seed) + '/' + std::to_string(frame);
+  const std::uint64_t hi = fingerprint(key + "/hi"), lo = fingerprint(key + "/lo");
+  char text[kUuidLength + 1];
+  std::snprintf(text, sizeof text, "%08x-%04x-8%03x-%04x-%012llx", static_cast<unsigned>(hi >> 32),
+                static_cast<unsigned>((hi >> 16) & 0xffff), static_cast<unsigned>(hi & 0xfff),
+                static_cast<unsigned>(0x8000 | ((lo >> 48) & 0x3fff)),
+                static_cast<unsigned long long>(lo & 0xffffffffffffULL));
+  bytes.replace(kUuidAt, kUuidLength, text, kUuidLength);
+}
+
+// What OpenVDB reads without comparing (readVdbGrid has checked every size it trusts): a leaf's
+// voxel offsets must rise to its point count, and every attribute array must hold that many
+// points, or the handles below would read past the arrays.
+void checkLeaf(const vdbp::PointDataTree::LeafNodeType& leaf, const std::string& file) {
+  openvdb::Index32 count = 0;
+  for (openvdb::Index n = 0; n < vdbp::PointDataTree::LeafNodeType::SIZE; ++n) {
+    const openvdb::Index32 end = leaf.getValue(n);
+    if (end < count) {
+      throw std::runtime_error(where(file) +
+                               ": a leaf's point offsets decrease (the file is corrupt)");
+    }
+    count = end;
+  }
+  const vdbp::AttributeSet& set = leaf.attributeSet();
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    const vdbp::AttributeArray* a = set.getConst(i);
+    if (a == nullptr || a->size() != count || (!a->isUniform() && a->dataSize() < a->size())) {
+      throw std::runtime_error(where(file) + ": a leaf's attributes do not hold its " +
+                               std::to_string(count) + " points (the file is corrupt)");
+    }
+  }
+}
+
+}  // namespace
+
+void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
+                        const std::filesystem::path& path, const VdbCacheOptions& options,
+                        Durability durability) {
+  openvdb::initialize();
+  const openvdb::GridCPtrVec grids{makeGrid(frame, meta, options)};
+  ArchiveBytes archive;
+  archive.setCompression(options.compression == VdbCacheOptions::Compression::Blosc
+                             ? openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK
+                             : openvdb::io::COMPRESS_ACTIVE_MASK);
+  std::string bytes = archive.of(grids);
+  stampUuid(bytes, meta, frame.frame);
+  writeFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      },
+      durability);
+}
+
+FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents* contents) {
+  const std::string file = path.string();
+  openvdb::initialize();
+  const openvdb::GridBase::Ptr base = readVdbGrid(file, kGridName);
+  const auto grid = openvdb::gridPtrCast<vdbp::PointDataGrid>(base);
+  if (!grid) {
+    throw std::runtime_error(where(file) + ": is a grid of type " + base->type() +
+                             " (expected a PointDataGrid)");
+  }
+  const vdbp::PointDataTree& tree = grid->constTree();
+  const openvdb::math::Transform& transform = grid->constTransform();
+  const bool identity = isIdentity(transform);
+
+  VdbCacheContents found;
+  std::vector<openvdb::Vec3f> position, velocity;
+  std::vector<std::int64_t> id;
+  std::vector<float> age, life, mass;
+  std::vector<std::string> customNames;
+  std::vector<std::vector<float>> custom;
+  bool first = true;
+  for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+    checkLeaf(*leaf, file);
+    const vdbp::AttributeSet::Descriptor& d = leaf->attributeSet().descriptor();
+    // Every leaf of a PointDataGrid shares one descriptor: positions and names are the first
+    // leaf's.
+    const std::size_t pPos = d.find("P");
+    if (pPos == vdbp::AttributeSet::INVALID_POS) {
+      throw std::runtime_error(where(file) + ": the points have no attribute P");
+    }
+    if (!leaf->constAttributeArray(pPos).hasValueType<openvdb::Vec3f>()) {
+      throw std::runtime_error(where(file) + ": P is of type " + d.valueType(pPos) +
+                               " (expected vec3s)");
+    }
+    auto find = [&](const char* name, auto typed) {
+      const std::size_t pos = d.find(name);
+      using T = decltype(typed);
+      if (pos == vdbp::AttributeSet::INVALID_POS) return pos;
+      return leaf->constAttributeArray(pos).template hasValueType<T>()
+                 ? pos
+                 : vdbp::AttributeSet::INVALID_POS;
+    };
+    const std::size_t vPos = find("v", openvdb::Vec3f());
+    const std::size_t idPos = find("id", std::int64_t());
+    const std::size_t id32Pos = find("id", std::int32_t());
+    const std::size_t agePos = find("age", float()), lifePos = find("life", float()),
+                      massPos = find("mass", float());
+    std::vector<std::size_t> customPos;
+    std::vector<std::string> names(d.size());
+    for (const auto& [name, pos] : d.map()) names[pos] = name;
+    for (std::size_t pos = 0; pos < d.size(); ++pos) {
+      if (!isStandard(names[pos]) && leaf->constAttributeArray(pos).hasValueType<float>())
+        customPos.push_back(pos);
+    }
+    if (first) {
+      found.hasVelocity = vPos != vdbp::AttributeSet::INVALID_POS;
+      found.hasId =
+          idPos != vdbp::AttributeSet::INVALID_POS || id32Pos != vdbp::AttributeSet::INVALID_POS;
+      found.hasAge = agePos != vdbp::AttributeSet::INVALID_POS;
+      found.hasLife = lifePos != vdbp::AttributeSet::INVALID_POS;
+      found.hasMass = massPos != vdbp::AttributeSet::INVALID_POS;
+      for (std::size_t pos : customPos) customNames.push_back(names[pos]);
+      custom.resize(customPos.size());
+      first = false;
+    }
+
+    vdbp::AttributeHandle<openvdb::Vec3f> p(leaf->constAttributeArray(pPos));
+    for (auto index = leaf->beginIndexAll(); index; ++index) {
+      const openvdb::Coord ijk = index.getCoord();
+      const openvdb::Vec3f o = p.get(*index);
+      openvdb::Vec3f x;
+      if (identity) {
+        // (ijk + P) · 1 as OpenVDB computes it, but a coordinate of voxel 0 is P as stored, so
+        // that −0.0 stays −0.0.
+        for (int c = 0; c < 3; ++c) {
+          x[c] = ijk[c] == 0
+                     ? o[c]
+                     : static_cast<float>(static_cast<double>(ijk[c]) + static_cast<double>(o[c]));
+        }
+      } else {
+        const openvdb::Vec3d w = transform.indexToWorld(ijk.asVec3d() + openvdb::Vec3d(o));
+        x = openvdb::Vec3f(static_cast<float>(w[0]), static_cast<float>(w[1]),
+                           static_cast<float>(w[2]));
+      }
+      position.push_back(x);
+    }
+    const openvdb::Index count = leaf->pointCount();
+    auto readAll = [&](std::size_t pos, auto& out, auto fallback) {
+      using T = std::decay_t<decltype(fallback)>;
+      if (pos == vdbp::AttributeSet::INVALID_POS) {
+        out.insert(out.end(), count, fallback);
+        return;
+      }
+      vdbp::AttributeHandle<T> h(leaf->constAttributeArray(pos));
+      for (openvdb::Index k = 0; k < count; ++k) out.push_back(h.get(k));
+    };
+    readAll(vPos, velocity, openvdb::Vec3f(0.0f));
+    if (idPos != vdbp::AttributeSet::INVALID_POS) {
+      readAll(idPos, id, std::int64_t{0});
+    } else if (id32Pos != vdbp::AttributeSet::INVALID_POS) {
+      std::vector<std::int32_t> narrow;
+      readAll(id32Pos, narrow, std::int32_t{0});
+      id.insert(id.end(), narrow.begin(), narrow.end());
+    } else {
+      // Without an id the rows are numbered in file order.
+      for (openvdb::Index k = 0; k < count; ++k) id.push_back(static_cast<std::int64_t>(id.size()));
+    }
+    readAll(agePos, age, 0.0f);
+    readAll(lifePos, life, std::numeric_limits<float>::infinity());
+    readAll(massPos, mass, 1.0f);
+    if (customPos.size() != custom.size()) {
+      throw std::runtime_error(where(file) + ": leaves with different attributes");
+    }
+    for (std::size_t a = 0; a < customPos.size(); ++a) readAll(customPos[a], custom[a], 0.0f);
+    if (position.size() != id.size()) {
+      throw std::runtime_error(where(file) + ": a leaf's offsets do not match its attributes");
+    }
+  }
+
+  // Rows in id order (ids are unique in a tickfx cache; equal ids keep the file's order).
+  const std::size_t n = position.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  if (found.hasId) {
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return static_cast<std::uint64_t>(id[a]) < static_cast<std::uint64_t>(id[b]);
+    });
+  }
+  FrameData frame;
+  frame.resize(n, customNames);
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = order[r];
+    const auto row = static_cast<Eigen::Index>(r);
+    for (int c = 0; c < 3; ++c) {
+      frame.position[c][row] = position[i][c];
+      frame.velocity[c][row] = velocity[i][c];
+    }
+    frame.id[r] = static_cast<std::uint64_t>(id[i]);
+    frame.age[row] = age[i];
+    frame.life[row] = life[i];
+    frame.mass[row] = mass[i];
+    for (std::size_t a = 0; a < custom.size(); ++a) frame.attributes[a][row] = custom[a][i];
+  }
+
+  VdbCacheMetadata& meta = found.metadata;
+  meta.effectHash = metaValue<std::string>(*grid, kMetaEffectHash).value_or("");
+  meta.seed = static_cast<std::uint64_t>(metaValue<std::int64_t>(*grid, kMetaSeed).value_or(0));
+  meta.stepRateHz = metaValue<std::int64_t>(*grid, kMetaStepRate).value_or(0);
+  meta.integrator = metaValue<std::string>(*grid, kMetaIntegrator).value_or("");
+  meta.tickfxVersion = metaValue<std::string>(*grid, kMetaVersion).value_or("");
+  frame.frame = metaValue<std::int64_t>(*grid, kMetaFrame).value_or(0);
+  frame.timeSeconds = metaValue<double>(*grid, kMetaTime).value_or(0.0);
+  if (contents != nullptr) *contents = found;
+  return frame;
+}
+
+}  // namespace tickfx::io
