@@ -465,6 +465,13 @@ directory = ""
              "as 24, 25, 30, 60, 120 or \"30000/1001\")",
              "bad.toml:7:11: error: output.formats: got a string \"csv\" (expected an array of "
              "cache formats, such as [\"csv\", \"ply\"])"}));
+  EXPECT_EQ(
+      messages("format_version = 1\n[simulation]\nstep_rate = 60\n[[emitters]]\n[output]\n"
+               "vdb_compression = \"zip\"\nvdb_positions = \"Fixed16\"\n"),
+      (Lines{"bad.toml:6:19: error: output.vdb_compression: unknown VDB compression \"zip\" "
+             "(expected one of: none, blosc)",
+             "bad.toml:7:17: error: output.vdb_positions: unknown VDB positions \"Fixed16\" (did "
+             "you mean \"fixed16\"?)"}));
 }
 
 TEST(ioParse, TablesOfTheWrongKind) {
@@ -631,6 +638,8 @@ TEST(ioParse, MinimalFileGetsTheDocumentedDefaults) {
   EXPECT_EQ(e.output.frameCount(), 240);
   EXPECT_EQ(e.output.formats, std::vector<CacheFormat>{CacheFormat::Csv});
   EXPECT_EQ(e.output.directory, "out");
+  EXPECT_EQ(e.output.vdb.compression, VdbCacheOptions::Compression::None);
+  EXPECT_EQ(e.output.vdb.positions, VdbCacheOptions::Positions::Exact);
   // Shape and force defaults.
   const LoadResult shapes = parseEffect(R"(format_version = 1
 [simulation]
@@ -736,6 +745,8 @@ fps = "30000/1001"
 frames = 90
 formats = ["ply", "csv"]
 directory = "cache/ring"
+vdb_compression = "blosc"
+vdb_positions = "fixed16"
 )",
                                         "all.toml");
   ASSERT_TRUE(result.ok()) << (result.diagnostics.empty() ? "" : result.diagnostics[0].format());
@@ -793,6 +804,8 @@ directory = "cache/ring"
   EXPECT_EQ(e.output.frameCount(), 90);
   EXPECT_EQ(e.output.formats, (std::vector<CacheFormat>{CacheFormat::Ply, CacheFormat::Csv}));
   EXPECT_EQ(e.output.directory, "cache/ring");
+  EXPECT_EQ(e.output.vdb.compression, VdbCacheOptions::Compression::Blosc);
+  EXPECT_EQ(e.output.vdb.positions, VdbCacheOptions::Positions::Fixed16);
   // Sources: values at their value, defaults at their table's header.
   const SourceLocation rate = e.sources.find("emitters.0.rate");
   EXPECT_EQ(rate.file, "all.toml");

@@ -238,6 +238,105 @@ TEST_F(ioVdbPoints, ManyPointsOverManyLeavesComeBackInIdOrder) {
   EXPECT_GT(vdbt::readPointsGrid(path("many.vdb"), "points").leaves.size(), 100u);
 }
 
+// Blosc is lossless: the odd frame (−0.0, denormals, inf, ids past 2⁶³) reads back bit for bit.
+TEST_F(ioVdbPoints, BloscCompressedCachesReadBackBitForBitAndSmaller) {
+  const FrameData frame = oddFrame();
+  const VdbCacheOptions blosc{VdbCacheOptions::Compression::Blosc};
+  writeVdbPointCache(frame, sampleMetadata(), path("b.vdb"), blosc);
+  expectSameBits(readVdbPointCache(path("b.vdb")), frame);
+  // Ids in steps of 3 and velocities of few distinct values compress: the file is smaller.
+  FrameData smooth;
+  const Eigen::Index n = 5000;
+  smooth.position.resize(n);
+  smooth.velocity.resize(n);
+  smooth.age = FloatColumn::Zero(n);
+  smooth.life = FloatColumn::Constant(n, kInf);
+  smooth.mass = FloatColumn::Ones(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    smooth.id.push_back(static_cast<std::uint64_t>(3 * i + 1));
+    for (int c = 0; c < 3; ++c) {
+      smooth.position[c][i] = 0.01f * static_cast<float>(i % 500) + static_cast<float>(c);
+      smooth.velocity[c][i] = static_cast<float>(c);
+    }
+  }
+  writeVdbPointCache(smooth, sampleMetadata(), path("s.vdb"), blosc);
+  writeVdbPointCache(smooth, sampleMetadata(), path("n.vdb"));
+  expectSameBits(readVdbPointCache(path("s.vdb")), smooth);
+  EXPECT_LT(2 * fs::file_size(path("s.vdb")), fs::file_size(path("n.vdb")));
+}
+
+// Fixed16 stores P as 16 bits within the point's 1 m voxel: within 1/65535 m of the float
+// (plus the float's own rounding of voxel + offset), every other column exact.
+TEST_F(ioVdbPoints, Fixed16PositionsReadBackWithin1Over65535Metre) {
+  FrameData frame;
+  const Eigen::Index n = 3000;
+  frame.position.resize(n);
+  frame.velocity.resize(n);
+  frame.age = FloatColumn::Constant(n, 0.25f);
+  frame.life = FloatColumn::Constant(n, kInf);
+  frame.mass = FloatColumn::Ones(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    frame.id.push_back(static_cast<std::uint64_t>(2 * i + 5));
+    for (int c = 0; c < 3; ++c) {
+      const double t =
+          std::fmod(0.5 + (0.7548776662466927 + 0.21 * c) * static_cast<double>(i + 1), 1.0);
+      frame.position[c][i] = static_cast<float>(120.0 * t - 60.0);
+      frame.velocity[c][i] = static_cast<float>(t - 0.5);
+    }
+  }
+  // Points on voxel faces and corners of the fixed-point range.
+  frame.position[0][0] = 0.5f;
+  frame.position[1][0] = -0.5f;
+  frame.position[2][0] = 2.4999998f;
+  const VdbCacheOptions fixed16{VdbCacheOptions::Compression::None,
+                                VdbCacheOptions::Positions::Fixed16};
+  writeVdbPointCache(frame, sampleMetadata(), path("q.vdb"), fixed16);
+  const FrameData back = readVdbPointCache(path("q.vdb"));
+  ASSERT_EQ(back.size(), frame.size());
+  EXPECT_EQ(back.id, frame.id);
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const double want = frame.position[c][i];
+      const double error = std::abs(static_cast<double>(back.position[c][i]) - want);
+      const double bound = 1.0 / 65535.0 + std::abs(want) * 0x1p-23;
+      EXPECT_LE(error, bound) << "row " << i << " P" << c << " " << want;
+      worst = std::max(worst, error);
+      EXPECT_EQ(bits(back.velocity[c][i]), bits(frame.velocity[c][i])) << "row " << i;
+    }
+    EXPECT_EQ(bits(back.age[i]), bits(0.25f));
+  }
+  // Quantised, not exact: a test of a writer that ignored the option would pass the bound too.
+  EXPECT_GT(worst, 1e-6);
+  // Smaller: 6 bytes a point instead of 12 for P.
+  writeVdbPointCache(frame, sampleMetadata(), path("x.vdb"));
+  EXPECT_LT(fs::file_size(path("q.vdb")) + 5 * static_cast<std::uintmax_t>(n),
+            fs::file_size(path("x.vdb")));
+}
+
+// What fixed point cannot hold: a NaN reads as (about) 0, a coordinate beyond ±2³⁰ m (inf included)
+// keeps its sign, half a metre, in voxel 0 of its axis.
+TEST_F(ioVdbPoints, Fixed16KeepsOnlyTheSignOfWhatItCannotHold) {
+  FrameData frame;
+  frame.resize(1, {});
+  frame.id = {1};
+  frame.position[0][0] = std::numeric_limits<float>::quiet_NaN();
+  frame.position[1][0] = -kInf;
+  frame.position[2][0] = 3e9f;
+  for (int c = 0; c < 3; ++c) frame.velocity[c][0] = 0.0f;
+  frame.age[0] = 0.0f;
+  frame.life[0] = 1.0f;
+  frame.mass[0] = 1.0f;
+  writeVdbPointCache(frame, sampleMetadata(), path("far.vdb"),
+                     {VdbCacheOptions::Compression::None, VdbCacheOptions::Positions::Fixed16});
+  const FrameData back = readVdbPointCache(path("far.vdb"));
+  ASSERT_EQ(back.size(), 1u);
+  // Fixed point has no 0: the middle code reads 32767/65535 − 0.5.
+  EXPECT_EQ(back.position[0][0], 32767.0f / 65535.0f - 0.5f);  // as OpenVDB decodes, in float
+  EXPECT_EQ(back.position[1][0], -0.5f);
+  EXPECT_EQ(back.position[2][0], 0.5f);
+}
+
 TEST_F(ioVdbPoints, AnEmptyFrameIsAnEmptyGrid) {
   FrameData empty;
   empty.frame = 1;

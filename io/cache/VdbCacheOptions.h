@@ -26,7 +26,8 @@ struct VdbCacheOptions {
     Exact,
     /// P as 16-bit fixed point within its 1 m voxel (OpenVDB's "fxpt16", Houdini's default for
     /// VDB points): 6 bytes a point instead of 12, coordinates to within 1/65535 m (15 µm). A
-    /// coordinate beyond ±2³⁰ m keeps only its sign (±0.5 m) and a NaN reads as 0.
+    /// coordinate beyond ±2³⁰ m keeps only its sign (±0.5 m) and a NaN reads as
+    /// −7.6 µm (the code nearest 0).
     Fixed16,
   };
   Compression compression = Compression::None;
