@@ -498,7 +498,10 @@ TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
       {"the default", Options{}},
       {"blosc", Options{Options::Compression::Blosc, Options::Positions::Exact}},
       {"fixed16", Options{Options::Compression::None, Options::Positions::Fixed16}}};
-  for (const auto& [label, options] : layouts) {
+  for (const auto& layout : layouts) {
+    // (A copy, not a structured binding: clang 14 cannot capture those in the lambda below.)
+    const std::string label = layout.first;
+    const Options& options = layout.second;
     writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"), options);
     const std::string bytes = fileBytes(path("f.vdb"));
     ASSERT_GT(bytes.size(), 10000u);  // the root's child alone has two 4 KB masks

@@ -4,6 +4,7 @@
 #include <openvdb/points/PointDataGrid.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -136,9 +137,10 @@ std::pair<openvdb::Int32, float> placeQuantised(float x) {
   return {static_cast<openvdb::Int32>(n), static_cast<float>(static_cast<double>(x) - n)};
 }
 
-// The points' slots in leaf, voxel and row order, and each row's offset in its voxel.
-std::vector<PointSlot> placePoints(const FrameData& frame, bool quantised,
-                                   std::vector<openvdb::Vec3f>& offset) {
+// Each point's voxel offset within its leaf (0 to 511) and each row's offset in its voxel; the
+// points' slots in row order (sorted below).
+std::vector<PointSlot> slotsInRowOrder(const FrameData& frame, bool quantised,
+                                       std::vector<openvdb::Vec3f>& offset) {
   const std::size_t n = frame.size();
   std::vector<PointSlot> slots(n);
   offset.resize(n);
@@ -158,8 +160,95 @@ std::vector<PointSlot> placePoints(const FrameData& frame, bool quantised,
                                       static_cast<openvdb::Index32>(Leaf::coordToOffset(voxel)), i};
                       }
                     });
-  tbb::parallel_sort(slots.begin(), slots.end());
   return slots;
+}
+
+// The slots in (leaf, voxel, row) order by a sort of 64-bit keys, when the leaves' bounding box,
+// 512 voxels and the rows fit in 64 bits (any effect of sane size): the leaf's index in the box
+// (x, then y, then z, as Coord's order), its voxel and its row, one integer a point, so a plain
+// integer sort gives exactly the order of PointSlot::operator<. False, slots untouched, otherwise.
+bool sortByKeys(std::vector<PointSlot>& slots) {
+  const std::size_t n = slots.size();
+  if (n == 0) return true;
+  using Box = std::pair<openvdb::Coord, openvdb::Coord>;
+  const auto leafBox = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+      Box{openvdb::Coord::max(), openvdb::Coord::min()},
+      [&](const tbb::blocked_range<std::size_t>& range, Box box) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+          box.first.minComponent(slots[i].leaf);
+          box.second.maxComponent(slots[i].leaf);
+        }
+        return box;
+      },
+      [](Box a, const Box& b) {  // min and max: the same answer in any grouping
+        a.first.minComponent(b.first);
+        a.second.maxComponent(b.second);
+        return a;
+      });
+  constexpr int kLeafLog2 = static_cast<int>(Leaf::LOG2DIM);
+  std::array<std::uint64_t, 3> extent{};
+  for (int c = 0; c < 3; ++c) {
+    extent[static_cast<std::size_t>(c)] =
+        (static_cast<std::uint64_t>(static_cast<std::int64_t>(leafBox.second[c]) -
+                                    leafBox.first[c]) >>
+         kLeafLog2) +
+        1;
+  }
+  const int rowBits = std::bit_width(n - 1);
+  const int voxelBits = 3 * kLeafLog2;
+  int leafBits = 0;
+  for (const std::uint64_t e : extent) leafBits += std::bit_width(e);
+  if (leafBits + voxelBits + rowBits > 64) return false;
+
+  const auto leafIndex = [&](const openvdb::Coord& leaf) {
+    std::uint64_t index = 0;
+    for (int c = 0; c < 3; ++c) {
+      index = index * extent[static_cast<std::size_t>(c)] +
+              (static_cast<std::uint64_t>(static_cast<std::int64_t>(leaf[c]) - leafBox.first[c]) >>
+               kLeafLog2);
+    }
+    return index;
+  };
+  std::vector<std::uint64_t> keys(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        const PointSlot& s = slots[i];
+                        keys[i] = (leafIndex(s.leaf) << (voxelBits + rowBits)) |
+                                  (std::uint64_t{s.voxel} << rowBits) | s.row;
+                      }
+                    });
+  tbb::parallel_sort(keys.begin(), keys.end());
+  // Rebuilt from the keys, in their order: the row names the point, whose leaf and voxel are
+  // those of its unsorted slot.
+  std::vector<PointSlot> sorted(n);
+  const std::uint64_t rowMask = (std::uint64_t{1} << rowBits) - 1;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        sorted[k] = slots[static_cast<std::size_t>(keys[k] & rowMask)];
+                      }
+                    });
+  slots = std::move(sorted);
+  return true;
+}
+
+// The points' slots in leaf, voxel and row order, and each row's offset in its voxel.
+std::vector<PointSlot> placePoints(const FrameData& frame, bool quantised,
+                                   std::vector<openvdb::Vec3f>& offset) {
+  std::vector<PointSlot> slots = slotsInRowOrder(frame, quantised, offset);
+  if (!sortByKeys(slots)) tbb::parallel_sort(slots.begin(), slots.end());
+  return slots;
+}
+
+// The array at `pos` of `leaf` as its own type, expanded to one value a point (each is then
+// set: no fill). Typed access calls the codec inline, where a handle calls through a pointer.
+template <typename Array>
+Array& expandedArray(Leaf& leaf, std::size_t pos) {
+  auto& array = static_cast<Array&>(leaf.attributeArray(pos));
+  array.expand(/*fill=*/false);
+  return array;
 }
 
 // One leaf holding slots [begin, end), every attribute filled.
@@ -181,28 +270,32 @@ std::unique_ptr<Leaf> makeLeaf(const FrameData& frame, const std::vector<PointSl
                             /*allowMismatchingDescriptors=*/true);
   leaf->setOffsets(offsets);
 
-  vdbp::AttributeWriteHandle<openvdb::Vec3f, typename PositionArray::Codec> p(
-      leaf->attributeArray(0));
-  vdbp::AttributeWriteHandle<openvdb::Vec3f> v(leaf->attributeArray(1));
-  vdbp::AttributeWriteHandle<std::int64_t> id(leaf->attributeArray(2));
-  vdbp::AttributeWriteHandle<float> age(leaf->attributeArray(3));
-  vdbp::AttributeWriteHandle<float> life(leaf->attributeArray(4));
-  vdbp::AttributeWriteHandle<float> mass(leaf->attributeArray(5));
-  std::vector<vdbp::AttributeWriteHandle<float>> custom;
+  // The leaf's rows, then one pass an attribute: each pass gathers from one or three columns,
+  // independent loads the processor can have in flight together.
+  std::vector<Eigen::Index> rows(count);
+  for (openvdb::Index k = 0; k < count; ++k)
+    rows[k] = static_cast<Eigen::Index>(slots[begin + k].row);
+  auto& p = expandedArray<PositionArray>(*leaf, 0);
+  for (openvdb::Index k = 0; k < count; ++k)
+    p.setUnsafe(k, offset[static_cast<std::size_t>(rows[k])]);
+  auto& v = expandedArray<VectorArray>(*leaf, 1);
+  for (openvdb::Index k = 0; k < count; ++k) {
+    const Eigen::Index r = rows[k];
+    v.setUnsafe(k, openvdb::Vec3f(frame.velocity[0][r], frame.velocity[1][r], frame.velocity[2][r]));
+  }
+  auto& id = expandedArray<IdArray>(*leaf, 2);
+  for (openvdb::Index k = 0; k < count; ++k)
+    id.setUnsafe(k, static_cast<std::int64_t>(frame.id[static_cast<std::size_t>(rows[k])]));
+  const auto floats = [&](std::size_t pos, const FloatColumn& column) {
+    auto& a = expandedArray<FloatArray>(*leaf, pos);
+    for (openvdb::Index k = 0; k < count; ++k) a.setUnsafe(k, column[rows[k]]);
+  };
+  floats(3, frame.age);
+  floats(4, frame.life);
+  floats(5, frame.mass);
   const std::size_t firstCustom = standardAttributes().size();
   for (std::size_t a = 0; a < frame.attributes.size(); ++a)
-    custom.emplace_back(leaf->attributeArray(firstCustom + a));
-  for (openvdb::Index k = 0; k < count; ++k) {
-    const std::size_t i = slots[begin + k].row;
-    const auto r = static_cast<Eigen::Index>(i);
-    p.set(k, offset[i]);
-    v.set(k, openvdb::Vec3f(frame.velocity[0][r], frame.velocity[1][r], frame.velocity[2][r]));
-    id.set(k, static_cast<std::int64_t>(frame.id[i]));
-    age.set(k, frame.age[r]);
-    life.set(k, frame.life[r]);
-    mass.set(k, frame.mass[r]);
-    for (std::size_t a = 0; a < custom.size(); ++a) custom[a].set(k, frame.attributes[a][r]);
-  }
+    floats(firstCustom + a, frame.attributes[a]);
   return leaf;
 }
 
@@ -287,8 +380,12 @@ bool isIdentity(const openvdb::math::Transform& transform) {
 // name and the run went on. Archive::write() with a seekable stream is what File::write() calls.
 class ArchiveBytes final : public openvdb::io::Archive {
  public:
-  std::string of(const openvdb::GridCPtrVec& grids) const {
-    std::ostringstream os(std::ios::binary);
+  /// `expectedBytes`: room reserved up front (a stream that grows copies what it holds each time
+  /// it doubles; untouched room costs no memory).
+  std::string of(const openvdb::GridCPtrVec& grids, std::size_t expectedBytes) const {
+    std::string room;
+    room.reserve(expectedBytes);
+    std::ostringstream os(std::move(room), std::ios::binary);
     Archive::write(os, grids, /*seekable=*/true);
     if (!os) throw std::runtime_error("cannot encode the VDB points grid");
     return std::move(os).str();
@@ -353,7 +450,12 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
   archive.setCompression(options.compression == VdbCacheOptions::Compression::Blosc
                              ? openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK
                              : openvdb::io::COMPRESS_ACTIVE_MASK);
-  std::string bytes = archive.of(grids);
+  // The arrays' bytes, a leaf's offsets and masks (at most 2 + 4 KiB), and the headers.
+  const std::size_t bytesPerPoint = 12 + 12 + 8 + 4 * (3 + frame.attributes.size());
+  const std::size_t leaves =
+      static_cast<const vdbp::PointDataGrid&>(*grids.front()).constTree().leafCount();
+  std::string bytes =
+      archive.of(grids, frame.size() * bytesPerPoint + leaves * (6 * 1024) + (64 << 10));
   stampUuid(bytes, meta, frame.frame);
   writeFileAtomically(
       path,
