@@ -122,6 +122,31 @@ void expectSameBits(const FrameData& got, const FrameData& want, bool signOfZero
   }
 }
 
+// n rows, ids 1, 4, 7, ... (increasing with gaps), age 0, immortal, 1 kg; P and v per row and
+// component from `position(i, c)` and `velocity(i, c)`.
+template <typename Position, typename Velocity>
+FrameData rowsOf(Eigen::Index n, Position position, Velocity velocity) {
+  FrameData frame;
+  frame.position.resize(n);
+  frame.velocity.resize(n);
+  frame.age = FloatColumn::Zero(n);
+  frame.life = FloatColumn::Constant(n, kInf);
+  frame.mass = FloatColumn::Ones(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    frame.id.push_back(static_cast<std::uint64_t>(3 * i + 1));
+    for (int c = 0; c < 3; ++c) {
+      frame.position[c][i] = position(i, c);
+      frame.velocity[c][i] = velocity(i, c);
+    }
+  }
+  return frame;
+}
+
+// A low-discrepancy value in [0, 1) for row i, component c: points scattered over a box.
+double scattered(Eigen::Index i, int c) {
+  return std::fmod(0.5 + (0.7548776662466927 + 0.21 * c) * static_cast<double>(i + 1), 1.0);
+}
+
 // ---- the cache read back through OpenVDB ------------------------------------------------------
 
 TEST_F(ioVdbPoints, OpenVdbReadsEveryAttributeBitwiseAndTheMetadata) {
@@ -216,22 +241,10 @@ TEST_F(ioVdbPoints, ReadBackGivesTheFrameInIdOrderWithItsBitsAndMetadata) {
 
 TEST_F(ioVdbPoints, ManyPointsOverManyLeavesComeBackInIdOrder) {
   // 5000 points scattered over ±200 m (hundreds of leaves), ids increasing with gaps.
-  FrameData frame;
-  const Eigen::Index n = 5000;
-  frame.position.resize(n);
-  frame.velocity.resize(n);
-  frame.age = FloatColumn::Zero(n);
-  frame.life = FloatColumn::Constant(n, kInf);
-  frame.mass = FloatColumn::Ones(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    frame.id.push_back(static_cast<std::uint64_t>(3 * i + 1));
-    for (int c = 0; c < 3; ++c) {
-      const double t =
-          std::fmod(0.5 + (0.7548776662466927 + 0.21 * c) * static_cast<double>(i + 1), 1.0);
-      frame.position[c][i] = static_cast<float>(400.0 * t - 200.0);
-      frame.velocity[c][i] = static_cast<float>(t);
-    }
-  }
+  const FrameData frame = rowsOf(
+      5000,
+      [](Eigen::Index i, int c) { return static_cast<float>(400.0 * scattered(i, c) - 200.0); },
+      [](Eigen::Index i, int c) { return static_cast<float>(scattered(i, c)); });
   writeVdbPointCache(frame, sampleMetadata(), path("many.vdb"));
   const FrameData back = readVdbPointCache(path("many.vdb"));
   expectSameBits(back, frame);
@@ -245,20 +258,12 @@ TEST_F(ioVdbPoints, BloscCompressedCachesReadBackBitForBitAndSmaller) {
   writeVdbPointCache(frame, sampleMetadata(), path("b.vdb"), blosc);
   expectSameBits(readVdbPointCache(path("b.vdb")), frame);
   // Ids in steps of 3 and velocities of few distinct values compress: the file is smaller.
-  FrameData smooth;
-  const Eigen::Index n = 5000;
-  smooth.position.resize(n);
-  smooth.velocity.resize(n);
-  smooth.age = FloatColumn::Zero(n);
-  smooth.life = FloatColumn::Constant(n, kInf);
-  smooth.mass = FloatColumn::Ones(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    smooth.id.push_back(static_cast<std::uint64_t>(3 * i + 1));
-    for (int c = 0; c < 3; ++c) {
-      smooth.position[c][i] = 0.01f * static_cast<float>(i % 500) + static_cast<float>(c);
-      smooth.velocity[c][i] = static_cast<float>(c);
-    }
-  }
+  const FrameData smooth = rowsOf(
+      5000,
+      [](Eigen::Index i, int c) {
+        return 0.01f * static_cast<float>(i % 500) + static_cast<float>(c);
+      },
+      [](Eigen::Index, int c) { return static_cast<float>(c); });
   writeVdbPointCache(smooth, sampleMetadata(), path("s.vdb"), blosc);
   writeVdbPointCache(smooth, sampleMetadata(), path("n.vdb"));
   expectSameBits(readVdbPointCache(path("s.vdb")), smooth);
@@ -268,22 +273,10 @@ TEST_F(ioVdbPoints, BloscCompressedCachesReadBackBitForBitAndSmaller) {
 // Fixed16 stores P as 16 bits within the point's 1 m voxel: within 1/65535 m of the float
 // (plus the float's own rounding of voxel + offset), every other column exact.
 TEST_F(ioVdbPoints, Fixed16PositionsReadBackWithin1Over65535Metre) {
-  FrameData frame;
   const Eigen::Index n = 3000;
-  frame.position.resize(n);
-  frame.velocity.resize(n);
-  frame.age = FloatColumn::Constant(n, 0.25f);
-  frame.life = FloatColumn::Constant(n, kInf);
-  frame.mass = FloatColumn::Ones(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    frame.id.push_back(static_cast<std::uint64_t>(2 * i + 5));
-    for (int c = 0; c < 3; ++c) {
-      const double t =
-          std::fmod(0.5 + (0.7548776662466927 + 0.21 * c) * static_cast<double>(i + 1), 1.0);
-      frame.position[c][i] = static_cast<float>(120.0 * t - 60.0);
-      frame.velocity[c][i] = static_cast<float>(t - 0.5);
-    }
-  }
+  FrameData frame = rowsOf(
+      n, [](Eigen::Index i, int c) { return static_cast<float>(120.0 * scattered(i, c) - 60.0); },
+      [](Eigen::Index i, int c) { return static_cast<float>(scattered(i, c) - 0.5); });
   // Points on voxel faces and corners of the fixed-point range.
   frame.position[0][0] = 0.5f;
   frame.position[1][0] = -0.5f;
@@ -304,7 +297,7 @@ TEST_F(ioVdbPoints, Fixed16PositionsReadBackWithin1Over65535Metre) {
       worst = std::max(worst, error);
       EXPECT_EQ(bits(back.velocity[c][i]), bits(frame.velocity[c][i])) << "row " << i;
     }
-    EXPECT_EQ(bits(back.age[i]), bits(0.25f));
+    EXPECT_EQ(bits(back.age[i]), bits(frame.age[i]));
   }
   // Quantised, not exact: a test of a writer that ignored the option would pass the bound too.
   EXPECT_GT(worst, 1e-6);
