@@ -36,7 +36,9 @@ void runBlocks(std::size_t blocks, const std::function<void(std::size_t)>& block
   const std::size_t threads = std::clamp<std::size_t>(arenaThreads, 1, blocks);
   std::atomic<std::size_t> next{0};
   const auto work = [&] {
-    for (std::size_t b = next.fetch_add(1); b < blocks; b = next.fetch_add(1)) block(b);
+    for (std::size_t b = next.fetch_add(1, std::memory_order_relaxed); b < blocks;
+         b = next.fetch_add(1, std::memory_order_relaxed))
+      block(b);
   };
   std::vector<std::thread> helpers;
   for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(work);
