@@ -6,6 +6,7 @@
 
 #include "particles/DetMath.h"
 #include "particles/ExactTime.h"
+#include "particles/ParallelFor.h"
 #include "particles/Random.h"
 
 namespace tickfx {
@@ -123,8 +124,12 @@ std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t
   // Particles the pool has no room for are counted, not sampled.
   const std::uint64_t room = pool.maxParticles() - pool.size();
   const std::uint64_t tried = std::min<std::uint64_t>(last - first, room);
-  for (std::uint64_t serial = first; serial < first + tried; ++serial)
-    pool.spawn(sample(seed, serial), tick);
+  // Every particle is a pure function of its serial: the rows are reserved in serial order, then
+  // filled in parallel blocks, with the bits of one spawn() after another.
+  const std::size_t firstRow = pool.appendRows(static_cast<std::size_t>(tried), tick);
+  parallelForRows(static_cast<std::size_t>(tried), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) pool.setRow(firstRow + k, sample(seed, first + k));
+  });
   pool.refuseSpawns(last - first - tried);
   return last - first;
 }

@@ -71,12 +71,34 @@ std::size_t ParticlePool::spawn(const ParticleInit& init, std::int64_t tick) {
     ++droppedSpawns_;
     return npos;
   }
-  if (size_ == storageRows_) {
-    grow(std::min(maxParticles_, std::max<std::size_t>(1024, storageRows_ * 2)));
+  const std::size_t i = appendRows(1, tick);
+  setRow(i, init);
+  return i;
+}
+
+std::size_t ParticlePool::appendRows(std::size_t count, std::int64_t tick) {
+  TICKFX_ASSERT(count <= maxParticles_ - size_, "rows appended past maxParticles");
+  const std::size_t first = size_;
+  if (first + count > storageRows_) {
+    // Geometric growth as one spawn at a time would make it, or room for the whole burst.
+    const std::size_t doubled = std::max<std::size_t>(1024, storageRows_ * 2);
+    grow(std::min(maxParticles_, std::max(doubled, first + count)));
   }
-  const std::size_t i = size_++;
-  TICKFX_ASSERT(i < storageRows_, "a spawn past the pool's storage");
-  const auto r = static_cast<Eigen::Index>(i);
+  size_ += count;
+  TICKFX_ASSERT(size_ <= storageRows_, "rows appended past the pool's storage");
+  for (std::size_t i = first; i < size_; ++i) {
+    id_[i] = nextId_++;
+    birthTick_[i] = tick;
+    dead_[i] = 0;
+  }
+  const auto head = static_cast<Eigen::Index>(first), n = static_cast<Eigen::Index>(count);
+  for (NamedColumn& a : attributes_) a.values.segment(head, n).setConstant(a.initial);
+  return first;
+}
+
+void ParticlePool::setRow(std::size_t row, const ParticleInit& init) {
+  TICKFX_ASSERT(row < size_, "a row set past the pool's size");
+  const auto r = static_cast<Eigen::Index>(row);
   position_.x[r] = init.position.x();
   position_.y[r] = init.position.y();
   position_.z[r] = init.position.z();
@@ -93,11 +115,6 @@ std::size_t ParticlePool::spawn(const ParticleInit& init, std::int64_t tick) {
   lifetime_[r] = init.lifetime;
   mass_[r] = init.mass;
   inverseMass_[r] = std::isinf(init.mass) ? 0.0f : 1.0f / init.mass;
-  id_[i] = nextId_++;
-  birthTick_[i] = tick;
-  dead_[i] = 0;
-  for (NamedColumn& a : attributes_) a.values[r] = a.initial;
-  return i;
 }
 
 std::optional<std::string> ParticlePool::restoreProblem(std::span<const std::uint64_t> ids,

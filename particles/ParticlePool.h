@@ -60,6 +60,15 @@ class ParticlePool {
   /// Appends a particle born at `tick`; returns its row, or npos when the pool is full.
   std::size_t spawn(const ParticleInit& init, std::int64_t tick);
   static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  /// Appends `count` rows born at `tick` (ids in order, custom attributes at their initial values)
+  /// and returns the first; setRow() gives each its values. The caller keeps size() + count within
+  /// maxParticles(). With every row set, the same rows, ids and bits as `count` spawn() calls in
+  /// order: an emitter fills the rows of a burst in parallel.
+  std::size_t appendRows(std::size_t count, std::int64_t tick);
+  /// Gives row `row` (appended, not yet stepped) its particle: position (and previous position),
+  /// velocity, lifetime and mass; acceleration and age 0. Different rows may be set at once from
+  /// different threads.
+  void setRow(std::size_t row, const ParticleInit& init);
   /// Counts `count` spawns refused without trying them (the caller saw the pool was full).
   void refuseSpawns(std::uint64_t count) { droppedSpawns_ += count; }
 

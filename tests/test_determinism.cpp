@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -68,18 +69,29 @@ INSTANTIATE_TEST_SUITE_P(Samples, EverySample, ::testing::ValuesIn(sampleEffects
                          });
 
 // Adds nothing; remembers which threads evaluated forces, to prove the thread count was real.
+// With `hold`, its first 200 blocks wait 0.2 ms each until three threads have been seen: on a
+// loaded 2-core machine the workers of an 8-thread arena may otherwise not be scheduled before one
+// or two threads have done every block (the bits agree either way; the proof would be missing).
 class ThreadRecorder final : public ForceModule {
  public:
+  explicit ThreadRecorder(bool hold) : hold_(hold) {}
   std::string_view typeName() const override { return "thread_recorder"; }
   void accumulate(const ForceInput&, RowRange, Vec3Rows&) const override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    threads_.insert(std::this_thread::get_id());
+    bool wait = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      threads_.insert(std::this_thread::get_id());
+      wait = hold_ && threads_.size() < 3 && ++held_ <= 200;
+    }
+    if (wait) std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
   std::size_t distinctThreads() const { return threads_.size(); }
 
  private:
+  bool hold_;
   mutable std::mutex mutex_;
   mutable std::set<std::thread::id> threads_;
+  mutable int held_ = 0;
 };
 
 TEST(Threads, OneTwoThreeAndEightThreadsGiveTheSameBitsAfterEveryTick) {
@@ -108,7 +120,8 @@ TEST(Threads, OneTwoThreeAndEightThreadsGiveTheSameBitsAfterEveryTick) {
     wind.frequency = 1.5;
     forces.add(std::make_unique<PeriodicWind>(wind));
     forces.add(std::make_unique<LinearDrag>(0.4f));
-    auto* recorder = static_cast<ThreadRecorder*>(&forces.add(std::make_unique<ThreadRecorder>()));
+    auto* recorder =
+        static_cast<ThreadRecorder*>(&forces.add(std::make_unique<ThreadRecorder>(threads == 8)));
     ParticleSystem system(settings, {e}, std::move(forces));
     std::vector<std::uint64_t> hashes;
     system.setTickObserver([&](const ParticleSystem& s) { hashes.push_back(stateHash(s.pool())); });

@@ -1,6 +1,7 @@
 // Emitters: shapes, directions, jitter, the purity of sample(), burst and rate timing, point lists.
 #include <gtest/gtest.h>
 
+#include <tbb/task_arena.h>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <bit>
@@ -16,6 +17,8 @@
 #include "CoreTestSupport.h"
 #include "particles/DetMath.h"
 #include "particles/Emitter.h"
+#include "particles/ParallelFor.h"
+#include "particles/ParticlePool.h"
 
 namespace tickfx {
 namespace {
@@ -260,6 +263,50 @@ TEST(EmitterSample, DifferentSeedEmitterOrSerialGivesDifferentParticles) {
     ASSERT_NE(p.lifetime, first.sample(43, serial).lifetime) << "serial " << serial;
     ASSERT_NE(p.position, second.sample(42, serial).position) << "serial " << serial;
     ASSERT_NE(p.position, first.sample(42, serial + 1).position) << "serial " << serial;
+  }
+}
+
+ParticleInit initOf(const ParticlePool& pool, Eigen::Index r) {
+  const auto at = [r](const Vec3Column& c) { return Eigen::Vector3f(c.x[r], c.y[r], c.z[r]); };
+  return ParticleInit{at(pool.position()), at(pool.velocity()), pool.lifetime()[r], pool.mass()[r]};
+}
+
+// A burst's rows are reserved at once and filled in parallel blocks: on any thread count, the
+// rows, ids, births and bits of one spawn() after another, and the spawns past a full pool are
+// counted, not filled.
+TEST(EmitterBulk, ABurstFillsTheRowsOfOneSpawnAtATimeOnAnyThreadCount) {
+  constexpr std::uint64_t kBurst = 3 * kParallelBlockRows + 17;
+  constexpr std::size_t kRoom = 2 * kParallelBlockRows + 5;  // 1 row taken below, then the burst
+  EmitterSettings s = randomEverything();
+  s.mass = 0.25;
+  s.bursts = {Burst{0.0, kBurst}};
+  const Emitter emitter(s, 2, 60);
+  ParticlePool expected(kRoom + 1);
+  const ParticleInit first = emitter.sample(7, 0);
+  expected.spawn(first, 0);
+  for (std::uint64_t serial = 0; serial < kBurst; ++serial)
+    expected.spawn(emitter.sample(7, serial), 0);
+  ASSERT_EQ(expected.size(), kRoom + 1);
+  ASSERT_EQ(expected.droppedSpawns(), kBurst - kRoom);
+  for (int threads : {1, 2, 3}) {
+    ParticlePool pool(kRoom + 1);
+    pool.spawn(first, 0);
+    tbb::task_arena arena(threads);
+    const std::uint64_t tried = arena.execute([&] { return emitter.emit(pool, 7, 0); });
+    EXPECT_EQ(tried, kBurst) << threads << " threads";
+    ASSERT_EQ(pool.size(), expected.size()) << threads << " threads";
+    EXPECT_EQ(pool.droppedSpawns(), expected.droppedSpawns()) << threads << " threads";
+    EXPECT_EQ(pool.nextId(), expected.nextId()) << threads << " threads";
+    EXPECT_EQ(pool.id(), expected.id()) << threads << " threads";
+    EXPECT_EQ(pool.birthTick(), expected.birthTick()) << threads << " threads";
+    for (std::size_t row = 0; row < pool.size(); ++row) {
+      const auto r = static_cast<Eigen::Index>(row);
+      const ParticleInit got = initOf(pool, r);
+      const ParticleInit want = initOf(expected, r);
+      ASSERT_TRUE(sameBits(got, want)) << "row " << row << ", " << threads << " threads";
+      ASSERT_EQ(test::bitsOf(pool.inverseMass()[r]), test::bitsOf(expected.inverseMass()[r]));
+      ASSERT_EQ(test::bitsOf(pool.previousPosition().x[r]), test::bitsOf(pool.position().x[r]));
+    }
   }
 }
 
