@@ -1,8 +1,11 @@
 #include "fields/ForceSet.h"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 #include <string>
+
+#include "particles/ParallelFor.h"
 
 namespace tickfx {
 
@@ -15,6 +18,20 @@ void holdPinned(const ForceInput& in, RowRange rows, Vec3Rows& value) {
   value.x = pinned.select(0.0f, value.x);
   value.y = pinned.select(0.0f, value.y);
   value.z = pinned.select(0.0f, value.z);
+}
+
+// Whether any of the first n inverse masses is 0. Every tick, since a host may change masses
+// between ticks: in parallel blocks, each a branch-free loop the compiler vectorises (Eigen's
+// (column == 0).any() ran serially at about a tenth of memory speed: 6 % of a 10⁶-particle tick).
+bool anyZero(const FloatColumn& inverseMass, std::size_t n) {
+  std::atomic<bool> found{false};
+  const float* values = inverseMass.data();
+  parallelForRows(n, [&](std::size_t begin, std::size_t end) {
+    int zero = 0;
+    for (std::size_t i = begin; i < end; ++i) zero |= static_cast<int>(values[i] == 0.0f);
+    if (zero != 0) found.store(true, std::memory_order_relaxed);
+  });
+  return found.load(std::memory_order_relaxed);
 }
 
 }  // namespace
@@ -42,8 +59,7 @@ bool ForceSet::isLocal() const {
 
 void ForceSet::beginTick(const ParticlePool& pool, std::int64_t tick) {
   for (auto& m : modules_) m->beginTick(pool, tick);
-  const auto n = static_cast<Eigen::Index>(pool.size());
-  anyPinned_ = n > 0 && (pool.inverseMass().head(n) == 0.0f).any();
+  anyPinned_ = anyZero(pool.inverseMass(), pool.size());
 }
 
 void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {

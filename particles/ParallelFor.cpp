@@ -79,4 +79,16 @@ void parallelForRows(std::size_t rows, const std::function<void(std::size_t, std
   runBlocks(blocks, block);
 }
 
+void parallelForTasks(std::size_t tasks, const std::function<void(std::size_t)>& task) {
+  if (tasks <= 1) {
+    if (tasks == 1) task(0);
+    return;
+  }
+  if (tExecutor != nullptr) {
+    tExecutor->run(tasks, task);
+    return;
+  }
+  runBlocks(tasks, task);
+}
+
 }  // namespace tickfx

@@ -18,6 +18,10 @@ inline constexpr std::size_t kParallelBlockRows = 8192;
 /// writes during the loop is fine (a gather).
 void parallelForRows(std::size_t rows, const std::function<void(std::size_t, std::size_t)>& body);
 
+/// Runs task(i) for every i in [0, tasks), each once, on the same threads as parallelForRows().
+/// For a few coarse independent jobs (moving the columns of a removal, one column a task).
+void parallelForTasks(std::size_t tasks, const std::function<void(std::size_t)>& task);
+
 /// While alive, parallelForRows() on this thread hands its blocks to `executor` (nullptr: TBB).
 /// ParticleSystem opens one around each tick when the host gave it an executor.
 class ExecutorScope {

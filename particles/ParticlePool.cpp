@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "particles/Assert.h"
 #include "particles/ParallelFor.h"
@@ -12,21 +14,50 @@
 namespace tickfx {
 namespace {
 
-// Moves the kept rows of [first, size) down over the removed ones, in order.
-template <typename Column>
-void compact(Column& column, const std::vector<std::uint8_t>& dead, std::size_t first,
-             std::size_t size) {
-  std::size_t w = first;
-  for (std::size_t i = first; i < size; ++i) {
-    if (dead[i] == 0) column[static_cast<Eigen::Index>(w++)] = column[static_cast<Eigen::Index>(i)];
+// A run of kept rows and where the removal moves it: rows [from, from + count) to `to` (to <=
+// from). Applied in order, a run's move never overwrites a later run's rows.
+struct KeptRun {
+  std::size_t from, count, to;
+};
+
+// The runs of kept rows in [first, size), rows before `first` staying where they are. Eight flags
+// at a time where they are all clear: deaths come in runs (the oldest particles of a rate emitter
+// die together), so the kept rows do too.
+std::vector<KeptRun> keptRuns(const std::vector<std::uint8_t>& dead, std::size_t first,
+                              std::size_t size) {
+  std::vector<KeptRun> runs;
+  const std::uint8_t* flags = dead.data();
+  std::size_t to = first;
+  std::size_t i = first;
+  while (i < size) {
+    while (i < size && flags[i] != 0) ++i;  // removed rows
+    const std::size_t from = i;
+    for (std::uint64_t word = 0; i + 8 <= size; i += 8) {
+      std::memcpy(&word, flags + i, sizeof word);
+      if (word != 0) break;
+    }
+    while (i < size && flags[i] == 0) ++i;
+    if (i > from) {
+      runs.push_back(KeptRun{from, i - from, to});
+      to += i - from;
+    }
   }
+  return runs;
 }
 
-void compact(Vec3Column& column, const std::vector<std::uint8_t>& dead, std::size_t first,
-             std::size_t size) {
-  compact(column.x, dead, first, size);
-  compact(column.y, dead, first, size);
-  compact(column.z, dead, first, size);
+// Moves each run of a column of T: memmove for long runs (a whole column is one or a few when
+// deaths come together, where a row-by-row copy behind a flag test ran at a fraction of memory
+// speed), a plain loop for short ones (deaths scattered by lifetime jitter).
+template <typename T>
+void moveRuns(T* column, const std::vector<KeptRun>& runs) {
+  for (const KeptRun& r : runs) {
+    if (r.from == r.to) continue;
+    if (r.count >= 16) {
+      std::memmove(column + r.to, column + r.from, r.count * sizeof(T));
+    } else {
+      for (std::size_t k = 0; k < r.count; ++k) column[r.to + k] = column[r.from + k];
+    }
+  }
 }
 
 }  // namespace
@@ -52,6 +83,12 @@ ParticlePool::ParticlePool(std::size_t maxParticles) : maxParticles_(maxParticle
 
 void ParticlePool::reserve(std::size_t rows) {
   if (rows > storageRows_) grow(std::min(rows, maxParticles_));
+}
+
+std::size_t ParticlePool::bytesPerRow() const {
+  constexpr std::size_t kVec3 = 3 * sizeof(float);
+  return 4 * kVec3 + 4 * sizeof(float) + sizeof(std::uint64_t) + sizeof(std::int64_t) +
+         sizeof(std::uint8_t) + attributes_.size() * sizeof(float);
 }
 
 void ParticlePool::grow(std::size_t rows) {
@@ -161,28 +198,42 @@ void ParticlePool::updateAges(std::int64_t tick, std::int64_t stepRateHz) {
 }
 
 std::size_t ParticlePool::firstDeadRow() const {
-  const auto firstDead =
-      std::find_if(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_),
-                   [](std::uint8_t d) { return d != 0; });
-  return static_cast<std::size_t>(firstDead - dead_.begin());
+  // Eight flags at a time: deaths are rare, and a byte-by-byte search was 2 % of a tick at 10⁶.
+  const std::uint8_t* flags = dead_.data();
+  std::size_t i = 0;
+  for (; i + 8 <= size_; i += 8) {
+    std::uint64_t word = 0;
+    std::memcpy(&word, flags + i, sizeof word);
+    if (word != 0) break;
+  }
+  while (i < size_ && flags[i] == 0) ++i;
+  return i;
 }
 
 std::size_t ParticlePool::removeDead() {
   // Most ticks nobody dies: find that out with one byte scan and touch nothing else.
   const std::size_t first = firstDeadRow();
   if (first == size_) return 0;
-  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_})
-    compact(*c, dead_, first, size_);
-  for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_})
-    compact(*c, dead_, first, size_);
-  compact(id_, dead_, first, size_);
-  compact(birthTick_, dead_, first, size_);
-  for (NamedColumn& a : attributes_) compact(a.values, dead_, first, size_);
-  const std::size_t kept =
-      first + static_cast<std::size_t>(
-                  std::count(dead_.begin() + static_cast<std::ptrdiff_t>(first),
-                             dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0}));
-  std::fill(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(kept), std::uint8_t{0});
+  const std::vector<KeptRun> runs = keptRuns(dead_, first, size_);
+  // Columns are independent: each is a task, moved whole (bytes only, nothing to reorder).
+  std::vector<float*> floats;
+  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_}) {
+    for (int k = 0; k < 3; ++k) floats.push_back((*c)[k].data());
+  }
+  for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_}) floats.push_back(c->data());
+  for (NamedColumn& a : attributes_) floats.push_back(a.values.data());
+  parallelForTasks(floats.size() + 2, [&](std::size_t c) {
+    if (c < floats.size()) {
+      moveRuns(floats[c], runs);
+    } else if (c == floats.size()) {
+      moveRuns(id_.data(), runs);
+    } else {
+      moveRuns(birthTick_.data(), runs);
+    }
+  });
+  const std::size_t kept = runs.empty() ? first : runs.back().to + runs.back().count;
+  std::fill(dead_.begin() + static_cast<std::ptrdiff_t>(first),
+            dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
   const std::size_t removed = size_ - kept;
   size_ = kept;
   firstUnstepped_ = std::min(firstUnstepped_, size_);
@@ -193,7 +244,9 @@ void ParticlePool::applyRemovalTo(Vec3Column& column) const {
   TICKFX_ASSERT(static_cast<std::size_t>(column.x.size()) >= size_,
                 "a column shorter than the pool it follows");
   const std::size_t first = firstDeadRow();
-  if (first < size_) compact(column, dead_, first, size_);
+  if (first == size_) return;
+  const std::vector<KeptRun> runs = keptRuns(dead_, first, size_);
+  for (int k = 0; k < 3; ++k) moveRuns(column[k].data(), runs);
 }
 
 std::size_t ParticlePool::addAttribute(const std::string& name, float initial) {

@@ -129,6 +129,9 @@ class ParticlePool {
 
   /// Rows the columns currently hold (>= size()); grows geometrically, never past maxParticles.
   std::size_t storageRows() const { return storageRows_; }
+  /// Bytes a row takes over every column, the named attributes included: the pool's columns hold
+  /// storageRows() · bytesPerRow() bytes.
+  std::size_t bytesPerRow() const;
   /// Makes room for `rows` rows without changing size() (for restoring a saved state).
   void reserve(std::size_t rows);
   /// Sets size() directly (throws std::invalid_argument past maxParticles) and clears the dead

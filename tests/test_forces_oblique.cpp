@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <ostream>
@@ -27,11 +28,13 @@
 #include "ObliqueTestSupport.h"
 #include "fields/AnalyticField.h"
 #include "fields/AnchorSpring.h"
+#include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
 #include "fields/SpringNetwork.h"
 #include "fields/VectorField.h"
+#include "particles/ParallelFor.h"
 
 namespace tickfx::oblique {
 namespace {
@@ -654,5 +657,32 @@ TEST(GravityPerRow, AddsTheUniformVectorOnEveryAxis) {
   }
 }
 
+// A pinned particle holds still wherever it sits in a pool of many parallel blocks: ForceSet
+// looks for pins over the whole pool each tick (beginTick), in blocks, and holds them per row.
+TEST(ForceSetPins, APinnedParticleInAnyBlockOfALargePoolGetsNoAcceleration) {
+  constexpr std::size_t kRows = 3 * kParallelBlockRows + 5;
+  for (const std::size_t pinnedRow : {std::size_t{0}, 2 * kParallelBlockRows + 3, kRows - 1}) {
+    ParticlePool pool(kRows);
+    for (std::size_t r = 0; r < kRows; ++r) {
+      ParticleInit init;
+      if (r == pinnedRow) init.mass = std::numeric_limits<float>::infinity();
+      pool.spawn(init, 0);
+    }
+    ForceSet forces;
+    forces.add(std::make_unique<Gravity>(Eigen::Vector3f(0.0f, -9.81f, 0.0f)));
+    forces.beginTick(pool, 0);
+    const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), {}};
+    Vec3Column a;
+    a.resize(static_cast<Eigen::Index>(kRows));
+    const RowRange rows{0, kRows};
+    Vec3Rows out = Vec3Rows::of(a, rows);
+    forces.evaluate(in, rows, out);
+    for (std::size_t r = 0; r < kRows; ++r) {
+      const float expected = r == pinnedRow ? 0.0f : -9.81f;
+      ASSERT_EQ(a.y[static_cast<Eigen::Index>(r)], expected)
+          << "row " << r << ", pin " << pinnedRow;
+    }
+  }
+}
 }  // namespace
 }  // namespace tickfx

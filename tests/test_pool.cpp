@@ -1,8 +1,11 @@
 // The particle pool: the hard cap, stable deaths, exact ages, custom attributes.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cstdint>
+#include <functional>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "CoreTestSupport.h"
@@ -136,6 +139,86 @@ TEST(ParticlePool, DeathsKeepIdOrderAndMoveEveryColumn) {
     EXPECT_EQ(pool.birthTick()[i], expected[i] < 20 ? 0 : 30);
     EXPECT_EQ(pool.attribute(tag)[r], expected[i] < 20 ? 10.0f * x : -1.0f);
     EXPECT_EQ(pool.dead()[i], 0);
+  }
+}
+
+// removeDead() finds a flagged row wherever it sits: first, last, and on either side of every
+// boundary of the eight-flags-at-a-time search.
+TEST(ParticlePool, ADeadRowIsFoundWhereverItSits) {
+  constexpr int kRows = 21;
+  for (int d = 0; d < kRows; ++d) {
+    ParticlePool pool(kRows);
+    for (int i = 0; i < kRows; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);
+    pool.dead()[static_cast<std::size_t>(d)] = 1;
+    ASSERT_EQ(pool.removeDead(), 1u) << "dead row " << d;
+    ASSERT_EQ(pool.size(), static_cast<std::size_t>(kRows - 1));
+    for (int i = 0; i < kRows - 1; ++i)
+      ASSERT_EQ(pool.id()[static_cast<std::size_t>(i)],
+                static_cast<std::uint64_t>(i < d ? i : i + 1));
+  }
+}
+
+// What the pool's memory is made of: four vectors (position, velocity, previous position,
+// acceleration), four floats (age, lifetime, mass, inverse mass), the id, the birth tick, the
+// dead flag, and a float for each named attribute.
+TEST(ParticlePool, BytesPerRowCountEveryColumn) {
+  ParticlePool pool(8);
+  EXPECT_EQ(pool.bytesPerRow(), 4u * 12u + 4u * 4u + 8u + 8u + 1u);
+  pool.addAttribute("temperature");
+  pool.addAttribute("temperature");  // the same attribute: no new column
+  pool.addAttribute("Cd_r");
+  EXPECT_EQ(pool.bytesPerRow(), 81u + 2u * 4u);
+}
+
+// Removal moves runs of kept rows: one long run when the oldest die together (a rate emitter
+// with a fixed lifetime), many short ones when deaths are scattered. Each pattern keeps the
+// survivors in id order with every column, on 1 and 2 threads, and leaves no flag set.
+TEST(ParticlePool, EveryPatternOfDeathsKeepsTheSurvivorsWithTheirColumns) {
+  constexpr int kRows = 3000;
+  const std::vector<std::pair<const char*, std::function<bool(int)>>> patterns{
+      {"the oldest 1000", [](int i) { return i < 1000; }},
+      {"the youngest 7", [](int i) { return i >= kRows - 7; }},
+      {"every other", [](int i) { return i % 2 == 1; }},
+      {"runs of 5 every 37", [](int i) { return i % 37 < 5; }},
+      {"scattered", [](int i) { return (i * 7919) % 101 == 3; }},
+      {"all", [](int) { return true; }},
+  };
+  for (const auto& [name, dies] : patterns) {
+    for (int threads : {1, 2}) {
+      ParticlePool pool(kRows);
+      const std::size_t tag = pool.addAttribute("tag", -1.0f);
+      std::vector<std::uint64_t> expected;
+      for (int i = 0; i < kRows; ++i) {
+        pool.spawn(tagged(static_cast<float>(i)), i / 100);
+        pool.attribute(tag)[i] = 10.0f * static_cast<float>(i);
+        if (dies(i)) {
+          pool.dead()[static_cast<std::size_t>(i)] = 1;
+        } else {
+          expected.push_back(static_cast<std::uint64_t>(i));
+        }
+      }
+      Vec3Column follower = pool.velocity();  // a caller's copy, as the system keeps one
+      pool.applyRemovalTo(follower);
+      tbb::task_arena arena(threads);
+      const std::size_t removed = arena.execute([&] { return pool.removeDead(); });
+      ASSERT_EQ(removed, kRows - expected.size()) << name;
+      ASSERT_EQ(pool.size(), expected.size()) << name;
+      for (std::size_t i = 0; i < expected.size(); ++i) {
+        const auto r = static_cast<Eigen::Index>(i);
+        const float x = static_cast<float>(expected[i]);
+        ASSERT_EQ(pool.id()[i], expected[i]) << name << ", row " << i;
+        ASSERT_EQ(pool.birthTick()[i], static_cast<std::int64_t>(expected[i] / 100)) << name;
+        ASSERT_EQ(pool.position().y[r], 2.0f * x) << name << ", row " << i;
+        ASSERT_EQ(pool.previousPosition().z[r], -x) << name << ", row " << i;
+        ASSERT_EQ(pool.velocity().x[r], 0.5f * x) << name << ", row " << i;
+        ASSERT_EQ(follower.x[r], 0.5f * x) << name << ", row " << i;
+        ASSERT_EQ(pool.mass()[r], 1.0f + x) << name << ", row " << i;
+        ASSERT_EQ(pool.inverseMass()[r], 1.0f / (1.0f + x)) << name << ", row " << i;
+        ASSERT_EQ(pool.attribute(tag)[r], 10.0f * x) << name << ", row " << i;
+      }
+      for (int i = 0; i < kRows; ++i)
+        ASSERT_EQ(pool.dead()[static_cast<std::size_t>(i)], 0) << name;
+    }
   }
 }
 
