@@ -17,6 +17,9 @@ double sin(double x);
 /// Cosine of `x` radians; same guarantees as det::sin.
 double cos(double x);
 
+/// det::sin(x) and det::cos(x), the same bits, from one range reduction.
+void sincos(double x, double& sine, double& cosine);
+
 /// Cube root of `x` >= 0 by Newton's method from an exact power-of-two start; deterministic.
 double cbrt(double x);
 

@@ -97,7 +97,12 @@ Emitter::Emitter(EmitterSettings settings, std::uint32_t index, std::int64_t ste
   throwIfAny("emitter", s_.validate());
   // Both normalise in double: validate() made sure they can.
   s_.direction.normalize();
-  if (auto* disc = std::get_if<DiscShape>(&s_.shape)) disc->normal.normalize();
+  if (auto* disc = std::get_if<DiscShape>(&s_.shape)) {
+    disc->normal.normalize();
+    basis(disc->normal, discB1_, discB2_);
+  }
+  basis(s_.direction, directionB1_, directionB2_);
+  cosSpread_ = det::cos(s_.spreadDegrees * (det::kPi / 180.0));
   rate_ = EmissionRate(std::llround(s_.rate * static_cast<double>(EmissionRate::kMicrosPerSecond)),
                        s_.start, s_.stop, stepRate_);
   for (const Burst& b : s_.bursts)
@@ -135,8 +140,9 @@ std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t
 }
 
 ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
-  auto uniform = [&](RandomPurpose purpose) {
-    return randomUniform(RandomKey{seed, index_, serial, static_cast<std::uint32_t>(purpose)});
+  const ParticleRandom random(seed, index_, serial);
+  const auto uniform = [&](RandomPurpose purpose) {
+    return random.uniform(static_cast<std::uint32_t>(purpose));
   };
   constexpr double kTwoPi = 2.0 * det::kPi;
 
@@ -144,34 +150,32 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
   if (const auto* sphere = std::get_if<SphereShape>(&s_.shape)) {
     const double z = 1.0 - 2.0 * uniform(RandomPurpose::PositionU);
     const double rxy = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = kTwoPi * uniform(RandomPurpose::PositionV);
+    double sinPhi = 0.0, cosPhi = 0.0;
+    det::sincos(kTwoPi * uniform(RandomPurpose::PositionV), sinPhi, cosPhi);
     const double r = sphere->surface
                          ? sphere->radius
                          : sphere->radius * det::cbrt(uniform(RandomPurpose::PositionW));
-    offset = r * Eigen::Vector3d(rxy * det::cos(phi), rxy * det::sin(phi), z);
+    offset = r * Eigen::Vector3d(rxy * cosPhi, rxy * sinPhi, z);
   } else if (const auto* box = std::get_if<BoxShape>(&s_.shape)) {
     offset = Eigen::Vector3d(uniform(RandomPurpose::PositionU) - 0.5,
                              uniform(RandomPurpose::PositionV) - 0.5,
                              uniform(RandomPurpose::PositionW) - 0.5)
                  .cwiseProduct(box->size);
   } else if (const auto* disc = std::get_if<DiscShape>(&s_.shape)) {
-    Eigen::Vector3d b1, b2;
-    basis(disc->normal, b1, b2);
     const double r = disc->radius * std::sqrt(uniform(RandomPurpose::PositionU));
-    const double phi = kTwoPi * uniform(RandomPurpose::PositionV);
-    offset = (r * det::cos(phi)) * b1 + (r * det::sin(phi)) * b2;
+    double sinPhi = 0.0, cosPhi = 0.0;
+    det::sincos(kTwoPi * uniform(RandomPurpose::PositionV), sinPhi, cosPhi);
+    offset = (r * cosPhi) * discB1_ + (r * sinPhi) * discB2_;
   }
 
   Eigen::Vector3d dir = s_.direction;
   if (s_.spreadDegrees > 0.0) {
     // Uniform over the spherical cap of half-angle `spread` around the direction.
-    Eigen::Vector3d b1, b2;
-    basis(s_.direction, b1, b2);
-    const double cosMax = det::cos(s_.spreadDegrees * (det::kPi / 180.0));
-    const double cosT = 1.0 - uniform(RandomPurpose::DirectionU) * (1.0 - cosMax);
+    const double cosT = 1.0 - uniform(RandomPurpose::DirectionU) * (1.0 - cosSpread_);
     const double sinT = std::sqrt(std::max(0.0, 1.0 - cosT * cosT));
-    const double phi = kTwoPi * uniform(RandomPurpose::DirectionV);
-    dir = (sinT * det::cos(phi)) * b1 + (sinT * det::sin(phi)) * b2 + cosT * s_.direction;
+    double sinPhi = 0.0, cosPhi = 0.0;
+    det::sincos(kTwoPi * uniform(RandomPurpose::DirectionV), sinPhi, cosPhi);
+    dir = (sinT * cosPhi) * directionB1_ + (sinT * sinPhi) * directionB2_ + cosT * s_.direction;
   }
   const double speed =
       s_.speed * (1.0 + s_.speedJitter * (2.0 * uniform(RandomPurpose::Speed) - 1.0));

@@ -105,6 +105,10 @@ class Emitter {
   std::int64_t stepRate_;
   EmissionRate rate_{0, 0.0, 0.0, 1};
   std::vector<std::pair<std::int64_t, std::uint64_t>> burstTicks_;  // (tick, count), sorted
+  // What sample() would otherwise work out for every particle, worked out once (the same bits):
+  // the bases around the direction and the disc's normal, the cosine of the spread.
+  Eigen::Vector3d directionB1_, directionB2_, discB1_, discB2_;
+  double cosSpread_ = 1.0;
 };
 
 }  // namespace tickfx

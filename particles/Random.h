@@ -50,4 +50,19 @@ inline double uniformFromBits(std::uint64_t bits) {
   return static_cast<double>(bits >> 11) * 0x1.0p-53;
 }
 
+/// The draws of one particle: randomBits() and randomUniform() for (seed, emitter, serial) and any
+/// purpose, the same values, with the rounds that mix in the first three coordinates done once
+/// rather than once a draw.
+class ParticleRandom {
+ public:
+  ParticleRandom(std::uint64_t seed, std::uint32_t emitter, std::uint64_t serial);
+  std::uint64_t bits(std::uint32_t purpose) const {
+    return mix64(mixed_ ^ (static_cast<std::uint64_t>(purpose) * 0xf1357aea2e62a9c5ULL + 3));
+  }
+  double uniform(std::uint32_t purpose) const { return uniformFromBits(bits(purpose)); }
+
+ private:
+  std::uint64_t mixed_;
+};
+
 }  // namespace tickfx

@@ -127,6 +127,55 @@ TEST(DetMath, CbrtOfUniformNumbers) {
   }
 }
 
+// The Newton iteration as it was written first: every step until a fixed point or 60 of them.
+// det::cbrt stops early on a two-value cycle; its bits must be this loop's, cycles included.
+double cbrtAllSteps(double x) {
+  int e = 0;
+  const double m = std::frexp(x, &e);
+  double y = std::ldexp(1.0, e >= 0 ? e / 3 : -((-e) / 3));
+  y = y * (m > 0.75 ? 1.0 : 0.8);
+  for (int i = 0; i < 60; ++i) {
+    const double next = y - (y * y * y - x) / (3.0 * y * y);
+    if (next == y) break;
+    y = next;
+  }
+  return y;
+}
+
+TEST(DetMath, CbrtGivesTheBitsOfEverySixtyStepsIncludingCycles) {
+  int cycles = 0;
+  for (std::uint64_t serial = 0; serial < 200000; ++serial) {
+    const std::uint64_t bits = randomBits(RandomKey{5, 1, serial, 9});
+    // Half uniform numbers in (0, 1), half any positive finite double.
+    double x = serial % 2 == 0 ? uniformFromBits(bits) : std::bit_cast<double>(bits >> 1);
+    if (!(x > 0.0) || !std::isfinite(x)) continue;
+    const double all = cbrtAllSteps(x);
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(det::cbrt(x)), std::bit_cast<std::uint64_t>(all)) << x;
+    double y = all;
+    cycles += y - (y * y * y - x) / (3.0 * y * y) != y;  // still moving after 60 steps: a cycle
+  }
+  EXPECT_GT(cycles, 1000);  // about one input in 15: the cycle path is exercised
+}
+
+// sincos is sin and cos from one reduction: the same bits in every quadrant, for small, large
+// (Payne–Hanek) and negative arguments.
+TEST(DetMath, SincosGivesTheBitsOfSinAndCos) {
+  std::vector<double> xs{0.0,      -0.0, 1e-300, det::kPi / 4, det::kPi / 2,
+                         det::kPi, 1e6,  -1e6,   1e22,         -3e300};
+  for (int k = -2000; k <= 2000; ++k) xs.push_back(k * 0.0123456789);
+  for (std::uint64_t serial = 0; serial < 2000; ++serial)
+    xs.push_back(2.0 * det::kPi * randomUniform(RandomKey{1, 0, serial, 5}));
+  for (const double x : xs) {
+    double s = 0.0, c = 0.0;
+    det::sincos(x, s, c);
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(s), std::bit_cast<std::uint64_t>(det::sin(x))) << x;
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(c), std::bit_cast<std::uint64_t>(det::cos(x))) << x;
+  }
+  double s = 0.0, c = 0.0;
+  det::sincos(std::numeric_limits<double>::infinity(), s, c);
+  EXPECT_TRUE(std::isnan(s) && std::isnan(c));
+}
+
 TEST(Random, UniformIsInTheHalfOpenUnitIntervalWithMeanOneHalf) {
   EXPECT_EQ(uniformFromBits(0), 0.0);
   EXPECT_LT(uniformFromBits(~std::uint64_t{0}), 1.0);
@@ -176,6 +225,35 @@ TEST(Random, KnownKeysKeepTheirBitsAcrossVersions) {
   EXPECT_EQ(randomBits(RandomKey{0, 0, 0, 0}), 0xf55beca798195c6full);
   EXPECT_EQ(randomBits(RandomKey{7, 2, 1000, 4}), 0x80f5f13cd31e74e0ull);
   EXPECT_EQ(randomBits(RandomKey{~0ull, ~0u, ~0ull, ~0u}), 0xf7578c44c5683a89ull);
+}
+
+// randomBits as first written, a round per coordinate in turn (the pinned words below hold it).
+std::uint64_t bitsAsFirstWritten(const RandomKey& key) {
+  std::uint64_t h = splitmix64(key.seed);
+  h = mix64(h ^ (static_cast<std::uint64_t>(key.emitter) * 0xd1b54a32d192ed03ULL + 1));
+  h = mix64(h ^ (key.serial * 0xaef17502108ef2d9ULL + 2));
+  return mix64(h ^ (static_cast<std::uint64_t>(key.purpose) * 0xf1357aea2e62a9c5ULL + 3));
+}
+
+// ParticleRandom mixes (seed, emitter, serial) once for all of a particle's draws: the values of
+// the four rounds, and of randomBits and randomUniform, for every purpose.
+TEST(Random, AParticlesDrawsAreTheKeysValues) {
+  for (const std::uint64_t seed : {0ull, 7ull, ~0ull}) {
+    for (const std::uint32_t emitter : {0u, 3u, ~0u}) {
+      for (std::uint64_t serial = 0; serial < 300; ++serial) {
+        const ParticleRandom random(seed, emitter, serial * 0x9e3779b9ull);
+        for (const std::uint32_t purpose : {0u, 1u, 7u, 64u, ~0u}) {
+          const RandomKey key{seed, emitter, serial * 0x9e3779b9ull, purpose};
+          ASSERT_EQ(random.bits(purpose), bitsAsFirstWritten(key));
+          ASSERT_EQ(randomBits(key), bitsAsFirstWritten(key));
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(random.uniform(purpose)),
+                    std::bit_cast<std::uint64_t>(uniformFromBits(bitsAsFirstWritten(key))));
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(randomUniform(key)),
+                    std::bit_cast<std::uint64_t>(uniformFromBits(bitsAsFirstWritten(key))));
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
