@@ -1,8 +1,11 @@
 #include "fields/SpringNetwork.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+
+#include "particles/ParallelFor.h"
 
 namespace tickfx {
 namespace {
@@ -25,16 +28,45 @@ std::uint32_t rowOf(const std::vector<std::uint64_t>& ids, std::size_t size, std
 }  // namespace
 
 void SpringNetwork::beginTick(const ParticlePool& pool, std::int64_t /*tick*/) {
+  if (!tablesStillHold(pool)) rebuild(pool);
+}
+
+// The tables are a function of the rows' ids, the ids born so far (an end not born yet) and the
+// positions (breaks). Rows that did not move, no end born or dying, and no spring stretched past
+// its ratio give the tables of the tick before: most ticks of a cloth. The break test reads only
+// (parallel blocks, a flag); any break leaves the rebuild to do it in spring order.
+bool SpringNetwork::tablesStillHold(const ParticlePool& pool) const {
+  if (!built_ || pool.rowsVersion() != builtRowsVersion_) return false;
+  if (pendingEnds_ > 0 && pool.nextId() != builtNextId_) return false;
+  if (!breakable_) return true;
+  const Vec3Column& p = pool.position();
+  std::atomic<bool> broke{false};
+  parallelForRows(ends_.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const Ends& e = ends_[k];
+      const Spring& spring = springs_[e.spring];
+      if (!(spring.breakRatio > 0.0f)) continue;
+      const float dx = p.x[e.b] - p.x[e.a], dy = p.y[e.b] - p.y[e.a], dz = p.z[e.b] - p.z[e.a];
+      const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (length > spring.breakRatio * spring.restLength) {
+        broke.store(true, std::memory_order_relaxed);
+        return;
+      }
+    }
+  });
+  return !broke.load(std::memory_order_relaxed);
+}
+
+void SpringNetwork::rebuild(const ParticlePool& pool) {
   const std::size_t n = pool.size();
   const Vec3Column& p = pool.position();
   // Resolve ends, drop springs with a dead end, break the overstretched: all from the state at
   // the start of the tick, in spring order, so the surviving list is the same on every run.
-  struct Ends {
-    std::uint32_t a, b, spring;
-  };
-  std::vector<Ends> ends;
-  ends.reserve(springs_.size());
+  ends_.clear();
+  ends_.reserve(springs_.size());
   std::size_t kept = 0;
+  pendingEnds_ = 0;
+  breakable_ = false;
   for (std::size_t s = 0; s < springs_.size(); ++s) {
     const Spring& spring = springs_[s];
     const std::uint32_t ra = rowOf(pool.id(), n, spring.a);
@@ -43,7 +75,11 @@ void SpringNetwork::beginTick(const ParticlePool& pool, std::int64_t /*tick*/) {
       // An end not born yet keeps the spring; an end that died removes it.
       const bool died = (ra == kMissing && spring.a < pool.nextId()) ||
                         (rb == kMissing && spring.b < pool.nextId());
-      if (!died) springs_[kept++] = spring;
+      if (!died) {
+        breakable_ = breakable_ || spring.breakRatio > 0.0f;
+        springs_[kept++] = spring;
+        ++pendingEnds_;
+      }
       continue;
     }
     if (spring.breakRatio > 0.0f) {
@@ -53,25 +89,29 @@ void SpringNetwork::beginTick(const ParticlePool& pool, std::int64_t /*tick*/) {
         ++broken_;
         continue;
       }
+      breakable_ = true;
     }
-    ends.push_back(Ends{ra, rb, static_cast<std::uint32_t>(kept)});
+    ends_.push_back(Ends{ra, rb, static_cast<std::uint32_t>(kept)});
     springs_[kept++] = spring;
   }
   springs_.resize(kept);
 
   // Each row's links, in spring order (a counting sort keeps that order within a row).
   first_.assign(n + 1, 0);
-  for (const Ends& e : ends) {
+  for (const Ends& e : ends_) {
     ++first_[e.a + 1];
     ++first_[e.b + 1];
   }
   for (std::size_t r = 0; r < n; ++r) first_[r + 1] += first_[r];
   links_.resize(first_[n]);
   std::vector<std::uint32_t> fill(first_.begin(), first_.end() - 1);
-  for (const Ends& e : ends) {
+  for (const Ends& e : ends_) {
     links_[fill[e.a]++] = Link{e.b, e.spring};
     links_[fill[e.b]++] = Link{e.a, e.spring};
   }
+  built_ = true;
+  builtRowsVersion_ = pool.rowsVersion();
+  builtNextId_ = pool.nextId();
 }
 
 void SpringNetwork::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acc) const {

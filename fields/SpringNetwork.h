@@ -40,7 +40,10 @@ class SpringNetwork final : public ForceModule {
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
 
   /// Adds a spring (ends may be spawned later; until both exist it does nothing).
-  void add(const Spring& spring) { springs_.push_back(spring); }
+  void add(const Spring& spring) {
+    springs_.push_back(spring);
+    built_ = false;
+  }
   /// Springs still in the network (dead ends and broken ones are removed at beginTick).
   const std::vector<Spring>& springs() const { return springs_; }
   /// Springs broken by stretching since construction.
@@ -49,6 +52,7 @@ class SpringNetwork final : public ForceModule {
   void restore(std::vector<Spring> springs, std::uint64_t broken) {
     springs_ = std::move(springs);
     broken_ = broken;
+    built_ = false;
   }
 
  private:
@@ -57,11 +61,25 @@ class SpringNetwork final : public ForceModule {
     std::uint32_t spring;  // index into springs_
   };
 
+  struct Ends {
+    std::uint32_t a, b, spring;  // the rows of a spring's ends, and the spring's index
+  };
+
+  bool tablesStillHold(const ParticlePool& pool) const;
+  void rebuild(const ParticlePool& pool);
+
   std::vector<Spring> springs_;
   std::uint64_t broken_ = 0;
-  // Per tick: row → [first_[row], first_[row+1]) in links_, in spring order.
+  // Row → [first_[row], first_[row+1]) in links_, in spring order; rebuilt when rows moved, ends
+  // were born or died, or a spring broke (beginTick), else kept from the tick before.
   std::vector<std::uint32_t> first_;
   std::vector<Link> links_;
+  std::vector<Ends> ends_;  // the springs with both ends alive, in spring order
+  bool built_ = false;
+  bool breakable_ = false;       // some spring has a break ratio
+  std::size_t pendingEnds_ = 0;  // springs kept for an end not born yet
+  std::uint64_t builtRowsVersion_ = 0;
+  std::uint64_t builtNextId_ = 0;
 };
 
 }  // namespace tickfx

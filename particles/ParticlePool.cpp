@@ -236,6 +236,7 @@ std::size_t ParticlePool::removeDead() {
             dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
   const std::size_t removed = size_ - kept;
   size_ = kept;
+  ++rowsVersion_;
   firstUnstepped_ = std::min(firstUnstepped_, size_);
   return removed;
 }
@@ -273,6 +274,7 @@ void ParticlePool::resizeForRestore(std::size_t size, std::uint64_t nextId,
   }
   reserve(size);
   size_ = size;
+  ++rowsVersion_;
   std::fill(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
   firstUnstepped_ = size_;
   nextId_ = nextId;

@@ -127,6 +127,11 @@ class ParticlePool {
   FloatColumn& attribute(std::size_t index) { return attributes_[index].values; }
   const FloatColumn& attribute(std::size_t index) const { return attributes_[index].values; }
 
+  /// Changes whenever rows already in the pool may have moved or been replaced (a removal that
+  /// removed something, a restore); appending rows keeps it. A module that keeps tables by row
+  /// (springs) rebuilds them only when it changed.
+  std::uint64_t rowsVersion() const { return rowsVersion_; }
+
   /// Rows the columns currently hold (>= size()); grows geometrically, never past maxParticles.
   std::size_t storageRows() const { return storageRows_; }
   /// Bytes a row takes over every column, the named attributes included: the pool's columns hold
@@ -160,6 +165,7 @@ class ParticlePool {
   std::size_t firstUnstepped_ = 0;
   std::uint64_t nextId_ = 0;
   std::uint64_t droppedSpawns_ = 0;
+  std::uint64_t rowsVersion_ = 0;
 
   Vec3Column position_, velocity_, previous_, acceleration_;
   FloatColumn age_, lifetime_, mass_, inverseMass_;

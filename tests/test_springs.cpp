@@ -1394,5 +1394,63 @@ INSTANTIATE_TEST_SUITE_P(Schemes, ClothThreads,
                          ::testing::Values("semi_implicit_euler", "velocity_verlet", "rk4"),
                          integratorName);
 
+// A network keeps its tables from the tick before when no row moved, no end was born or died and
+// no spring broke. Tick by tick, through births, deaths and breaks, its springs and forces are
+// those of a network that rebuilds everything (a fresh one restored from its springs).
+TEST(SpringTables, KeptFromTheTickBeforeTheyGiveTheForcesOfARebuild) {
+  ParticlePool pool(64);
+  for (int i = 0; i < 40; ++i) {
+    ParticleInit init;
+    init.position = Eigen::Vector3f(static_cast<float>(i) * 1.1f, 0.01f * static_cast<float>(i), 0);
+    init.velocity = Eigen::Vector3f(0, 0.1f * static_cast<float>(i % 3), 0);
+    init.mass = i == 0 ? std::numeric_limits<float>::infinity() : 1.0f;
+    pool.spawn(init, 0);
+  }
+  SpringNetwork live;
+  for (std::uint64_t i = 0; i + 1 < 40; ++i)
+    live.add(Spring{i, i + 1, 1.0f, 40.0f, 0.5f, i % 4 == 0 ? 1.5f : 0.0f});
+  for (std::uint64_t i = 40; i < 45; ++i) live.add(Spring{i - 30, i, 1.0f, 20.0f, 0.0f, 0.0f});
+  for (std::int64_t tick = 0; tick < 30; ++tick) {
+    if (tick == 5) {
+      for (int i = 40; i < 45; ++i) pool.spawn(ParticleInit{}, tick);  // pending ends born
+    }
+    if (tick == 10) {
+      pool.dead()[7] = 1;  // an end dies
+      pool.removeDead();
+    }
+    if (tick == 15) pool.position().x[20] += 5.0f;  // stretches springs 19-20 and 20-21
+    if (tick == 20) pool.position().x[32] += 0.2f;  // moves, breaks nothing
+    SpringNetwork fresh;
+    fresh.restore(live.springs(), live.brokenCount());
+    live.beginTick(pool, tick);
+    fresh.beginTick(pool, tick);
+    ASSERT_EQ(live.springs().size(), fresh.springs().size()) << "tick " << tick;
+    for (std::size_t k = 0; k < live.springs().size(); ++k) {
+      ASSERT_EQ(live.springs()[k].a, fresh.springs()[k].a) << "tick " << tick;
+      ASSERT_EQ(live.springs()[k].b, fresh.springs()[k].b) << "tick " << tick;
+    }
+    ASSERT_EQ(live.brokenCount(), fresh.brokenCount()) << "tick " << tick;
+    const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()), {}};
+    const RowRange rows{0, pool.size()};
+    Vec3Column a, b;
+    a.resize(ix(pool.size()));
+    b.resize(ix(pool.size()));
+    for (int c = 0; c < 3; ++c) {
+      a[c].setZero();
+      b[c].setZero();
+    }
+    Vec3Rows ra = Vec3Rows::of(a, rows), rb = Vec3Rows::of(b, rows);
+    live.accumulate(in, rows, ra);
+    fresh.accumulate(in, rows, rb);
+    for (std::size_t r = 0; r < pool.size(); ++r) {
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(bitsOf(a[c][ix(r)]), bitsOf(b[c][ix(r)])) << "tick " << tick << ", row " << r;
+    }
+    // Move every particle a little, as a tick would, so the break test sees new lengths.
+    for (std::size_t r = 1; r < pool.size(); ++r) pool.position().y[ix(r)] += 0.001f * a.y[ix(r)];
+  }
+  EXPECT_EQ(live.brokenCount(), 1u);  // 20-21, breakable, pulled at tick 15 (19-20 cannot break)
+}
+
 }  // namespace
 }  // namespace tickfx
