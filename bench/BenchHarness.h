@@ -144,6 +144,34 @@ inline void printBuild() {
   }
 }
 
+// ---- summary lines --------------------------------------------------------------------------
+// Each bench ends with one line a figure, `name: value unit (ratios, targets)`, whose name holds a
+// size or a thread count; scripts/bench collects them from every bench's output.
+
+// %.3g without the exponent's plus sign and leading zeros: 1.27e7, 5e7, 0.62, 530.
+inline std::string g3(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  std::string s(buf);
+  const std::size_t e = s.find('e');
+  if (e == std::string::npos) return s;
+  const std::size_t digits = s[e + 1] == '-' ? e + 2 : e + 1;
+  s.erase(digits, s.find_first_not_of("+0", digits) - digits);
+  return s;
+}
+
+// 1e6 for 1000000; a count that is not a round power of ten as it is.
+inline std::string sizeLabel(std::size_t n) {
+  int exponent = 0;
+  std::size_t mantissa = n;
+  while (mantissa >= 10 && mantissa % 10 == 0) {
+    mantissa /= 10;
+    ++exponent;
+  }
+  if (exponent < 3) return std::to_string(n);
+  return std::to_string(mantissa) + "e" + std::to_string(exponent);
+}
+
 // The value of a `--key=value` argument, or nothing when `arg` is another argument.
 inline std::optional<std::string> valueOf(std::string_view arg, std::string_view prefix) {
   if (arg.substr(0, prefix.size()) != prefix) return std::nullopt;

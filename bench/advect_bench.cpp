@@ -23,6 +23,8 @@
 // Both run inside a tbb::task_arena of the case's thread count. Each batch first restores the
 // starting points (a 12 MB copy, the same for both), so every batch times the same trajectory.
 // The two give bitwise identical positions (checked below and in tests/test_vdb_advect.cpp).
+//
+// Output: the table, then one line a figure, `name: value unit (ratios, targets)`.
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/PointAdvect.h>
 #include <tbb/task_arena.h>
@@ -247,5 +249,22 @@ int main(int argc, char** argv) {
   std::printf(
       "\nratio: PointAdvect's time per step over the case's (> 1: faster than "
       "PointAdvect); each batch includes restoring the starting points.\n");
+
+  // The summary, one line a figure (BenchHarness.h).
+  std::printf("\n");
+  for (std::size_t i = 0; i < cases.size(); i += 2) {
+    const AdvectCase& c = cases[i];
+    const double oursT = bench::median(c.secondsPerTick);
+    const double theirsT = bench::median(cases[i + 1].secondsPerTick);
+    std::printf(
+        "advect order %d %d thread%s %s %s: %.2fx PointAdvect (target >= 2x), %s particle-steps/s "
+        "(PointAdvect %s",
+        c.order, c.threads, c.threads == 1 ? "" : "s", c.name.substr(0, c.name.find(' ')).c_str(),
+        bench::sizeLabel(count).c_str(), theirsT / oursT,
+        bench::g3(static_cast<double>(count) / oursT).c_str(),
+        bench::g3(static_cast<double>(count) / theirsT).c_str());
+    if (c.threads > 1) std::printf("; %.2f of %d cores busy", c.cpu / c.timed, c.threads);
+    std::printf(")\n");
+  }
   return 0;
 }

@@ -41,6 +41,8 @@
 // name of its own and the files are deleted between batches, outside the timed part: deleting
 // costs 0.03 s per GB while its pages are dirty and 0.2 s per GB once written back (ext4), as
 // much as dd's whole write, so timing it would pull every ratio towards 1.
+//
+// Output: the tables, then one line a figure, `name: value unit (ratios, targets)`.
 #include <fcntl.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
@@ -609,6 +611,31 @@ void printOverlap(const std::vector<OverlapRow>& rows, int rounds, int threads) 
   }
 }
 
+// The summary, one line a figure (BenchHarness.h), from both parts' tables.
+void printFigures(const Part1& p, const std::vector<OverlapRow>& overlap, int allThreads) {
+  std::printf("\n");
+  for (const ResultRow& r : p.rows) {
+    std::string name = r.format + " " + bench::sizeLabel(r.n);
+    if (r.threads != allThreads) name += " " + threadsLabel(r.threads);
+    if (r.synced) name += " synced";
+    // The targets are judged at 10⁶ on all threads with the default durability (printPart1).
+    const bool judged = r.n == kTargetSize && r.threads == allThreads && !r.synced;
+    const std::string where = judged ? "" : " at 1e6, " + threadsLabel(allThreads);
+    std::printf("cache %s: k = %.3g x dd%s (target <= %g%s), %s particles/s, %s MB/s\n",
+                name.c_str(), r.writer / r.dd, r.synced ? " with fsync" : "", r.target,
+                where.c_str(), bench::g3(static_cast<double>(r.n) / r.writer).c_str(),
+                bench::g3(r.bytes / 1e6 / r.writer).c_str());
+  }
+  for (const OverlapRow& r : overlap) {
+    const double a = bench::median(r.simulate.wall), b = bench::median(r.write.wall);
+    const double c = bench::median(r.overlapped.wall), d = bench::median(r.inlined.wall);
+    std::printf(
+        "cache overlap %s %s: wall %.3g x max(sim, write) (target <= 1.15), gain %.2fx over "
+        "inline\n",
+        r.format.c_str(), bench::sizeLabel(r.n).c_str(), c / std::max(a, b), d / c);
+  }
+}
+
 // ---- the run ----------------------------------------------------------------------------------
 
 void usage(const char* argv0) {
@@ -763,6 +790,7 @@ int run(int argc, char** argv) {
     printPart1(part1, allThreads);
     std::fflush(stdout);
 
+    std::vector<OverlapRow> overlapRows;
     if (overlapSize > 0) {
       std::printf("\noverlap: a burst of %zu particles, gravity, 120 Hz, 24 fps, %d rounds\n",
                   overlapSize, overlapRounds);
@@ -773,15 +801,16 @@ int run(int argc, char** argv) {
         fs::remove_all(dir, ec);
         return 1;
       }
-      std::vector<OverlapRow> rows;
       bool same = true;
       for (const io::CacheFormat format : {io::CacheFormat::Ply, io::CacheFormat::Csv})
-        same = runOverlap(format, *load.effect, overlapSize, overlapRounds, dir, rows) && same;
-      printOverlap(rows, overlapRounds, allThreads);
+        same =
+            runOverlap(format, *load.effect, overlapSize, overlapRounds, dir, overlapRows) && same;
+      printOverlap(overlapRows, overlapRounds, allThreads);
       if (!same)
         std::printf("CHECK FAILED: the overlap cases did not all start and end in one state\n");
       ok = ok && same;
     }
+    printFigures(part1, overlapRows, allThreads);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cache_bench: %s\n", e.what());
     fs::remove_all(dir, ec);

@@ -25,6 +25,8 @@
 // Timing as in tick_bench (BenchHarness.h): batches of ticks sized to min-time/reps seconds, the
 // cases taking turns batch by batch; a case's figure is the median over its batches of the time
 // per tick.
+//
+// Output: the table, then one line a figure, `name: value unit (ratios, targets)`.
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
@@ -254,5 +256,31 @@ int main(int argc, char** argv) {
                                                          static_cast<double>(acceleration.y.sum()));
   if (!same) std::printf("CHECK FAILED: 1 and 2 threads disagree after one tick\n");
   if (!finite) std::printf("CHECK FAILED: the cloth blew up; the figures time NaN arithmetic\n");
+
+  // The summary, one line a figure (BenchHarness.h).
+  const std::string size = std::to_string(o.side) + "^2";
+  const char* z = size.c_str();
+  const double evaluations = 2.0 * static_cast<double>(springs);
+  const double n = static_cast<double>(particles);
+  std::printf("\n");
+  std::printf(
+      "springs step 1 thread %s: %s particle-steps/s (%s spring evaluations/s, %s ms a tick)\n", z,
+      bench::g3(n / seconds[0]).c_str(), bench::g3(evaluations / seconds[0]).c_str(),
+      bench::g3(1e3 * seconds[0]).c_str());
+  std::printf(
+      "springs step 2 threads %s: %.2fx 1 thread (target >= 1.8x), %s particle-steps/s (%s spring "
+      "evaluations/s, %s ms a tick; %.2f of 2 cores busy)\n",
+      z, seconds[0] / seconds[1], bench::g3(n / seconds[1]).c_str(),
+      bench::g3(evaluations / seconds[1]).c_str(), bench::g3(1e3 * seconds[1]).c_str(),
+      cases[1].cpu / cases[1].timed);
+  std::printf("springs evaluate 1 thread %s: %s spring evaluations/s (%s ms a tick)\n", z,
+              bench::g3(evaluations / seconds[2]).c_str(), bench::g3(1e3 * seconds[2]).c_str());
+  std::printf(
+      "springs evaluate 2 threads %s: %.2fx 1 thread, %s spring evaluations/s (%s ms a tick; "
+      "%.2f of 2 cores busy)\n",
+      z, seconds[2] / seconds[3], bench::g3(evaluations / seconds[3]).c_str(),
+      bench::g3(1e3 * seconds[3]).c_str(), cases[3].cpu / cases[3].timed);
+  std::printf("springs beginTick %s: %s ms (serial; %.0f %% of a 1-thread step())\n", z,
+              bench::g3(1e3 * seconds[4]).c_str(), 100.0 * seconds[4] / seconds[0]);
   return same && finite ? 0 : 1;
 }

@@ -23,6 +23,8 @@
 //
 // Timing (BenchHarness.h): batches of ticks sized to min-time/reps seconds, the cases of one size
 // taking turns batch by batch; a case's figure is the median over its batches of the time per tick.
+//
+// Output: the tables, then one line a figure, `name: value unit (ratios, targets)`.
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
@@ -310,6 +312,7 @@ struct Row {
   std::string name;
   double stepsPerSecond;
   double ratio;
+  double cores;  // CPU over wall time while the case ran
 };
 
 std::string threadsLabel(int threads) {
@@ -403,7 +406,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
     std::printf("  %-30s %10.4f ms/tick  (median of %zu batches of %lld ticks; %.4f to %.4f)\n",
                 c.name.c_str(), 1e3 * s, c.secondsPerTick.size(), static_cast<long long>(c.batch),
                 1e3 * *lo, 1e3 * *hi);
-    rows.push_back({n, c.name, static_cast<double>(n) / s, aosSeconds / s});
+    rows.push_back({n, c.name, static_cast<double>(n) / s, aosSeconds / s, c.cpu / c.timed});
   }
   std::fflush(stdout);
 
@@ -418,6 +421,12 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 // that reads the tile anyway, so what is left is near the spread of where code and columns happen
 // to sit in memory: a second unchecked system, timed alongside, shows that spread (A/A).
 void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& timing) {
+  struct Cost {
+    std::size_t n;
+    std::string integrator;
+    double cost, spread;  // %
+  };
+  std::vector<Cost> costs;
   std::printf("\nnon-finite check, step() on 1 thread: checked against unchecked\n");
   std::printf("%10s  %-22s %14s %14s %10s %12s\n", "N", "integrator", "checked ms", "unchecked ms",
               "cost", "A/A spread");
@@ -441,10 +450,64 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
       const double with = bench::median(cases[0].secondsPerTick);
       const double without = bench::median(cases[1].secondsPerTick);
       const double copy = bench::median(cases[2].secondsPerTick);
+      costs.push_back({n, name, 100.0 * (with / without - 1.0), 100.0 * (copy / without - 1.0)});
       std::printf("%10zu  %-22s %14.4f %14.4f %+9.1f %% %+10.1f %%\n", n, name.c_str(), 1e3 * with,
-                  1e3 * without, 100.0 * (with / without - 1.0), 100.0 * (copy / without - 1.0));
+                  1e3 * without, costs.back().cost, costs.back().spread);
       std::fflush(stdout);
     }
+  }
+  std::printf("\n");
+  for (const Cost& c : costs) {
+    std::printf("check cost %s %s: %+.1f %% of the tick (target < 2 %%; A/A spread %+.1f %%)\n",
+                c.integrator.c_str(), bench::sizeLabel(c.n).c_str(), c.cost, c.spread);
+  }
+}
+
+// The summary, one line a figure (BenchHarness.h), from the rows of the table.
+void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& sizes,
+                  int allThreads) {
+  const std::string all = threadsLabel(allThreads);
+  const char* t = all.c_str();
+  std::printf("\n");
+  for (const std::size_t n : sizes) {
+    const auto row = [&](const std::string& name) {
+      for (const Row& r : rows) {
+        if (r.n == n && r.name == name) return r;
+      }
+      return Row{n, name, 0.0, 0.0, 0.0};
+    };
+    const std::string size = bench::sizeLabel(n);
+    const char* z = size.c_str();
+    const auto rate = [](const Row& r) { return bench::g3(r.stepsPerSecond); };
+    const Row aos = row("AoS loop, 1 thread"), soa = row("hand SoA loop, 1 thread"),
+              integrate = row("tickfx integrate, 1 thread"), step = row("tickfx step(), 1 thread");
+    const double a = aos.stepsPerSecond, h = soa.stepsPerSecond;
+    std::printf("tick AoS loop 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread)\n", z,
+                rate(aos).c_str(), a / h);
+    std::printf("tick hand SoA 1 thread %s: %s particle-steps/s (%.2fx AoS)\n", z,
+                rate(soa).c_str(), h / a);
+    std::printf(
+        "tick integrate 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread; %.2fx AoS)\n", z,
+        rate(integrate).c_str(), integrate.stepsPerSecond / h, integrate.stepsPerSecond / a);
+    std::printf(
+        "tick step 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread, target >= 0.9x; "
+        "%.2fx AoS)\n",
+        z, rate(step).c_str(), step.stepsPerSecond / h, step.stepsPerSecond / a);
+    if (allThreads == 1) continue;
+    const Row soaAll = row("hand SoA loop, " + all), integrateAll = row("tickfx integrate, " + all),
+              stepAll = row("tickfx step(), " + all);
+    const double hAll = soaAll.stepsPerSecond;
+    std::printf("tick hand SoA %s %s: %s particle-steps/s (%.2fx hand SoA 1 thread; %.2fx AoS)\n",
+                t, z, rate(soaAll).c_str(), hAll / h, hAll / a);
+    std::printf(
+        "tick integrate %s %s: %s particle-steps/s (%.2fx tickfx 1 thread; %.2fx hand SoA %s)\n", t,
+        z, rate(integrateAll).c_str(), integrateAll.stepsPerSecond / integrate.stepsPerSecond,
+        integrateAll.stepsPerSecond / hAll, t);
+    std::printf(
+        "tick step %s %s: %s particle-steps/s (%.2fx tickfx 1 thread, target >= 1.8x at 1e7; "
+        "%.2fx hand SoA %s; %.2f of %d cores busy)\n",
+        t, z, rate(stepAll).c_str(), stepAll.stepsPerSecond / step.stepsPerSecond,
+        stepAll.stepsPerSecond / hAll, t, stepAll.cores, allThreads);
   }
 }
 
@@ -527,5 +590,6 @@ int main(int argc, char** argv) {
   for (const Row& r : rows) {
     std::printf("%10zu  %-30s %18.4g %14.2f\n", r.n, r.name.c_str(), r.stepsPerSecond, r.ratio);
   }
+  printFigures(rows, o.sizes, allThreads);
   return ok ? 0 : 1;
 }
