@@ -160,6 +160,30 @@ inline std::string g3(double v) {
   return s;
 }
 
+// A whole count written as 1000000 or 1e6, at least `least` and at most 4e9; nothing otherwise.
+inline std::optional<std::size_t> parseCount(const std::string& item, double least) {
+  char* end = nullptr;
+  const double v = std::strtod(item.c_str(), &end);
+  if (item.empty() || *end != '\0' || !(v >= least) || v > 4e9 || v != std::floor(v)) {
+    return std::nullopt;
+  }
+  return static_cast<std::size_t>(v);
+}
+
+// A comma-separated list of counts of at least 1 (`--sizes=1e4,1e6`); nothing if any is not one.
+inline std::optional<std::vector<std::size_t>> parseSizes(std::string_view list) {
+  std::vector<std::size_t> sizes;
+  while (!list.empty()) {
+    const std::size_t comma = list.find(',');
+    const std::optional<std::size_t> n = parseCount(std::string(list.substr(0, comma)), 1.0);
+    if (!n) return std::nullopt;
+    sizes.push_back(*n);
+    list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
+  }
+  if (sizes.empty()) return std::nullopt;
+  return sizes;
+}
+
 // 1e6 for 1000000; a count that is not a round power of ten as it is.
 inline std::string sizeLabel(std::size_t n) {
   int exponent = 0;

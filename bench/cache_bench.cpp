@@ -652,27 +652,6 @@ void usage(const char* argv0) {
       argv0);
 }
 
-std::optional<std::size_t> parseCount(const std::string& item, double least) {
-  char* end = nullptr;
-  const double v = std::strtod(item.c_str(), &end);  // accepts 1e6 as well as 1000000
-  if (item.empty() || *end != '\0' || !(v >= least) || v > 1e9 || v != std::floor(v))
-    return std::nullopt;
-  return static_cast<std::size_t>(v);
-}
-
-std::optional<std::vector<std::size_t>> parseSizes(std::string_view list) {
-  std::vector<std::size_t> sizes;
-  while (!list.empty()) {
-    const std::size_t comma = list.find(',');
-    const std::optional<std::size_t> n = parseCount(std::string(list.substr(0, comma)), 1.0);
-    if (!n) return std::nullopt;
-    sizes.push_back(*n);
-    list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
-  }
-  if (sizes.empty()) return std::nullopt;
-  return sizes;
-}
-
 double freeBytes(const fs::path& dir) {
   struct statvfs s {};
   if (::statvfs(dir.c_str(), &s) != 0) return 0.0;
@@ -692,12 +671,12 @@ int run(int argc, char** argv) {
   bench::CommandLine cl;
   const auto own = [&](std::string_view arg) {
     if (auto v = bench::valueOf(arg, "--sizes=")) {
-      sizes = parseSizes(*v);
+      sizes = bench::parseSizes(*v);
       if (!sizes) std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
       return sizes ? bench::Arg::kTaken : bench::Arg::kBad;
     }
     if (auto v = bench::valueOf(arg, "--overlap=")) {
-      overlap = parseCount(*v, 0.0);
+      overlap = bench::parseCount(*v, 0.0);
       if (!overlap) std::fprintf(stderr, "bad --overlap: %s\n", v->c_str());
       return overlap ? bench::Arg::kTaken : bench::Arg::kBad;
     }

@@ -217,17 +217,6 @@ bool timeBursts(std::vector<BurstCase>& cases, const bench::Timing& timing) {
   return true;
 }
 
-std::string sizeLabel(std::size_t n) {
-  int exponent = 0;
-  std::size_t mantissa = n;
-  while (mantissa >= 10 && mantissa % 10 == 0) {
-    mantissa /= 10;
-    ++exponent;
-  }
-  if (exponent < 3) return std::to_string(n);
-  return std::to_string(mantissa) + "e" + std::to_string(exponent);
-}
-
 // At most 3 significant digits, as 3.14e7 or 5e7: short, and read back by any float parser.
 std::string sci(double v) {
   char buf[32];
@@ -278,7 +267,7 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
                std::vector<Figure>& figures, double& checksum) {
   std::printf("\nburst of N = %zu\n", n);
   std::fflush(stdout);
-  const std::string label = sizeLabel(n);
+  const std::string label = bench::sizeLabel(n);
   std::vector<int> threadCounts{1};
   if (arenas.allThreads > 1) threadCounts.push_back(arenas.allThreads);
 
@@ -556,7 +545,7 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
               "Emitter::emit() alone", 1e3 * emitAlone, emitSeconds.size(), perTick);
   std::fflush(stdout);
 
-  const std::string pop = sizeLabel(population);
+  const std::string pop = bench::sizeLabel(population);
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "steady %s tick with emitter 1 thread: %.4g ms (%.4g ms without emission; A/A "
@@ -602,28 +591,6 @@ void usage(const char* argv0) {
       argv0);
 }
 
-std::optional<std::size_t> parseCount(const std::string& item, double lowest) {
-  char* end = nullptr;
-  const double v = std::strtod(item.c_str(), &end);  // accepts 1e6 as well as 1000000
-  if (item.empty() || *end != '\0' || !(v >= lowest) || v > 4e9 || v != std::floor(v)) {
-    return std::nullopt;
-  }
-  return static_cast<std::size_t>(v);
-}
-
-std::optional<std::vector<std::size_t>> parseSizes(std::string_view list) {
-  std::vector<std::size_t> sizes;
-  while (!list.empty()) {
-    const std::size_t comma = list.find(',');
-    const std::optional<std::size_t> n = parseCount(std::string(list.substr(0, comma)), 1.0);
-    if (!n) return std::nullopt;
-    sizes.push_back(*n);
-    list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
-  }
-  if (sizes.empty()) return std::nullopt;
-  return sizes;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -632,7 +599,7 @@ int main(int argc, char** argv) {
   bench::CommandLine cl;
   const auto own = [&](std::string_view arg) {
     if (const std::optional<std::string> v = bench::valueOf(arg, "--sizes=")) {
-      sizes = parseSizes(*v);
+      sizes = bench::parseSizes(*v);
       if (!sizes) {
         std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
         return bench::Arg::kBad;
@@ -640,7 +607,7 @@ int main(int argc, char** argv) {
       return bench::Arg::kTaken;
     }
     if (const std::optional<std::string> v = bench::valueOf(arg, "--steady=")) {
-      steady = parseCount(*v, 0.0);
+      steady = bench::parseCount(*v, 0.0);
       if (!steady || (*steady > 0 && *steady < 60)) {
         std::fprintf(stderr, "bad --steady: %s (0, or at least 60 particles)\n", v->c_str());
         return bench::Arg::kBad;

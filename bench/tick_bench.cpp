@@ -522,23 +522,6 @@ void usage(const char* argv0) {
       argv0);
 }
 
-std::optional<std::vector<std::size_t>> parseSizes(std::string_view list) {
-  std::vector<std::size_t> sizes;
-  while (!list.empty()) {
-    const std::size_t comma = list.find(',');
-    const std::string item(list.substr(0, comma));
-    list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);  // accepts 1e6 as well as 1000000
-    if (item.empty() || *end != '\0' || !(v >= 1.0) || v > 4e9 || v != std::floor(v)) {
-      return std::nullopt;
-    }
-    sizes.push_back(static_cast<std::size_t>(v));
-  }
-  if (sizes.empty()) return std::nullopt;
-  return sizes;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -552,7 +535,7 @@ int main(int argc, char** argv) {
     }
     const std::optional<std::string> v = bench::valueOf(arg, "--sizes=");
     if (!v) return bench::Arg::kNotMine;
-    sizes = parseSizes(*v);
+    sizes = bench::parseSizes(*v);
     if (!sizes) {
       std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
       return bench::Arg::kBad;
