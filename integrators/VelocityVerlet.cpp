@@ -10,6 +10,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   const float halfDt2 = 0.5f * dt * dt;
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
+  pool.keepAcceleration();  // a(t) is kept from one tick to the next
   Vec3Column& a = pool.acceleration();
   Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = pool.firstUnstepped();

@@ -87,14 +87,21 @@ void ParticlePool::reserve(std::size_t rows) {
 
 std::size_t ParticlePool::bytesPerRow() const {
   constexpr std::size_t kVec3 = 3 * sizeof(float);
-  return 4 * kVec3 + 4 * sizeof(float) + sizeof(std::uint64_t) + sizeof(std::int64_t) +
-         sizeof(std::uint8_t) + attributes_.size() * sizeof(float);
+  return (keepsAcceleration_ ? 4 : 3) * kVec3 + 4 * sizeof(float) + sizeof(std::uint64_t) +
+         sizeof(std::int64_t) + sizeof(std::uint8_t) + attributes_.size() * sizeof(float);
+}
+
+void ParticlePool::keepAcceleration() {
+  if (keepsAcceleration_) return;
+  acceleration_.resize(static_cast<Eigen::Index>(storageRows_));
+  for (int c = 0; c < 3; ++c) acceleration_[c].setZero();
+  keepsAcceleration_ = true;
 }
 
 void ParticlePool::grow(std::size_t rows) {
   const auto n = static_cast<Eigen::Index>(rows);
-  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_})
-    c->conservativeResize(n);
+  for (Vec3Column* c : {&position_, &velocity_, &previous_}) c->conservativeResize(n);
+  if (keepsAcceleration_) acceleration_.conservativeResize(n);
   for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_}) c->conservativeResize(n);
   id_.resize(rows);
   birthTick_.resize(rows);
@@ -145,9 +152,11 @@ void ParticlePool::setRow(std::size_t row, const ParticleInit& init) {
   previous_.x[r] = init.position.x();
   previous_.y[r] = init.position.y();
   previous_.z[r] = init.position.z();
-  acceleration_.x[r] = 0.0f;
-  acceleration_.y[r] = 0.0f;
-  acceleration_.z[r] = 0.0f;
+  if (keepsAcceleration_) {
+    acceleration_.x[r] = 0.0f;
+    acceleration_.y[r] = 0.0f;
+    acceleration_.z[r] = 0.0f;
+  }
   age_[r] = 0.0f;
   lifetime_[r] = init.lifetime;
   mass_[r] = init.mass;
@@ -218,6 +227,7 @@ std::size_t ParticlePool::removeDead() {
   // Columns are independent: each is a task, moved whole (bytes only, nothing to reorder).
   std::vector<float*> floats;
   for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_}) {
+    if (c == &acceleration_ && !keepsAcceleration_) continue;
     for (int k = 0; k < 3; ++k) floats.push_back((*c)[k].data());
   }
   for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_}) floats.push_back(c->data());

@@ -66,8 +66,8 @@ class ParticlePool {
   /// order: an emitter fills the rows of a burst in parallel.
   std::size_t appendRows(std::size_t count, std::int64_t tick);
   /// Gives row `row` (appended, not yet stepped) its particle: position (and previous position),
-  /// velocity, lifetime and mass; acceleration and age 0. Different rows may be set at once from
-  /// different threads.
+  /// velocity, lifetime and mass; acceleration (when kept) and age 0. Different rows may be set at
+  /// once from different threads.
   void setRow(std::size_t row, const ParticleInit& init);
   /// Counts `count` spawns refused without trying them (the caller saw the pool was full).
   void refuseSpawns(std::uint64_t count) { droppedSpawns_ += count; }
@@ -93,8 +93,13 @@ class ParticlePool {
   Vec3Column& velocity() { return velocity_; }
   /// Position at the previous tick (for interpolation, and position Verlet's history).
   Vec3Column& previousPosition() { return previous_; }
-  /// Acceleration at the current state, kept by velocity Verlet between ticks (m/s²).
+  /// Acceleration at the current state, kept by velocity Verlet between ticks (m/s²). The column
+  /// exists only once keepAcceleration() was called (velocity Verlet does); until then it holds
+  /// no rows, and the state has 0 there (the state hash and checkpoints count it as zeros).
   Vec3Column& acceleration() { return acceleration_; }
+  /// Gives the pool its acceleration column, every row 0, if it has none yet.
+  void keepAcceleration();
+  bool keepsAcceleration() const { return keepsAcceleration_; }
   FloatColumn& age() { return age_; }
   FloatColumn& lifetime() { return lifetime_; }
   FloatColumn& mass() { return mass_; }
@@ -166,6 +171,7 @@ class ParticlePool {
   std::uint64_t nextId_ = 0;
   std::uint64_t droppedSpawns_ = 0;
   std::uint64_t rowsVersion_ = 0;
+  bool keepsAcceleration_ = false;
 
   Vec3Column position_, velocity_, previous_, acceleration_;
   FloatColumn age_, lifetime_, mass_, inverseMass_;

@@ -17,10 +17,15 @@ class Hasher {
     h_ *= 0xbf58476d1ce4e5b9ULL;
     h_ ^= h_ >> 32;
   }
-  void addFloats(const FloatColumn& column, std::size_t rows) {
+  // A null column is rows zeros (+0.0f): a column the pool does not keep.
+  void addFloats(const FloatColumn* column, std::size_t rows) {
+    if (column == nullptr) {
+      for (std::size_t i = 0; i < rows; ++i) add(0);
+      return;
+    }
     for (std::size_t i = 0; i < rows; ++i) {
       std::uint32_t bits = 0;
-      std::memcpy(&bits, &column[static_cast<Eigen::Index>(i)], sizeof bits);
+      std::memcpy(&bits, &(*column)[static_cast<Eigen::Index>(i)], sizeof bits);
       add(bits);
     }
   }
@@ -30,40 +35,20 @@ class Hasher {
   std::uint64_t h_ = 0xcbf29ce484222325ULL;
 };
 
-}  // namespace
-
-std::uint64_t stateHash(const ParticlePool& pool) {
-  Hasher h;
-  const std::size_t n = pool.size();
-  h.add(n);
-  h.add(pool.nextId());
-  h.add(pool.droppedSpawns());
-  for (std::size_t i = 0; i < n; ++i) h.add(pool.id()[i]);
-  for (std::size_t i = 0; i < n; ++i) h.add(static_cast<std::uint64_t>(pool.birthTick()[i]));
-  for (const Vec3Column* c :
-       {&pool.position(), &pool.velocity(), &pool.previousPosition(), &pool.acceleration()}) {
-    for (int k = 0; k < 3; ++k) h.addFloats((*c)[k], n);
-  }
-  for (const FloatColumn* c : {&pool.age(), &pool.lifetime(), &pool.mass(), &pool.inverseMass()}) {
-    h.addFloats(*c, n);
-  }
-  for (std::size_t a = 0; a < pool.attributeCount(); ++a) h.addFloats(pool.attribute(a), n);
-  return h.value();
-}
-
-namespace {
-
-// The float columns in stateHash()'s order, with their names.
+// The float columns in stateHash()'s order, with their names; null for a column the pool does not
+// keep (acceleration before velocity Verlet), whose values are all zero.
 std::vector<std::pair<std::string, const FloatColumn*>> floatColumns(const ParticlePool& pool) {
   std::vector<std::pair<std::string, const FloatColumn*>> columns;
   const std::pair<const char*, const Vec3Column*> vectors[] = {
       {"position", &pool.position()},
       {"velocity", &pool.velocity()},
       {"previous_position", &pool.previousPosition()},
-      {"acceleration", &pool.acceleration()}};
+      {"acceleration", pool.keepsAcceleration() ? &pool.acceleration() : nullptr}};
   for (const auto& [name, column] : vectors) {
-    for (int k = 0; k < 3; ++k)
-      columns.emplace_back(std::string(name) + "." + "xyz"[k], &(*column)[k]);
+    for (int k = 0; k < 3; ++k) {
+      columns.emplace_back(std::string(name) + "." + "xyz"[k],
+                           column != nullptr ? &(*column)[k] : nullptr);
+    }
   }
   columns.emplace_back("age", &pool.age());
   columns.emplace_back("lifetime", &pool.lifetime());
@@ -75,6 +60,18 @@ std::vector<std::pair<std::string, const FloatColumn*>> floatColumns(const Parti
 }
 
 }  // namespace
+
+std::uint64_t stateHash(const ParticlePool& pool) {
+  Hasher h;
+  const std::size_t n = pool.size();
+  h.add(n);
+  h.add(pool.nextId());
+  h.add(pool.droppedSpawns());
+  for (std::size_t i = 0; i < n; ++i) h.add(pool.id()[i]);
+  for (std::size_t i = 0; i < n; ++i) h.add(static_cast<std::uint64_t>(pool.birthTick()[i]));
+  for (const auto& column : floatColumns(pool)) h.addFloats(column.second, n);
+  return h.value();
+}
 
 std::vector<std::string> stateColumnNames(const ParticlePool& pool) {
   std::vector<std::string> names = {"counters", "id", "birth_tick"};
@@ -100,7 +97,7 @@ std::vector<std::uint64_t> stateColumnHashes(const ParticlePool& pool) {
   for (const auto& column : floatColumns(pool)) {
     Hasher h;
     h.add(n);
-    h.addFloats(*column.second, n);
+    h.addFloats(column.second, n);
     hashes.push_back(h.value());
   }
   return hashes;
@@ -110,8 +107,9 @@ std::vector<std::uint64_t> stateRowBits(const ParticlePool& pool, std::size_t ro
   std::vector<std::uint64_t> bits = {pool.id()[row],
                                      static_cast<std::uint64_t>(pool.birthTick()[row])};
   for (const auto& column : floatColumns(pool)) {
-    std::uint32_t b = 0;
-    std::memcpy(&b, &(*column.second)[static_cast<Eigen::Index>(row)], sizeof b);
+    std::uint32_t b = 0;  // +0.0f in a column the pool does not keep
+    if (column.second != nullptr)
+      std::memcpy(&b, &(*column.second)[static_cast<Eigen::Index>(row)], sizeof b);
     bits.push_back(b);
   }
   return bits;

@@ -158,16 +158,42 @@ TEST(ParticlePool, ADeadRowIsFoundWhereverItSits) {
   }
 }
 
-// What the pool's memory is made of: four vectors (position, velocity, previous position,
-// acceleration), four floats (age, lifetime, mass, inverse mass), the id, the birth tick, the
-// dead flag, and a float for each named attribute.
+// What the pool's memory is made of: three vectors (position, velocity, previous position), four
+// floats (age, lifetime, mass, inverse mass), the id, the birth tick, the dead flag, a float for
+// each named attribute, and the acceleration (a vector) once something keeps it.
 TEST(ParticlePool, BytesPerRowCountEveryColumn) {
   ParticlePool pool(8);
-  EXPECT_EQ(pool.bytesPerRow(), 4u * 12u + 4u * 4u + 8u + 8u + 1u);
+  EXPECT_EQ(pool.bytesPerRow(), 3u * 12u + 4u * 4u + 8u + 8u + 1u);
   pool.addAttribute("temperature");
   pool.addAttribute("temperature");  // the same attribute: no new column
   pool.addAttribute("Cd_r");
+  EXPECT_EQ(pool.bytesPerRow(), 69u + 2u * 4u);
+  pool.keepAcceleration();
   EXPECT_EQ(pool.bytesPerRow(), 81u + 2u * 4u);
+}
+
+// The acceleration column exists once kept, zero for the rows already there and the rows spawned
+// after; it grows and moves with the others. Before, the state hash counts it as zeros.
+TEST(ParticlePool, AKeptAccelerationIsZeroForEveryRowAndMovesWithIt) {
+  ParticlePool pool(5000);
+  for (int i = 0; i < 3; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);
+  const std::uint64_t before = stateHash(pool);
+  EXPECT_FALSE(pool.keepsAcceleration());
+  EXPECT_EQ(pool.acceleration().x.size(), 0);
+  pool.keepAcceleration();
+  ASSERT_TRUE(pool.keepsAcceleration());
+  EXPECT_EQ(stateHash(pool), before);                                           // zeros either way
+  for (int i = 3; i < 4000; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);  // grows
+  ASSERT_GE(pool.acceleration().y.size(), 4000);
+  for (Eigen::Index r = 0; r < 4000; ++r) {
+    ASSERT_EQ(pool.acceleration().y[r], 0.0f) << r;
+    pool.acceleration().y[r] = static_cast<float>(r);
+  }
+  pool.dead()[1] = 1;
+  pool.removeDead();
+  EXPECT_EQ(pool.acceleration().y[0], 0.0f);
+  EXPECT_EQ(pool.acceleration().y[1], 2.0f);
+  EXPECT_EQ(pool.acceleration().y[3998], 3999.0f);
 }
 
 // Removal moves runs of kept rows: one long run when the oldest die together (a rate emitter

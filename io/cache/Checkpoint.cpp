@@ -28,15 +28,18 @@ constexpr std::size_t kLengthOffset = 16;
 constexpr std::size_t kEffectHashOffset = 24;
 
 // The float columns in file order; writer and reader share this list so they cannot disagree.
+// f gets null for the acceleration of a pool that does not keep it: zeros in the file.
 template <typename Pool, typename F>
 void forEachFloatColumn(Pool& pool, F&& f) {
   for (auto* c :
        {&pool.position(), &pool.velocity(), &pool.previousPosition(), &pool.acceleration()}) {
-    for (int k = 0; k < 3; ++k) f((*c)[k]);
+    const bool absent = c == &pool.acceleration() && !pool.keepsAcceleration();
+    for (int k = 0; k < 3; ++k) f(absent ? nullptr : &(*c)[k]);
   }
-  for (auto* c : {&pool.age(), &pool.lifetime(), &pool.mass(), &pool.inverseMass()}) f(*c);
+  for (auto* c : {&pool.age(), &pool.lifetime(), &pool.mass(), &pool.inverseMass()}) f(c);
 }
 constexpr int kFloatColumns = 16;
+constexpr int kFirstAccelerationColumn = 9;  // after position, velocity, previous position
 
 std::uint64_t loadU64(const char* p) {
   std::uint64_t v = 0;
@@ -310,11 +313,19 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
 void apply(const Parsed& p, ParticleSystem& system) {
   ParticlePool& pool = system.pool();
   const auto n = static_cast<std::size_t>(p.size);
-  pool.reserve(n);  // the only step that can fail (allocation), and it changes no state
+  // Velocity Verlet's a(t) makes the pool keep an acceleration column (all zeros need none);
+  // like reserve(), an allocation that changes no value of the state.
+  for (int k = 0; k < 3 && !pool.keepsAcceleration(); ++k) {
+    const char* bytes = p.floats[kFirstAccelerationColumn + k];
+    if (std::any_of(bytes, bytes + 4 * n, [](char b) { return b != 0; })) pool.keepAcceleration();
+  }
+  pool.reserve(n);  // the other allocation, changing no state either
   pool.resizeForRestore(n, p.nextId, p.droppedSpawns);
   int c = 0;
-  forEachFloatColumn(
-      pool, [&](FloatColumn& column) { loadLittleEndian(p.floats[c++], column.data(), n); });
+  forEachFloatColumn(pool, [&](FloatColumn* column) {
+    if (column != nullptr) loadLittleEndian(p.floats[c], column->data(), n);
+    ++c;
+  });
   loadLittleEndian(p.ids, pool.id().data(), n);
   loadLittleEndian(p.births, pool.birthTick().data(), n);
   for (const auto& [name, values] : p.attributes) {
@@ -385,7 +396,11 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   w.u64(pool.nextId());
   w.u64(pool.droppedSpawns());
   w.u32(static_cast<std::uint32_t>(pool.attributeCount()));
-  forEachFloatColumn(pool, [&](const FloatColumn& column) { w.column(column.data(), n); });
+  const FloatColumn zeros =
+      pool.keepsAcceleration() ? FloatColumn() : FloatColumn::Zero(static_cast<Eigen::Index>(n));
+  forEachFloatColumn(pool, [&](const FloatColumn* column) {
+    w.column(column != nullptr ? column->data() : zeros.data(), n);
+  });
   w.column(pool.id().data(), n);
   w.column(pool.birthTick().data(), n);
   // What render copies interpolate velocities from, so that a resumed run's caches match.
