@@ -25,6 +25,15 @@ std::uint32_t rowOf(const std::vector<std::uint64_t>& ids, std::size_t size, std
   return (it != end && *it == id) ? static_cast<std::uint32_t>(it - ids.begin()) : kMissing;
 }
 
+// Whether a breakable spring between rows ra and rb is stretched past its ratio.
+bool stretchedPastItsRatio(const Spring& spring, const Vec3Column& p, std::uint32_t ra,
+                           std::uint32_t rb) {
+  if (!(spring.breakRatio > 0.0f)) return false;
+  const float dx = p.x[rb] - p.x[ra], dy = p.y[rb] - p.y[ra], dz = p.z[rb] - p.z[ra];
+  const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
+  return length > spring.breakRatio * spring.restLength;
+}
+
 }  // namespace
 
 void SpringNetwork::beginTick(const ParticlePool& pool, std::int64_t /*tick*/) {
@@ -44,11 +53,7 @@ bool SpringNetwork::tablesStillHold(const ParticlePool& pool) const {
   parallelForRows(ends_.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const Ends& e = ends_[k];
-      const Spring& spring = springs_[e.spring];
-      if (!(spring.breakRatio > 0.0f)) continue;
-      const float dx = p.x[e.b] - p.x[e.a], dy = p.y[e.b] - p.y[e.a], dz = p.z[e.b] - p.z[e.a];
-      const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
-      if (length > spring.breakRatio * spring.restLength) {
+      if (stretchedPastItsRatio(springs_[e.spring], p, e.a, e.b)) {
         broke.store(true, std::memory_order_relaxed);
         return;
       }
@@ -82,15 +87,11 @@ void SpringNetwork::rebuild(const ParticlePool& pool) {
       }
       continue;
     }
-    if (spring.breakRatio > 0.0f) {
-      const float dx = p.x[rb] - p.x[ra], dy = p.y[rb] - p.y[ra], dz = p.z[rb] - p.z[ra];
-      const float length = std::sqrt(dx * dx + dy * dy + dz * dz);
-      if (length > spring.breakRatio * spring.restLength) {
-        ++broken_;
-        continue;
-      }
-      breakable_ = true;
+    if (stretchedPastItsRatio(spring, p, ra, rb)) {
+      ++broken_;
+      continue;
     }
+    breakable_ = breakable_ || spring.breakRatio > 0.0f;
     ends_.push_back(Ends{ra, rb, static_cast<std::uint32_t>(kept)});
     springs_[kept++] = spring;
   }

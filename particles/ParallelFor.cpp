@@ -68,15 +68,10 @@ void parallelForRows(std::size_t rows, const std::function<void(std::size_t, std
     if (rows > 0) body(0, rows);
     return;
   }
-  const std::function<void(std::size_t)> block = [&](std::size_t b) {
+  parallelForTasks(blocks, [&](std::size_t b) {
     const std::size_t begin = b * kParallelBlockRows;
     body(begin, std::min(rows, begin + kParallelBlockRows));
-  };
-  if (tExecutor != nullptr) {
-    tExecutor->run(blocks, block);
-    return;
-  }
-  runBlocks(blocks, block);
+  });
 }
 
 void parallelForTasks(std::size_t tasks, const std::function<void(std::size_t)>& task) {

@@ -20,9 +20,19 @@ struct KeptRun {
   std::size_t from, count, to;
 };
 
-// The runs of kept rows in [first, size), rows before `first` staying where they are. Eight flags
-// at a time where they are all clear: deaths come in runs (the oldest particles of a rate emitter
-// die together), so the kept rows do too.
+// The first flagged row in [from, size), or size. Eight flags at a time: deaths are rare, or come
+// in runs (the oldest particles of a rate emitter die together), so the clear stretches are long.
+std::size_t firstFlagged(const std::uint8_t* flags, std::size_t from, std::size_t size) {
+  std::size_t i = from;
+  for (std::uint64_t word = 0; i + 8 <= size; i += 8) {
+    std::memcpy(&word, flags + i, sizeof word);
+    if (word != 0) break;
+  }
+  while (i < size && flags[i] == 0) ++i;
+  return i;
+}
+
+// The runs of kept rows in [first, size), rows before `first` staying where they are.
 std::vector<KeptRun> keptRuns(const std::vector<std::uint8_t>& dead, std::size_t first,
                               std::size_t size) {
   std::vector<KeptRun> runs;
@@ -32,11 +42,7 @@ std::vector<KeptRun> keptRuns(const std::vector<std::uint8_t>& dead, std::size_t
   while (i < size) {
     while (i < size && flags[i] != 0) ++i;  // removed rows
     const std::size_t from = i;
-    for (std::uint64_t word = 0; i + 8 <= size; i += 8) {
-      std::memcpy(&word, flags + i, sizeof word);
-      if (word != 0) break;
-    }
-    while (i < size && flags[i] == 0) ++i;
+    i = firstFlagged(flags, i, size);
     if (i > from) {
       runs.push_back(KeptRun{from, i - from, to});
       to += i - from;
@@ -206,18 +212,7 @@ void ParticlePool::updateAges(std::int64_t tick, std::int64_t stepRateHz) {
   });
 }
 
-std::size_t ParticlePool::firstDeadRow() const {
-  // Eight flags at a time: deaths are rare, and a byte-by-byte search was 2 % of a tick at 10⁶.
-  const std::uint8_t* flags = dead_.data();
-  std::size_t i = 0;
-  for (; i + 8 <= size_; i += 8) {
-    std::uint64_t word = 0;
-    std::memcpy(&word, flags + i, sizeof word);
-    if (word != 0) break;
-  }
-  while (i < size_ && flags[i] == 0) ++i;
-  return i;
-}
+std::size_t ParticlePool::firstDeadRow() const { return firstFlagged(dead_.data(), 0, size_); }
 
 std::size_t ParticlePool::removeDead() {
   // Most ticks nobody dies: find that out with one byte scan and touch nothing else.
