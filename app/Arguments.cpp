@@ -77,4 +77,12 @@ double parseNumber(const std::string& text, const std::string& option, double mi
   return value;
 }
 
+std::string joinWords(const std::vector<std::string>& words, const std::string& last) {
+  std::string out;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    out += (i == 0 ? "" : (i + 1 == words.size() ? last : ", ")) + words[i];
+  }
+  return out;
+}
+
 }  // namespace tickfx::app

@@ -43,4 +43,7 @@ long long parseInteger(const std::string& text, const std::string& option, long 
 /// Parses a finite number in [min, max]; UsageError naming `option` otherwise.
 double parseNumber(const std::string& text, const std::string& option, double min, double max);
 
+/// "a, b or c" with `last` = " or ": the words of a usage message's list of choices.
+std::string joinWords(const std::vector<std::string>& words, const std::string& last);
+
 }  // namespace tickfx::app

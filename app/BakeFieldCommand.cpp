@@ -75,14 +75,6 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& kindOptions
   return options;
 }
 
-std::string join(const std::vector<std::string>& words, const std::string& last) {
-  std::string out;
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    out += (i == 0 ? "" : (i + 1 == words.size() ? last : ", ")) + words[i];
-  }
-  return out;
-}
-
 // "x,y,z" (or `count` numbers), each a number in [-1e9, 1e9].
 std::vector<double> parseList(const std::string& text, const std::string& option, std::size_t count,
                               const std::string& shape) {
@@ -189,14 +181,14 @@ int bakeFieldCommand(Arguments& args) {
   }
   if (own == nullptr) {
     const std::optional<std::string> guess = io::closestMatch(kind, kinds);
-    throw UsageError(
-        "bake-field: unknown kind '" + kind + "' " +
-        (guess ? "(did you mean '" + *guess + "'?)" : "(expected " + join(kinds, " or ") + ")"));
+    throw UsageError("bake-field: unknown kind '" + kind + "' " +
+                     (guess ? "(did you mean '" + *guess + "'?)"
+                            : "(expected " + joinWords(kinds, " or ") + ")"));
   }
   for (const auto& [option, value] : given) {
     if (std::find(own->begin(), own->end(), option) == own->end()) {
       throw UsageError("bake-field: " + option + " does not apply to kind '" + kind +
-                       "' (its options: " + join(*own, " and ") + ")");
+                       "' (its options: " + joinWords(*own, " and ") + ")");
     }
   }
   if (!out || out->empty()) throw UsageError("bake-field: --out FILE.vdb is required");

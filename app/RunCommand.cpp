@@ -144,10 +144,8 @@ auto parseVdbChoice(const std::string& option, const std::string& value,
                     const std::vector<std::string>& names, Named named) {
   const auto choice = named(value);
   if (!choice) {
-    std::string expected;
-    for (const std::string& name : names) expected += (expected.empty() ? "" : " or ") + name;
-    throw UsageError("run: " + option + ": unknown value '" + value + "' (expected " + expected +
-                     ")");
+    throw UsageError("run: " + option + ": unknown value '" + value + "' (expected " +
+                     joinWords(names, " or ") + ")");
   }
   return *choice;
 }
