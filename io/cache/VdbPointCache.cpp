@@ -65,15 +65,20 @@ std::string where(const std::string& path) { return vdbGridLabel(path, kGridName
 // bitwise (the voxel size is 1), |o| <= 0.5 in the voxel nearest to x. When that is not exact
 // (x beyond the bound, inf, nan; −0.0, whose sign no sum with n = 0 keeps) the coordinate goes
 // whole into voxel 0.
+// Coord::round's rule, floor(x + 0.5), for a finite |x| < 2³⁰, and x's offset from that voxel,
+// in float alone (a float → double → float round trip is what g++ 12's vectoriser may fold
+// away): x − floor(x) is exact, and so is x − n for the nearest integer n.
+std::pair<openvdb::Int32, float> nearestVoxel(float x) {
+  float n = std::floor(x);
+  if (x - n >= 0.5f) n += 1.0f;
+  return {static_cast<openvdb::Int32>(n), x - n};
+}
+
 std::pair<openvdb::Int32, float> place(float x) {
-  if (std::isfinite(x) && std::abs(x) < kLargestIndex) {
-    // Coord::round's rule (floor(x + 0.5)); x − n is exact in float for |x − n| <= 1.
-    const double n = std::floor(static_cast<double>(x) + 0.5);
-    const auto offset = static_cast<float>(static_cast<double>(x) - n);
-    const auto back = static_cast<float>(n + static_cast<double>(offset));
-    if (std::bit_cast<std::uint32_t>(back) == std::bit_cast<std::uint32_t>(x)) {
-      return {static_cast<openvdb::Int32>(n), offset};
-    }
+  if (std::isfinite(x) && std::abs(x) < static_cast<float>(kLargestIndex)) {
+    const auto [n, offset] = nearestVoxel(x);
+    const float back = static_cast<float>(n) + offset;
+    if (std::bit_cast<std::uint32_t>(back) == std::bit_cast<std::uint32_t>(x)) return {n, offset};
   }
   return {0, x};
 }
@@ -132,9 +137,8 @@ struct PointSlot {
 // bits: the codec quantises the offset anyway (and turns a NaN into undefined behaviour).
 std::pair<openvdb::Int32, float> placeQuantised(float x) {
   if (std::isnan(x)) return {0, 0.0f};
-  if (!(std::abs(x) < kLargestIndex)) return {0, x > 0 ? 0.5f : -0.5f};
-  const double n = std::floor(static_cast<double>(x) + 0.5);
-  return {static_cast<openvdb::Int32>(n), static_cast<float>(static_cast<double>(x) - n)};
+  if (!(std::abs(x) < static_cast<float>(kLargestIndex))) return {0, x > 0 ? 0.5f : -0.5f};
+  return nearestVoxel(x);
 }
 
 // Each point's voxel offset within its leaf (0 to 511) and each row's offset in its voxel; the
@@ -281,7 +285,8 @@ std::unique_ptr<Leaf> makeLeaf(const FrameData& frame, const std::vector<PointSl
   auto& v = expandedArray<VectorArray>(*leaf, 1);
   for (openvdb::Index k = 0; k < count; ++k) {
     const Eigen::Index r = rows[k];
-    v.setUnsafe(k, openvdb::Vec3f(frame.velocity[0][r], frame.velocity[1][r], frame.velocity[2][r]));
+    v.setUnsafe(k,
+                openvdb::Vec3f(frame.velocity[0][r], frame.velocity[1][r], frame.velocity[2][r]));
   }
   auto& id = expandedArray<IdArray>(*leaf, 2);
   for (openvdb::Index k = 0; k < count; ++k)
