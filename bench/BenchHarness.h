@@ -65,6 +65,8 @@ struct Case {
 
   std::string name;
   std::function<void(std::int64_t ticks)> run;
+  /// Batches are whole multiples of this many ticks (a frame of several ticks).
+  std::int64_t ticksPerFrame = 1;
   std::int64_t batch = 1;
   std::vector<double> secondsPerTick;
   double timed = 0.0;
@@ -84,13 +86,15 @@ inline double timeBatch(Case& c, double* cpu = nullptr) {
 // Grows the batch until it takes `target` seconds. Its runs are not recorded, so they are also
 // the warm-up (first-touch page faults of scratch columns, caches, TBB workers waking up).
 inline void calibrate(Case& c, double target) {
-  c.batch = 1;
+  const std::int64_t unit = c.ticksPerFrame;
+  c.batch = unit;
   for (;;) {
     const double s = timeBatch(c);
     if (s >= target) return;
     const double grow = s > 0.0 ? std::min(10.0, 1.2 * target / s) : 10.0;
-    c.batch = std::max(c.batch + 1,
-                       static_cast<std::int64_t>(std::ceil(static_cast<double>(c.batch) * grow)));
+    const std::int64_t grown = std::max(
+        c.batch + 1, static_cast<std::int64_t>(std::ceil(static_cast<double>(c.batch) * grow)));
+    c.batch = (grown + unit - 1) / unit * unit;
   }
 }
 

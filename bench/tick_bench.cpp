@@ -18,6 +18,8 @@
 //                     only, the part of a tick that does the physics.
 //   tickfx step()     ParticleSystem::step(): the above plus emitters, ForceSet::beginTick, age
 //                     recomputation and removal of the dead, i.e. what a tick costs a user.
+//   tickfx fused x4   stepTicks(4): frames of four ticks, each block of rows taken through all
+//                     four while in cache (fused frames), the same bits as four step() calls.
 // Each tickfx case runs with 1 thread and with all threads, so the table separates the gain of
 // the layout from the gain of threading.
 //
@@ -319,6 +321,13 @@ std::string threadsLabel(int threads) {
   return std::to_string(threads) + (threads == 1 ? " thread" : " threads");
 }
 
+// Ticks a frame in the fused cases (issue 13's target: 4).
+constexpr std::int64_t kFusedTicks = 4;
+
+std::string fusedLabel(int threads) {
+  return "tickfx fused x" + std::to_string(kFusedTicks) + ", " + threadsLabel(threads);
+}
+
 // Runs every case for `n` particles; returns false when the two sides disagree.
 bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& rows,
              double& checksum) {
@@ -331,6 +340,9 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   // The same system without the per-tick non-finite check: what the check costs a tick.
   std::unique_ptr<tickfx::ParticleSystem> unchecked =
       makeSystem(n, 1, tickfx::NonfinitePolicy::Keep);
+  // Systems advanced kFusedTicks ticks a frame: fused frames (ParticleSystem's class comment).
+  std::unique_ptr<tickfx::ParticleSystem> fusedOne = makeSystem(n, 1);
+  std::unique_ptr<tickfx::ParticleSystem> fusedAll = allThreads > 1 ? makeSystem(n, 0) : nullptr;
 
   // Tick 0 from the identical initial state on every side.
   tbb::task_arena arenaOne(1), arenaAll(allThreads);
@@ -397,6 +409,18 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
     });
   }
 
+  // Frames of kFusedTicks ticks (batches are whole frames).
+  const auto frames = [](tickfx::ParticleSystem& system, std::int64_t ticks) {
+    for (; ticks > 0; ticks -= kFusedTicks) system.stepTicks(kFusedTicks);
+  };
+  cases.emplace_back(fusedLabel(1), [&](std::int64_t ticks) { frames(*fusedOne, ticks); });
+  cases.back().ticksPerFrame = kFusedTicks;
+  if (fusedAll) {
+    cases.emplace_back(fusedLabel(allThreads),
+                       [&](std::int64_t ticks) { frames(*fusedAll, ticks); });
+    cases.back().ticksPerFrame = kFusedTicks;
+  }
+
   bench::timeCases(cases, o.timing);
 
   const double aosSeconds = bench::median(cases.front().secondsPerTick);
@@ -412,7 +436,8 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 
   checksum += positionSum(aos) + soaOne.positionSum() + soaAll.positionSum() +
               positionSum(one->pool()) + positionSum(unchecked->pool()) +
-              (all ? positionSum(all->pool()) : 0.0);
+              (all ? positionSum(all->pool()) : 0.0) + positionSum(fusedOne->pool()) +
+              (fusedAll ? positionSum(fusedAll->pool()) : 0.0);
   return d.withinRoundOff && soaSame;
 }
 
@@ -493,7 +518,20 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
         "tick step 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread, target >= 0.9x; "
         "%.2fx AoS)\n",
         z, rate(step).c_str(), step.stepsPerSecond / h, step.stepsPerSecond / a);
+    const Row fused = row(fusedLabel(1));
+    std::printf(
+        "tick fused %lld ticks a frame 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread, "
+        "target >= 1.5x at 1e7; %.2fx tickfx step())\n",
+        static_cast<long long>(kFusedTicks), z, rate(fused).c_str(), fused.stepsPerSecond / h,
+        fused.stepsPerSecond / step.stepsPerSecond);
     if (allThreads == 1) continue;
+    const Row fusedAll = row(fusedLabel(allThreads));
+    std::printf(
+        "tick fused %lld ticks a frame %s %s: %s particle-steps/s (%.2fx tickfx fused 1 thread; "
+        "%.2fx hand SoA %s)\n",
+        static_cast<long long>(kFusedTicks), t, z, rate(fusedAll).c_str(),
+        fusedAll.stepsPerSecond / fused.stepsPerSecond,
+        fusedAll.stepsPerSecond / row("hand SoA loop, " + all).stepsPerSecond, t);
     const Row soaAll = row("hand SoA loop, " + all), integrateAll = row("tickfx integrate, " + all),
               stepAll = row("tickfx step(), " + all);
     const double hAll = soaAll.stepsPerSecond;

@@ -86,6 +86,7 @@ class AnalyticForce final : public ForceModule {
   enum class Mode { Force, Drag, Advect };
   AnalyticForce(AnalyticField field, Mode mode, float gain);
   std::string_view typeName() const override { return "analytic_field"; }
+  bool interleavesTicks() const override { return true; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   bool prescribesVelocity() const override { return mode_ == Mode::Advect; }
   void accumulateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const override;

@@ -13,6 +13,7 @@ class AnchorSpring final : public ForceModule {
   AnchorSpring(const Eigen::Vector3f& rest, float stiffness, float damping = 0.0f)
       : rest_(rest), k_(stiffness), c_(damping) {}
   std::string_view typeName() const override { return "anchor_spring"; }
+  bool interleavesTicks() const override { return true; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   float stiffness() const { return k_; }
   float damping() const { return c_; }

@@ -114,6 +114,11 @@ class ForceModule {
   /// their passes over a small tile of rows; a module reading other rows must say false.
   virtual bool isLocal() const { return true; }
 
+  /// True when the module may be evaluated for several ticks at once, blocks of rows apart: it
+  /// is local, its beginTick() and endTick() do nothing, and what it adds depends on the row's
+  /// state and the instant alone. A system whose modules all say so advances a frame's ticks
+  /// block by block (ParticleSystem, fused frames). False unless a module says otherwise.
+  virtual bool interleavesTicks() const { return false; }
   /// When the acceleration at `in` is the same for every particle, stores it in `a` and returns
   /// true. ForceSet then adds a leading run of such modules once per evaluation instead of once
   /// per particle; the per-particle sum keeps the same order, so the bits do not change.

@@ -57,6 +57,11 @@ bool ForceSet::isLocal() const {
   return std::all_of(modules_.begin(), modules_.end(), [](const auto& m) { return m->isLocal(); });
 }
 
+bool ForceSet::interleavesTicks() const {
+  return std::all_of(modules_.begin(), modules_.end(),
+                     [](const auto& m) { return m->interleavesTicks(); });
+}
+
 void ForceSet::beginTick(const ParticlePool& pool, std::int64_t tick) {
   for (auto& m : modules_) m->beginTick(pool, tick);
   anyPinned_ = anyZero(pool.inverseMass(), pool.size());

@@ -27,6 +27,9 @@ class ForceSet {
   /// True when every module is local (see ForceModule::isLocal).
   bool isLocal() const;
 
+  /// True when every module interleaves ticks (see ForceModule::interleavesTicks).
+  bool interleavesTicks() const;
+
   /// Once per tick before any evaluation: the modules' beginTick, and whether any particle is
   /// pinned (inverse mass 0), which evaluate() then holds still.
   void beginTick(const ParticlePool& pool, std::int64_t tick);

@@ -12,6 +12,7 @@ class LinearDrag final : public ForceModule {
   LinearDrag(float k, const Eigen::Vector3f& airVelocity = Eigen::Vector3f::Zero())
       : k_(k), air_(airVelocity) {}
   std::string_view typeName() const override { return "drag"; }
+  bool interleavesTicks() const override { return true; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
 
  private:

@@ -29,6 +29,7 @@ class PeriodicWind final : public ForceModule {
   /// Throws std::invalid_argument with the first of settings.validate().
   explicit PeriodicWind(const Settings& settings);
   std::string_view typeName() const override { return "wind"; }
+  bool interleavesTicks() const override { return true; }
   bool uniformAcceleration(const ForceInput& in, Eigen::Vector3f& a) const override;
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   /// The scalar strength (m/s²) at time `t` seconds.

@@ -75,6 +75,8 @@ class VectorField final : public ForceModule {
   VectorField& operator=(const VectorField&) = delete;
 
   std::string_view typeName() const override { return "vector_field"; }
+  /// Not with `outside = "kill"`, whose endTick() flags particles at each tick's end.
+  bool interleavesTicks() const override { return s_.outside != Outside::Kill; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   bool prescribesVelocity() const override { return s_.mode == Mode::Advect; }
   void accumulateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const override;

@@ -38,7 +38,7 @@ enum Slot : int { kState = kPoolColumn, K1 = 0, K2, K3, K4, X2, X3, X4 };
 }  // namespace
 
 void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
-                     const RowPass& afterEachTile) {
+                     const StepRows& rows, const RowPass& afterEachTile) {
   const float h = time.dt();
   const float halfH = 0.5f * h;
   // PointAdvect's constants, in its order of operations: (h·S)·(1/6) with S the stage sum.
@@ -95,20 +95,20 @@ void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime&
   const bool fused = forces.isLocal();
   switch (scheme_) {
     case AdvectionScheme::Euler:
-      runPasses(pool.size(), fused, scratch_, {sample(kState, t0, K1), finish}, afterEachTile);
+      runPasses(rows, fused, scratch_, {sample(kState, t0, K1), finish}, afterEachTile);
       break;
     case AdvectionScheme::Midpoint:
-      runPasses(pool.size(), fused, scratch_,
+      runPasses(rows, fused, scratch_,
                 {sample(kState, t0, K1), predict(K1, halfH, X2), sample(X2, tHalf, K2), finish},
                 afterEachTile);
       break;
     case AdvectionScheme::Heun:
-      runPasses(pool.size(), fused, scratch_,
+      runPasses(rows, fused, scratch_,
                 {sample(kState, t0, K1), predict(K1, h, X2), sample(X2, t1, K2), finish},
                 afterEachTile);
       break;
     case AdvectionScheme::RungeKutta4:
-      runPasses(pool.size(), fused, scratch_,
+      runPasses(rows, fused, scratch_,
                 {sample(kState, t0, K1), predict(K1, halfH, X2), sample(X2, tHalf, K2),
                  predict(K2, halfH, X3), sample(X3, tHalf, K3), predict(K3, h, X4),
                  sample(X4, t1, K4), finish},

@@ -36,8 +36,8 @@ class Advection {
  public:
   explicit Advection(AdvectionScheme scheme) : scheme_(scheme) {}
   AdvectionScheme scheme() const { return scheme_; }
-  /// `afterEachTile`: as runPasses() takes it.
-  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+  /// Advances `rows` (see StepRows). `afterEachTile`: as runPasses() takes it.
+  void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time, const StepRows& rows,
             const RowPass& afterEachTile = {});
 
  private:

@@ -16,7 +16,8 @@ class ExplicitEuler final : public Integrator {
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Euler; }
 
  protected:
-  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 const StepRows& rows, NonfiniteCheck* check) override;
 
  private:
   StageScratch scratch_{1};  // acceleration

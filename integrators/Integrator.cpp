@@ -7,21 +7,32 @@ Integrator::~Integrator() = default;
 
 void Integrator::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                       NonfiniteCheck* check) {
-  check_ = check;
-  if (!forces.prescribesVelocity()) {
-    integrate(pool, forces, time);
-  } else {
-    if (!advection_) advection_ = std::make_unique<Advection>(advectionScheme());
-    advection_->step(pool, forces, time, afterEachTile(pool));
-  }
-  check_ = nullptr;
+  prepare(pool, forces);
+  stepRows(pool, forces, time, StepRows::wholePool(pool), check);
 }
 
-RowPass Integrator::afterEachTile(ParticlePool& pool) const {
-  if (check_ == nullptr) return {};
-  return [check = check_, &pool](const Tile& tile) {
-    check->scan(pool, tile.rows().begin, tile.rows().end);
-  };
+void Integrator::prepare(ParticlePool& pool, const ForceSet& forces) {
+  prepareColumns(pool);
+  if (forces.prescribesVelocity() && !advection_) {
+    advection_ = std::make_unique<Advection>(advectionScheme());
+  }
+}
+
+void Integrator::stepRows(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                          const StepRows& rows, NonfiniteCheck* check) {
+  if (!forces.prescribesVelocity()) {
+    integrate(pool, forces, time, rows, check);
+    return;
+  }
+  TICKFX_ASSERT(advection_ != nullptr, "an advected step before prepare()");
+  // The advection schemes check each tile once their passes are done with it.
+  RowPass scan;
+  if (check != nullptr) {
+    scan = [check, &pool](const Tile& tile) {
+      check->scan(pool, tile.rows().begin, tile.rows().end);
+    };
+  }
+  advection_->step(pool, forces, time, rows, scan);
 }
 
 }  // namespace tickfx

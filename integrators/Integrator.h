@@ -26,10 +26,10 @@ struct StepTime {
   TickInstant stage(int halves) const { return {tick, halves, stepRateHz}; }
 };
 
-/// A time-stepping scheme. An integrator advances rows [0, pool.size()) by one tick, asking the
-/// forces for accelerations at the states and times its scheme needs, and stores the position it
-/// started from in pool.previousPosition() (for interpolation). Rows from pool.firstUnstepped()
-/// on were spawned this tick: schemes with history start them on their own.
+/// A time-stepping scheme. An integrator advances rows (all of the pool, or a block: StepRows) by
+/// one tick, asking the forces for accelerations at the states and times its scheme needs, and
+/// stores the position it started from in pool.previousPosition() (for interpolation). Rows from
+/// StepRows::fresh on were spawned this tick: schemes with history start them on their own.
 ///
 /// When the forces prescribe velocity (advection, ForceSet::prescribesVelocity), step() runs the
 /// scheme's first-order counterpart instead (advectionScheme(); see integrators/Advection.h).
@@ -57,20 +57,30 @@ class Integrator {
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
             NonfiniteCheck* check = nullptr);
 
+  /// Readies the pool's columns and this integrator for `forces` (velocity Verlet's kept
+  /// acceleration, the advection scheme), so that stepRows() may then run on disjoint blocks
+  /// from several threads at once. step() does it itself.
+  void prepare(ParticlePool& pool, const ForceSet& forces);
+
+  /// step() for `rows` alone, after prepare(). Calls for disjoint blocks of rows may run at once
+  /// when every force is local (ForceSet::isLocal): a fused frame's blocks. A row gets the same
+  /// bits as from step().
+  void stepRows(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                const StepRows& rows, NonfiniteCheck* check);
+
  protected:
-  /// The scheme itself, under forces that add acceleration.
-  virtual void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) = 0;
-  /// The step's NonfiniteCheck, null when nothing is checked. integrate() checks the values its
-  /// last update loop writes, in that loop (updateRows(), integrators/CheckedRows.h).
-  NonfiniteCheck* nonfiniteCheck() const { return check_; }
+  /// The scheme itself, under forces that add acceleration, over `rows`. With `check` set, the
+  /// scheme checks the values its last update loop writes, in that loop (updateRows(),
+  /// integrators/CheckedRows.h). Called concurrently for disjoint blocks (see stepRows()): it
+  /// writes nothing of the integrator's own but its scratch in split passes.
+  virtual void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                         const StepRows& rows, NonfiniteCheck* check) = 0;
+
+  /// Pool columns the scheme keeps from tick to tick (velocity Verlet's acceleration).
+  virtual void prepareColumns(ParticlePool& /*pool*/) const {}
 
  private:
-  /// What the advection schemes hand runPasses() as its afterEachTile: a scan of each tile once
-  /// its passes are done, when the step checks.
-  RowPass afterEachTile(ParticlePool& pool) const;
-
-  std::unique_ptr<Advection> advection_;  // made on the first advected step
-  NonfiniteCheck* check_ = nullptr;       // during step() only
+  std::unique_ptr<Advection> advection_;  // made by the first prepare() that advects
 };
 
 /// The integrator called `name`; throws std::invalid_argument for an unknown name.

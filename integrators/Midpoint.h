@@ -19,7 +19,8 @@ class Midpoint final : public Integrator {
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Midpoint; }
 
  protected:
-  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 const StepRows& rows, NonfiniteCheck* check) override;
 
  private:
   StageScratch scratch_{2};  // acceleration, midpoint velocity

@@ -4,7 +4,8 @@
 
 namespace tickfx {
 
-void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                               const StepRows& rows, NonfiniteCheck* check) {
   const float dt = time.dt();
   const float dt2 = dt * dt;
   const float halfDt2 = 0.5f * dt2;
@@ -12,12 +13,11 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  const std::size_t fresh = pool.firstUnstepped();
-  const std::size_t n = pool.size();
+  const std::size_t fresh = rows.fresh;
+  const std::size_t n = rows.rows.end;
   const TickInstant t0 = time.stage(0);
-  NonfiniteCheck* const check = nonfiniteCheck();
   runPasses(
-      n, forces.isLocal(), scratch_,
+      rows, forces.isLocal(), scratch_,
       {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
          const RowRange r = tile.rows();
          // A new particle has no history: give it the position it would have had a step ago.

@@ -10,7 +10,8 @@ enum Slot : int { kState = kPoolColumn, K1 = 0, K2, K3, K4, P2, V2, P3, V3, P4, 
 
 }  // namespace
 
-void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                            const StepRows& rows, NonfiniteCheck* check) {
   const float h = time.dt();
   const float halfH = 0.5f * h;
   const float sixthH = h / 6.0f;
@@ -18,7 +19,6 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
-  NonfiniteCheck* const check = nonfiniteCheck();
 
   auto velocityRows = [&](const Tile& tile, int slot) {
     return slot == kState ? rowsOf(v, tile.rows()) : tile.stage(slot);
@@ -39,7 +39,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
     };
   };
   runPasses(
-      pool.size(), forces.isLocal(), scratch_,
+      rows, forces.isLocal(), scratch_,
       {evaluate(kState, kState, t0, K1), advance(kState, K1, P2, V2, halfH),
        evaluate(P2, V2, tHalf, K2), advance(V2, K2, P3, V3, halfH), evaluate(P3, V3, tHalf, K3),
        advance(V3, K3, P4, V4, h), evaluate(P4, V4, t1, K4), [&](const Tile& tile) {

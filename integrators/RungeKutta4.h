@@ -16,7 +16,8 @@ class RungeKutta4 final : public Integrator {
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::RungeKutta4; }
 
  protected:
-  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 const StepRows& rows, NonfiniteCheck* check) override;
 
  private:
   StageScratch scratch_{10};  // k1..k4, then the stage states p2 v2 p3 v3 p4 v4

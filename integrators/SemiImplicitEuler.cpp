@@ -4,15 +4,14 @@
 
 namespace tickfx {
 
-void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces,
-                                  const StepTime& time) {
+void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                                  const StepRows& rows, NonfiniteCheck* check) {
   const float dt = time.dt();
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0);
-  NonfiniteCheck* const check = nonfiniteCheck();
-  runPasses(pool.size(), forces.isLocal(), scratch_,
+  runPasses(rows, forces.isLocal(), scratch_,
             {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                         old = rowsOf(prev, tile.rows());

@@ -31,11 +31,21 @@ void StageScratch::ensureRows(std::size_t rows) {
   }
 }
 
-void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
+void runPasses(const StepRows& rows, bool fused, StageScratch& scratch,
                std::initializer_list<RowPass> passes, const RowPass& afterEachTile) {
   const int count = scratch.count();
+  const std::size_t first = rows.rows.begin;
+  // Calls body(begin, end) for absolute rows, in parallel blocks or on this thread.
+  const auto overRows = [&](const std::function<void(std::size_t, std::size_t)>& body) {
+    if (rows.serial) {
+      body(first, rows.rows.end);
+    } else {
+      parallelForRows(rows.rows.end - first,
+                      [&](std::size_t b, std::size_t e) { body(first + b, first + e); });
+    }
+  };
   if (fused) {
-    parallelForRows(rows, [&](std::size_t b, std::size_t e) {
+    overRows([&](std::size_t b, std::size_t e) {
       alignas(64) float buffer[StageScratch::kMaxColumns * 3 * Tile::kRows];
       float* stage[StageScratch::kMaxColumns][3];
       for (std::size_t t = b; t < e; t += Tile::kRows) {
@@ -49,15 +59,15 @@ void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
     });
     return;
   }
-  scratch.ensureRows(rows);
+  // Split passes index their stage columns by pool row.
+  TICKFX_ASSERT(!rows.serial, "split passes over a block of rows");
+  scratch.ensureRows(rows.rows.end);
   float* stage[StageScratch::kMaxColumns][3];
   for (int k = 0; k < count; ++k) {
     for (int c = 0; c < 3; ++c) stage[k][c] = scratch.column(k)[c].data();
   }
   const auto overAllRows = [&](const RowPass& pass) {
-    parallelForRows(rows, [&](std::size_t b, std::size_t e) {
-      pass(Tile(RowRange{b, e}, stage, count, 0));
-    });
+    overRows([&](std::size_t b, std::size_t e) { pass(Tile(RowRange{b, e}, stage, count, 0)); });
   };
   for (const RowPass& pass : passes) overAllRows(pass);
   if (afterEachTile) overAllRows(afterEachTile);

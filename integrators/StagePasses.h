@@ -64,15 +64,30 @@ class Tile {
 /// One pass of an integrator over a tile: a force evaluation or a state update.
 using RowPass = std::function<void(const Tile&)>;
 
-/// Runs `passes` over rows [0, rows). With `fused` (every force local) each tile of Tile::kRows
-/// rows runs all passes in turn while its rows and stage values are in L1/L2 cache; otherwise
-/// each pass finishes for all rows before the next starts, because a non-local force reads rows
-/// that other blocks are updating. Each row sees exactly the same arithmetic either way, so the
-/// bits do not depend on the mode, the tile size or the thread count.
+/// The rows one integrator step advances: every row of the pool, in parallel (a tick), or one
+/// block of rows on the calling thread (a fused frame, whose caller runs its blocks in parallel
+/// and takes each through all the frame's ticks).
+struct StepRows {
+  RowRange rows;
+  /// Rows [fresh, rows.end) were spawned this tick: schemes with history start them on their own.
+  std::size_t fresh = 0;
+  /// Run on the calling thread: the caller parallelises.
+  bool serial = false;
+  /// Every row of `pool`, its unstepped rows fresh, in parallel.
+  static StepRows wholePool(const ParticlePool& pool) {
+    return {RowRange{0, pool.size()}, pool.firstUnstepped(), false};
+  }
+};
+
+/// Runs `passes` over `rows`. With `fused` (every force local) each tile of Tile::kRows rows runs
+/// all passes in turn while its rows and stage values are in L1/L2 cache; otherwise each pass
+/// finishes for all rows before the next starts, because a non-local force reads rows that other
+/// blocks are updating. Each row sees exactly the same arithmetic either way, so the bits do not
+/// depend on the mode, the tile size, the thread count or how the rows are split into calls.
 ///
 /// `afterEachTile`, when set, runs on each tile once every pass is done with it (in a fused run
 /// while the tile's rows are still in cache): a read-only check of the tile's new state.
-void runPasses(std::size_t rows, bool fused, StageScratch& scratch,
+void runPasses(const StepRows& rows, bool fused, StageScratch& scratch,
                std::initializer_list<RowPass> passes, const RowPass& afterEachTile = {});
 
 /// In forcePass() and flowPass(): the pool's own column instead of a stage value.

@@ -4,20 +4,19 @@
 
 namespace tickfx {
 
-void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) {
+void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                               const StepRows& rows, NonfiniteCheck* check) {
   const float dt = time.dt();
   const float halfDt = 0.5f * dt;
   const float halfDt2 = 0.5f * dt * dt;
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
-  pool.keepAcceleration();  // a(t) is kept from one tick to the next
   Vec3Column& a = pool.acceleration();
   Vec3Column& prev = pool.previousPosition();
-  const std::size_t fresh = pool.firstUnstepped();
-  const std::size_t n = pool.size();
+  const std::size_t fresh = rows.fresh;
+  const std::size_t n = rows.rows.end;
   const TickInstant t0 = time.stage(0), t1 = time.stage(2);
-  NonfiniteCheck* const check = nonfiniteCheck();
-  runPasses(n, forces.isLocal(), scratch_,
+  runPasses(rows, forces.isLocal(), scratch_,
             {[&](const Tile& tile) {
                // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
                const RowRange started = intersect(tile.rows(), fresh, n);

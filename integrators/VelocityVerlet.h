@@ -18,7 +18,9 @@ class VelocityVerlet final : public Integrator {
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Heun; }
 
  protected:
-  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time) override;
+  void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 const StepRows& rows, NonfiniteCheck* check) override;
+  void prepareColumns(ParticlePool& pool) const override { pool.keepAcceleration(); }
 
  private:
   StageScratch scratch_{2};  // predicted velocity, new acceleration

@@ -246,6 +246,16 @@ std::size_t ParticlePool::removeDead() {
   return removed;
 }
 
+void ParticlePool::dropNewest(std::size_t size, std::uint64_t nextId) {
+  TICKFX_ASSERT(size <= size_ && nextId <= nextId_ && nextId_ - nextId == size_ - size,
+                "dropping rows that were not the newest spawns");
+  size_ = size;
+  nextId_ = nextId;
+  ++rowsVersion_;
+  std::fill(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
+  firstUnstepped_ = std::min(firstUnstepped_, size_);
+}
+
 void ParticlePool::applyRemovalTo(Vec3Column& column) const {
   TICKFX_ASSERT(static_cast<std::size_t>(column.x.size()) >= size_,
                 "a column shorter than the pool it follows");

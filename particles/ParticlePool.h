@@ -71,6 +71,10 @@ class ParticlePool {
   void setRow(std::size_t row, const ParticleInit& init);
   /// Counts `count` spawns refused without trying them (the caller saw the pool was full).
   void refuseSpawns(std::uint64_t count) { droppedSpawns_ += count; }
+  /// Takes back the newest rows, [size, size()), and the ids they were given, so that ids from
+  /// `nextId` on are handed out again; clears the dead flags of the rows kept. Undoes the spawns
+  /// since the pool had `size` rows and `nextId` (a fused frame going back to its start).
+  void dropNewest(std::size_t size, std::uint64_t nextId);
 
   /// Rows [firstUnstepped(), size()) have not been through an integrator step yet (spawned this
   /// tick). Self-starting integrators (position Verlet, velocity Verlet) need to know.

@@ -98,12 +98,136 @@ void ParticleSystem::stepTicks(std::int64_t ticks) {
 void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
   if (ticks <= 0 || nonfiniteStop_) return;
   runParallel([&] {
+    if (fusesTicks(ticks) && runFusedTicks(ticks, keepVelocities)) return;
     for (std::int64_t i = 0; i < ticks && !nonfiniteStop_; ++i) {
       // Only the last tick of a frame needs its starting velocities, for interpolation.
       runTick(keepVelocities && i == ticks - 1);
       if (tickObserver_) tickObserver_(*this);
     }
   });
+}
+
+// The rows of a fused frame's first tick, saved under NonfinitePolicy::Stop.
+struct ParticleSystem::FrameStart {
+  Vec3Column position, velocity, previous, acceleration;
+  std::size_t rows = 0;
+
+  void reserve(const ParticlePool& pool) {
+    rows = pool.size();
+    const auto need = static_cast<Eigen::Index>(pool.storageRows());
+    for (Vec3Column* c : {&position, &velocity, &previous, &acceleration}) {
+      if (c->x.size() < need) c->resize(need);
+    }
+  }
+  // Copies rows [b, e) from `from` to `to`, column by column.
+  static void copy(const Vec3Column& from, Vec3Column& to, std::size_t b, std::size_t e) {
+    const auto i = static_cast<Eigen::Index>(b), n = static_cast<Eigen::Index>(e - b);
+    for (int c = 0; c < 3; ++c) to[c].segment(i, n) = from[c].segment(i, n);
+  }
+  void save(ParticlePool& pool, std::size_t b, std::size_t e) {
+    copy(pool.position(), position, b, e);
+    copy(pool.velocity(), velocity, b, e);
+    copy(pool.previousPosition(), previous, b, e);
+    if (pool.keepsAcceleration()) copy(pool.acceleration(), acceleration, b, e);
+  }
+  void restore(ParticlePool& pool, std::size_t b, std::size_t e) const {
+    copy(position, pool.position(), b, e);
+    copy(velocity, pool.velocity(), b, e);
+    copy(previous, pool.previousPosition(), b, e);
+    if (pool.keepsAcceleration()) copy(acceleration, pool.acceleration(), b, e);
+  }
+};
+
+bool ParticleSystem::fusesTicks(std::int64_t ticks) const {
+  if (ticks < 2 || tickObserver_ || settings_.nonfinite == NonfinitePolicy::Kill ||
+      !forces_.interleavesTicks()) {
+    return false;
+  }
+  for (const PendingStructure& p : structures_) {
+    if (p.tick >= tick_ && p.tick < tick_ + ticks) return false;
+  }
+  // Every birth of the frame must fit with every particle alive at its start: deaths come at the
+  // frame's end, and no spawn may be refused that the ticks one by one would have made.
+  std::uint64_t births = 0;
+  for (const Emitter& e : emitters_)
+    births += e.serialBefore(tick_ + ticks) - e.serialBefore(tick_);
+  return births <= pool_.maxParticles() - pool_.size();
+}
+
+bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
+  const std::int64_t first = tick_;
+  const std::size_t startRows = pool_.size();
+  const std::size_t stepped = pool_.firstUnstepped();
+  const std::uint64_t startId = pool_.nextId();
+  // Rows born at tick first + j end at bornBy[j]; rows before bornBy[0] step from the first tick.
+  std::vector<std::size_t> bornBy(static_cast<std::size_t>(ticks));
+  for (std::int64_t j = 0; j < ticks; ++j) {
+    for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, first + j);
+    bornBy[static_cast<std::size_t>(j)] = pool_.size();
+  }
+  const std::size_t rows = pool_.size();
+  integrator_->prepare(pool_, forces_);
+  forces_.beginTick(pool_, first);  // no module's own tables; whether any particle is pinned
+  const bool stop = settings_.nonfinite == NonfinitePolicy::Stop;
+  if (stop) {
+    if (!frameStart_) frameStart_ = std::make_unique<FrameStart>();
+    frameStart_->reserve(pool_);
+    frameStart_->rows = startRows;
+  }
+  if (keepVelocities) previousVelocity_.resize(static_cast<Eigen::Index>(rows));
+
+  // Blocks never straddle a birth tick: block i starts at tick first + firstTick[i].
+  struct Block {
+    std::size_t begin, end;
+    std::int64_t firstTick;
+  };
+  std::vector<Block> blocks;
+  std::size_t begin = 0;
+  for (std::int64_t j = 0; j < ticks; ++j) {
+    const std::size_t end = bornBy[static_cast<std::size_t>(j)];
+    for (std::size_t b = begin; b < end; b += kParallelBlockRows) {
+      blocks.push_back({b, std::min(end, b + kParallelBlockRows), j});
+    }
+    begin = end;
+  }
+  NonfiniteCheck* const check = stop ? &nonfiniteCheck_ : nullptr;
+  parallelForTasks(blocks.size(), [&](std::size_t i) {
+    const Block& block = blocks[i];
+    if (stop && block.begin < startRows) {
+      frameStart_->save(pool_, block.begin, std::min(block.end, startRows));
+    }
+    for (std::int64_t j = block.firstTick; j < ticks; ++j) {
+      if (keepVelocities && j == ticks - 1) {
+        FrameStart::copy(pool_.velocity(), previousVelocity_, block.begin, block.end);
+      }
+      // A block is fresh from the row the pool had stepped (the first tick) or whole (a birth
+      // tick), then stepped.
+      const std::size_t fresh = j != block.firstTick ? block.end
+                                : j == 0             ? std::max(block.begin, stepped)
+                                                     : block.begin;
+      const StepRows blockRows{RowRange{block.begin, block.end}, std::min(fresh, block.end), true};
+      integrator_->stepRows(pool_, forces_, StepTime{first + j, settings_.stepRateHz}, blockRows,
+                            check);
+    }
+  });
+  if (stop && nonfiniteCheck_.found()) {
+    // Back to the frame's start: its ticks one by one then stop at the one that went non-finite.
+    nonfiniteCheck_.clear();
+    pool_.dropNewest(startRows, startId);
+    parallelForRows(startRows,
+                    [&](std::size_t b, std::size_t e) { frameStart_->restore(pool_, b, e); });
+    return false;
+  }
+  pool_.markAllStepped();
+  tick_ = first + ticks;
+  pool_.updateAges(tick_, settings_.stepRateHz);
+  if (keepVelocities) {
+    pool_.applyRemovalTo(previousVelocity_);
+    velocitiesTick_ = tick_;
+  }
+  pool_.removeDead();
+  fusedTicks_ += ticks;
+  return true;
 }
 
 void ParticleSystem::runTick(bool keepVelocities) {

@@ -43,6 +43,17 @@ struct SystemSettings {
 /// the frame time, so the state after tick k is the same for any sequence of frames that reaches
 /// it.
 ///
+/// A frame of several ticks under forces that interleave ticks (local modules with no per-tick
+/// tables: ForceSet::interleavesTicks) is fused: each block of rows goes through all the frame's
+/// ticks while it is in cache, then the next block. The frame's births are spawned first, each
+/// block starting at its birth tick, and the deaths of all its ticks are removed at its end. The
+/// rows, ids and bits are those of the ticks one by one (tested for every integrator); a frame
+/// whose ticks a tick observer watches, that may reach maxParticles, that gives birth to a
+/// structure or that kills non-finite particles runs tick by tick. Under NonfinitePolicy::Stop a
+/// fused frame keeps a copy of the positions, velocities and previous positions it started from
+/// (36 bytes a particle, 48 with velocity Verlet): on finding a non-finite value it goes back and
+/// runs its ticks one by one, which stop at the exact tick.
+///
 /// Not thread-safe: one thread drives a system. Inside a tick the system runs its loops in its
 /// own TBB arena, or on the host's executor (setTaskExecutor()); it never changes TBB's
 /// process-wide limits.
@@ -76,6 +87,8 @@ class ParticleSystem {
   /// since the system was made (a restored system counts from its restore).
   std::uint64_t nonfiniteKilled() const { return nonfiniteKilled_; }
 
+  /// Ticks run in fused frames so far (see the class comment): for tests and benches.
+  std::int64_t fusedTicks() const { return fusedTicks_; }
   /// Ticks completed so far: the state is the state after tick tickCount() − 1 (or the initial
   /// state for 0), at time tickCount() / stepRate seconds.
   std::int64_t tickCount() const { return tick_; }
@@ -150,6 +163,8 @@ class ParticleSystem {
   struct PendingStructure;
   void runTicks(std::int64_t ticks, bool keepVelocities);
   void runTick(bool keepVelocities);
+  bool fusesTicks(std::int64_t ticks) const;
+  bool runFusedTicks(std::int64_t ticks, bool keepVelocities);
   void takeNonfinite();
   void spawnStructure(const StructureBuild& build);
 
@@ -172,6 +187,7 @@ class ParticleSystem {
   void runParallel(F&& f) const;
   std::function<void(const ParticleSystem&)> tickObserver_;
   std::int64_t tick_ = 0;
+  std::int64_t fusedTicks_ = 0;
   float alpha_ = 1.0f;
   // The shown time as the driver's frameOffset(): past tick tick_ − 1, kFlicksPerSecond = on
   // tick_.
@@ -180,6 +196,9 @@ class ParticleSystem {
   // kept by advance() for interpolation; valid while velocitiesTick_ == tick_.
   Vec3Column previousVelocity_;
   std::int64_t velocitiesTick_ = -1;
+  // Under NonfinitePolicy::Stop, the state a fused frame started from, to go back to.
+  struct FrameStart;
+  std::unique_ptr<FrameStart> frameStart_;
   NonfiniteCheck nonfiniteCheck_;
   std::optional<NonfiniteEvent> nonfiniteStop_;
   std::uint64_t nonfiniteKilled_ = 0;

@@ -1,0 +1,234 @@
+// A frame of several ticks under local forces runs block by block, each block through all the
+// frame's ticks (fused). It must give the rows, ids and bits of the ticks run one by one, with
+// births and deaths inside the frame, for every integrator and thread count, and stop at the same
+// tick when the state goes non-finite.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fields/AnalyticField.h"
+#include "fields/AnchorSpring.h"
+#include "fields/Gravity.h"
+#include "fields/LinearDrag.h"
+#include "fields/PeriodicWind.h"
+#include "particles/Clock.h"
+#include "particles/ParticleSystem.h"
+#include "particles/StateHash.h"
+
+namespace tickfx {
+namespace {
+
+constexpr std::int64_t kRate = 60;
+
+// A frame of `ticks` ticks at kRate.
+Flicks frameOf(std::int64_t ticks) { return ticks * (kFlicksPerSecond / kRate); }
+
+EmitterSettings busyEmitter() {
+  EmitterSettings e;
+  e.shape = SphereShape{0.5, false};
+  e.bursts = {{0.0, 20000}, {0.3, 9000}};  // several blocks; a burst in the middle of a frame
+  e.rate = 3001.0;                         // births every tick, starting mid-block
+  e.speed = 3.0;
+  e.spreadDegrees = 40.0;
+  e.lifetime = 0.2;  // deaths every tick once the first ones expire, inside frames
+  e.lifetimeJitter = 0.5;
+  return e;
+}
+
+ForceSet localForces() {
+  ForceSet forces;
+  forces.add(std::make_unique<Gravity>());
+  PeriodicWind::Settings wind;
+  wind.amplitude = 4.0f;
+  wind.frequency = 3.0;
+  forces.add(std::make_unique<PeriodicWind>(wind));
+  forces.add(std::make_unique<LinearDrag>(0.3f, Eigen::Vector3f(1.0f, 0.0f, 0.0f)));
+  forces.add(std::make_unique<AnchorSpring>(Eigen::Vector3f(0.0f, 2.0f, 0.0f), 2.0f, 0.1f));
+  return forces;
+}
+
+ForceSet advectingForces() {
+  ForceSet forces;
+  forces.add(std::make_unique<AnalyticForce>(AnalyticField::curlNoise(7, 2.0, 1.5, 4, 1.0),
+                                             AnalyticForce::Mode::Advect, 1.0f));
+  return forces;
+}
+
+std::unique_ptr<ParticleSystem> makeSystem(const std::string& integrator, int threads,
+                                           ForceSet forces, bool oneByOne) {
+  SystemSettings settings;
+  settings.stepRateHz = kRate;
+  settings.integrator = integrator;
+  settings.seed = 41;
+  settings.threads = threads;
+  auto system =
+      std::make_unique<ParticleSystem>(settings, std::vector{busyEmitter()}, std::move(forces));
+  // A tick observer sees every tick: the system then never fuses.
+  if (oneByOne) system->setTickObserver([](const ParticleSystem&) {});
+  return system;
+}
+
+template <typename Column>
+bool sameBits(const Column& a, const Column& b, std::size_t rows) {
+  return std::memcmp(a.data(), b.data(), rows * sizeof(a.data()[0])) == 0;
+}
+
+bool sameBits(const Vec3Column& a, const Vec3Column& b, std::size_t rows) {
+  return sameBits(a.x, b.x, rows) && sameBits(a.y, b.y, rows) && sameBits(a.z, b.z, rows);
+}
+
+// Every column of the state and every render copy, bit for bit.
+void expectSameState(const ParticleSystem& fused, const ParticleSystem& reference) {
+  ASSERT_EQ(fused.tickCount(), reference.tickCount());
+  const ParticlePool& a = fused.pool();
+  const ParticlePool& b = reference.pool();
+  ASSERT_EQ(a.size(), b.size()) << "at tick " << reference.tickCount();
+  const std::size_t n = a.size();
+  EXPECT_TRUE(sameBits(a.id(), b.id(), n));
+  EXPECT_TRUE(sameBits(a.position(), b.position(), n));
+  EXPECT_TRUE(sameBits(a.velocity(), b.velocity(), n));
+  EXPECT_TRUE(sameBits(a.previousPosition(), b.previousPosition(), n));
+  EXPECT_TRUE(sameBits(a.age(), b.age(), n));
+  EXPECT_TRUE(sameBits(a.lifetime(), b.lifetime(), n));
+  EXPECT_EQ(a.keepsAcceleration(), b.keepsAcceleration());
+  if (a.keepsAcceleration()) {
+    EXPECT_TRUE(sameBits(a.acceleration(), b.acceleration(), n));
+  }
+  EXPECT_EQ(a.nextId(), b.nextId());
+  EXPECT_EQ(a.droppedSpawns(), b.droppedSpawns());
+  EXPECT_EQ(stateHash(a), stateHash(b));
+  Vec3Column pa, pb, va, vb;
+  fused.renderPositions(pa);
+  reference.renderPositions(pb);
+  fused.renderVelocities(va);
+  reference.renderVelocities(vb);
+  EXPECT_TRUE(sameBits(pa, pb, n));
+  EXPECT_TRUE(sameBits(va, vb, n));
+  FloatColumn aa, ab;
+  fused.renderAges(aa);
+  reference.renderAges(ab);
+  EXPECT_TRUE(sameBits(aa, ab, n));
+}
+
+// Frames of 4, 3, 1, 2 and 5 ticks, then frames between ticks (2.5 ticks: interpolated copies).
+const std::vector<Flicks>& frames() {
+  static const std::vector<Flicks> f = [] {
+    std::vector<Flicks> out;
+    for (int repeat = 0; repeat < 3; ++repeat) {
+      for (std::int64_t ticks : {4, 3, 1, 2, 5}) out.push_back(frameOf(ticks));
+    }
+    for (int i = 0; i < 4; ++i) out.push_back(frameOf(5) / 2);
+    return out;
+  }();
+  return f;
+}
+
+void expectFusedMatchesOneByOne(const std::string& integrator, ForceSet (*forces)(),
+                                const std::vector<int>& threadCounts) {
+  const auto reference = makeSystem(integrator, 1, forces(), true);
+  std::vector<std::unique_ptr<ParticleSystem>> fused;
+  for (int threads : threadCounts)
+    fused.push_back(makeSystem(integrator, threads, forces(), false));
+  std::size_t crowd = 0;
+  for (const Flicks frame : frames()) {
+    reference->advance(frame);
+    crowd = std::max(crowd, reference->pool().size());
+    for (auto& system : fused) {
+      system->advance(frame);
+      SCOPED_TRACE("threads " + std::to_string(system->settings().threads));
+      expectSameState(*system, *reference);
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
+  EXPECT_EQ(reference->fusedTicks(), 0);
+  for (auto& system : fused) EXPECT_GT(system->fusedTicks(), 0);
+  EXPECT_GT(crowd, 20000u);  // the test moved several blocks of rows, not a few survivors
+}
+
+class FusedFrames : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(FusedFrames, GiveTheRowsIdsAndBitsOfTicksOneByOne) {
+  expectFusedMatchesOneByOne(GetParam(), &localForces, {1, 2, 3});
+}
+
+TEST_P(FusedFrames, GiveTheBitsOfTicksOneByOneUnderAdvection) {
+  expectFusedMatchesOneByOne(GetParam(), &advectingForces, {2});
+}
+
+INSTANTIATE_TEST_SUITE_P(AllIntegrators, FusedFrames, ::testing::ValuesIn(integratorNames()),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+TEST(FusedFrames, RunEveryFrameOfSeveralTicksAndNoOther) {
+  const auto system = makeSystem("semi_implicit_euler", 2, localForces(), false);
+  std::int64_t expected = 0;
+  for (const Flicks frame : frames()) {
+    const AdvanceResult r = system->advance(frame);
+    if (r.ticks >= 2) expected += r.ticks;
+  }
+  EXPECT_EQ(system->fusedTicks(), expected);
+  EXPECT_EQ(expected, 3 * (4 + 3 + 2 + 5) + (2 + 3 + 2 + 3));  // 2.5-tick frames: 2, 3, 2, 3
+}
+
+// Explicit Euler on a stiff spring at 60 Hz (ω = 1000 rad/s, ω·dt ≈ 17): each tick multiplies
+// the amplitude by about 17, so the state overflows after some thirty ticks, inside a frame.
+std::unique_ptr<ParticleSystem> unstableSystem(bool oneByOne) {
+  SystemSettings settings;
+  settings.stepRateHz = kRate;
+  settings.integrator = "explicit_euler";
+  settings.seed = 5;
+  settings.threads = 2;
+  EmitterSettings e = busyEmitter();
+  e.lifetime = 100.0;
+  ForceSet forces;
+  forces.add(std::make_unique<AnchorSpring>(Eigen::Vector3f(0.0f, 2.0f, 0.0f), 1.0e6f, 0.0f));
+  auto system = std::make_unique<ParticleSystem>(settings, std::vector{e}, std::move(forces));
+  if (oneByOne) system->setTickObserver([](const ParticleSystem&) {});
+  return system;
+}
+
+TEST(FusedFrames, StopAtTheTickThatWentNonFiniteWithItsState) {
+  const auto fused = unstableSystem(false);
+  const auto reference = unstableSystem(true);
+  for (int frame = 0; frame < 200 && !reference->nonfiniteStop(); ++frame) {
+    reference->advance(frameOf(5));
+    fused->advance(frameOf(5));
+  }
+  ASSERT_TRUE(reference->nonfiniteStop().has_value()) << "the spring never blew up";
+  ASSERT_TRUE(fused->nonfiniteStop().has_value());
+  EXPECT_NE(reference->nonfiniteStop()->tick % 5, 0) << "the test wants a stop inside a frame";
+  EXPECT_EQ(fused->nonfiniteStop()->tick, reference->nonfiniteStop()->tick);
+  EXPECT_EQ(fused->nonfiniteStop()->particles, reference->nonfiniteStop()->particles);
+  EXPECT_EQ(fused->nonfiniteStop()->firstIds, reference->nonfiniteStop()->firstIds);
+  EXPECT_GT(fused->fusedTicks(), 0);
+  expectSameState(*fused, *reference);
+}
+
+TEST(FusedFrames, AFrameThatMayFillThePoolRunsTickByTick) {
+  const auto make = [](bool oneByOne) {
+    SystemSettings settings;
+    settings.stepRateHz = kRate;
+    settings.seed = 3;
+    settings.maxParticles = 20300;  // the first frame fits; the rate then meets the cap
+    auto system =
+        std::make_unique<ParticleSystem>(settings, std::vector{busyEmitter()}, localForces());
+    if (oneByOne) system->setTickObserver([](const ParticleSystem&) {});
+    return system;
+  };
+  const auto fused = make(false);
+  const auto reference = make(true);
+  for (int frame = 0; frame < 12; ++frame) {
+    fused->advance(frameOf(4));
+    reference->advance(frameOf(4));
+    expectSameState(*fused, *reference);
+  }
+  EXPECT_GT(reference->pool().droppedSpawns(), 0u) << "the test wants refused spawns";
+  EXPECT_GT(fused->fusedTicks(), 0);       // the first frame fits
+  EXPECT_LT(fused->fusedTicks(), 12 * 4);  // the frames at the cap do not
+}
+
+}  // namespace
+}  // namespace tickfx
