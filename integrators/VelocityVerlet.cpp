@@ -16,45 +16,56 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   const std::size_t fresh = rows.fresh;
   const std::size_t n = rows.rows.end;
   const TickInstant t0 = time.stage(0), t1 = time.stage(2);
-  runPasses(rows, forces.isLocal(), scratch_,
-            {[&](const Tile& tile) {
-               // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
-               const RowRange started = intersect(tile.rows(), fresh, n);
-               if (started.count() == 0) return;
-               Vec3Rows out = rowsOf(a, started);
-               forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0}, started, out);
-             },
-             [&](const Tile& tile) {
-               Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()),
-                        vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows()),
-                        old = rowsOf(prev, tile.rows());
-               for (int c = 0; c < 3; ++c) {
-                 old[c] = pr[c];
-                 pr[c] += vr[c] * dt + ar[c] * halfDt2;
-                 vPred[c] = vr[c] + ar[c] * dt;
-               }
-             },
-             forcePass(pool, forces, kPoolColumn, 0, t1, 1),
-             [&](const Tile& tile) {
-               Vec3Rows aNew = tile.stage(1), pr = rowsOf(p, tile.rows()),
-                        vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
-               bool suspect = false;
-               // The position is final since the first update; it is checked here, with the new
-               // velocity, from cache.
-               const auto update = [halfDt](Eigen::Index i, const float* pos, float* vel,
-                                            float* acc, const float* accNext) {
-                 const float velocity = vel[i] + (acc[i] + accNext[i]) * halfDt;
-                 vel[i] = velocity;
-                 acc[i] = accNext[i];
-                 return pos[i] + velocity;
-               };
-               for (int c = 0; c < 3; ++c) {
-                 suspect |= updateRows(check, vr.x.size(), update,
-                                       static_cast<const float*>(pr[c].data()), vr[c].data(),
-                                       ar[c].data(), static_cast<const float*>(aNew[c].data()));
-               }
-               if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
-             }});
+  runPasses(
+      rows, forces.isLocal(), scratch_,
+      {[&](const Tile& tile) {
+         // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
+         const RowRange started = intersect(tile.rows(), fresh, n);
+         if (started.count() == 0) return;
+         Vec3Rows out = rowsOf(a, started);
+         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0}, started, out);
+       },
+       [&](const Tile& tile) {
+         Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                  ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
+         bool suspect = false;
+         // The position is final here: it is checked as it is written.
+         const auto update = [dt, halfDt2](Eigen::Index i, float* pos, float* last, float* pred,
+                                           const float* vel, const float* acc) {
+           const float position = pos[i];
+           const float next = position + (vel[i] * dt + acc[i] * halfDt2);
+           last[i] = position;
+           pos[i] = next;
+           pred[i] = vel[i] + acc[i] * dt;
+           return next;
+         };
+         for (int c = 0; c < 3; ++c) {
+           suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), old[c].data(),
+                                 vPred[c].data(), static_cast<const float*>(vr[c].data()),
+                                 static_cast<const float*>(ar[c].data()));
+         }
+         // The velocity is still the tick's start (finite), so the scan flags the rows
+         // whose new position is not; the last pass adds those whose new velocity is not.
+         if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+       },
+       forcePass(pool, forces, kPoolColumn, 0, t1, 1),
+       [&](const Tile& tile) {
+         Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
+         bool suspect = false;
+         // The new velocity alone: the position was checked by the first update.
+         const auto update = [halfDt](Eigen::Index i, float* vel, float* acc,
+                                      const float* accNext) {
+           const float velocity = vel[i] + (acc[i] + accNext[i]) * halfDt;
+           vel[i] = velocity;
+           acc[i] = accNext[i];
+           return velocity;
+         };
+         for (int c = 0; c < 3; ++c) {
+           suspect |= updateRows(check, vr.x.size(), update, vr[c].data(), ar[c].data(),
+                                 static_cast<const float*>(aNew[c].data()));
+         }
+         if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+       }});
 }
 
 }  // namespace tickfx
