@@ -48,6 +48,9 @@ class Integrator {
   virtual int order() const = 0;
   /// Force evaluations per tick (RK4: 4).
   virtual int evaluationsPerStep() const = 0;
+  /// True when the scheme reads pool.previousPosition() as state (position Verlet's x_{n−1});
+  /// the others only write it, for interpolation.
+  virtual bool readsPreviousPosition() const { return false; }
   /// How this scheme advances x' = u(x, t) when the forces prescribe velocity.
   virtual AdvectionScheme advectionScheme() const = 0;
 

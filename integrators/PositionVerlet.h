@@ -20,6 +20,7 @@ class PositionVerlet final : public Integrator {
   std::string_view name() const override { return "position_verlet"; }
   int order() const override { return 2; }
   int evaluationsPerStep() const override { return 1; }
+  bool readsPreviousPosition() const override { return true; }
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Euler; }
 
  protected:

@@ -110,30 +110,37 @@ void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
 // The rows of a fused frame's first tick, saved under NonfinitePolicy::Stop.
 struct ParticleSystem::FrameStart {
   Vec3Column position, velocity, previous, acceleration;
-  std::size_t rows = 0;
 
-  void reserve(const ParticlePool& pool) {
-    rows = pool.size();
+  void reserve(const ParticlePool& pool, bool previousToo) {
+    withPrevious = previousToo;
     const auto need = static_cast<Eigen::Index>(pool.storageRows());
-    for (Vec3Column* c : {&position, &velocity, &previous, &acceleration}) {
-      if (c->x.size() < need) c->resize(need);
-    }
+    const auto grow = [need](Vec3Column& c) {
+      if (c.x.size() < need) c.resize(need);
+    };
+    grow(position);
+    grow(velocity);
+    if (withPrevious) grow(previous);
+    if (pool.keepsAcceleration()) grow(acceleration);
   }
   // Copies rows [b, e) from `from` to `to`, column by column.
   static void copy(const Vec3Column& from, Vec3Column& to, std::size_t b, std::size_t e) {
     const auto i = static_cast<Eigen::Index>(b), n = static_cast<Eigen::Index>(e - b);
     for (int c = 0; c < 3; ++c) to[c].segment(i, n) = from[c].segment(i, n);
   }
+  // The state a tick reads: the previous position only for a scheme that reads it (the others
+  // write it afresh each tick), the acceleration only when the pool keeps it.
+  bool withPrevious = false;
+
   void save(ParticlePool& pool, std::size_t b, std::size_t e) {
     copy(pool.position(), position, b, e);
     copy(pool.velocity(), velocity, b, e);
-    copy(pool.previousPosition(), previous, b, e);
+    if (withPrevious) copy(pool.previousPosition(), previous, b, e);
     if (pool.keepsAcceleration()) copy(pool.acceleration(), acceleration, b, e);
   }
   void restore(ParticlePool& pool, std::size_t b, std::size_t e) const {
     copy(position, pool.position(), b, e);
     copy(velocity, pool.velocity(), b, e);
-    copy(previous, pool.previousPosition(), b, e);
+    if (withPrevious) copy(previous, pool.previousPosition(), b, e);
     if (pool.keepsAcceleration()) copy(acceleration, pool.acceleration(), b, e);
   }
 };
@@ -171,8 +178,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
   const bool stop = settings_.nonfinite == NonfinitePolicy::Stop;
   if (stop) {
     if (!frameStart_) frameStart_ = std::make_unique<FrameStart>();
-    frameStart_->reserve(pool_);
-    frameStart_->rows = startRows;
+    frameStart_->reserve(pool_, integrator_->readsPreviousPosition());
   }
   if (keepVelocities) previousVelocity_.resize(static_cast<Eigen::Index>(rows));
 

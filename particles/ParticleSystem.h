@@ -50,9 +50,10 @@ struct SystemSettings {
 /// rows, ids and bits are those of the ticks one by one (tested for every integrator); a frame
 /// whose ticks a tick observer watches, that may reach maxParticles, that gives birth to a
 /// structure or that kills non-finite particles runs tick by tick. Under NonfinitePolicy::Stop a
-/// fused frame keeps a copy of the positions, velocities and previous positions it started from
-/// (36 bytes a particle, 48 with velocity Verlet): on finding a non-finite value it goes back and
-/// runs its ticks one by one, which stop at the exact tick.
+/// fused frame keeps a copy of the positions and velocities it started from (24 bytes a particle;
+/// 36 for position Verlet, which reads the previous position, and velocity Verlet, which keeps
+/// the acceleration): on finding a non-finite value it goes back and runs its ticks one by one,
+/// which stop at the exact tick.
 ///
 /// Not thread-safe: one thread drives a system. Inside a tick the system runs its loops in its
 /// own TBB arena, or on the host's executor (setTaskExecutor()); it never changes TBB's
