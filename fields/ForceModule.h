@@ -126,6 +126,10 @@ class ForceModule {
     return false;
   }
 
+  /// When the module is a linear drag, a += k·(air − v) per component in that order of operations,
+  /// stores k (1/s) and air (m/s) and returns true: a scheme may then form the acceleration inside
+  /// its own update loop (ForceSet::uniformAndDrag).
+  virtual bool linearDrag(float& /*k*/, Eigen::Vector3f& /*air*/) const { return false; }
   /// Called once per tick, on one thread, before any accumulate(): rebuild per-tick tables.
   virtual void beginTick(const ParticlePool& /*pool*/, std::int64_t /*tick*/) {}
 

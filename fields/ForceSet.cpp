@@ -67,10 +67,10 @@ void ForceSet::beginTick(const ParticlePool& pool, std::int64_t tick) {
   anyPinned_ = anyZero(pool.inverseMass(), pool.size());
 }
 
-void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
+std::size_t ForceSet::uniformPrefix(const ForceInput& in, Eigen::Vector3f& uniform) const {
   // Only a leading run of uniform modules is folded: (0 + g) + w is then the very sum each row
   // would have formed, while folding a uniform module after a per-row one would reorder it.
-  Eigen::Vector3f uniform = Eigen::Vector3f::Zero();
+  uniform = Eigen::Vector3f::Zero();
   std::size_t next = 0;
   for (Eigen::Vector3f a; next < modules_.size() && modules_[next]->uniformAcceleration(in, a);
        ++next) {
@@ -78,6 +78,24 @@ void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& accelerat
     uniform.y() += a.y();
     uniform.z() += a.z();
   }
+  return next;
+}
+
+std::optional<ForceSet::UniformAndDrag> ForceSet::uniformAndDrag(const ForceInput& in) const {
+  if (anyPinned_ || advects_) return std::nullopt;
+  UniformAndDrag form;
+  const std::size_t next = uniformPrefix(in, form.uniform);
+  if (next == modules_.size()) return form;
+  if (next + 1 == modules_.size() && modules_[next]->linearDrag(form.k, form.air)) {
+    form.drag = true;
+    return form;
+  }
+  return std::nullopt;
+}
+
+void ForceSet::evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const {
+  Eigen::Vector3f uniform;
+  std::size_t next = uniformPrefix(in, uniform);
   acceleration.x.setConstant(uniform.x());
   acceleration.y.setConstant(uniform.y());
   acceleration.z.setConstant(uniform.z());

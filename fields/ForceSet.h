@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "fields/ForceModule.h"
@@ -38,6 +39,19 @@ class ForceSet {
   /// 0 + a_1 + a_2 + ... in module order, for every row; 0 for pinned particles.
   void evaluate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const;
 
+  /// The acceleration evaluate() writes, when it is that simple: the modules are a leading run of
+  /// uniform modules (ForceModule::uniformAcceleration) and then at most one linear drag, and no
+  /// particle is pinned. Each row's acceleration is then `uniform`, plus k·(air − v) with a drag:
+  /// a scheme may form it inside its update loop, by the same operations, instead of in a pass
+  /// of its own.
+  struct UniformAndDrag {
+    Eigen::Vector3f uniform = Eigen::Vector3f::Zero();  // m/s²
+    bool drag = false;
+    float k = 0.0f;                                 // 1/s
+    Eigen::Vector3f air = Eigen::Vector3f::Zero();  // m/s
+  };
+  std::optional<UniformAndDrag> uniformAndDrag(const ForceInput& in) const;
+
   /// True when the modules prescribe velocity (advection): integrators then advance x' = u(x, t)
   /// with evaluateVelocity() instead of asking for accelerations.
   bool prescribesVelocity() const { return advects_; }
@@ -50,6 +64,9 @@ class ForceSet {
   void endTick(ParticlePool& pool, const TickInstant& end);
 
  private:
+  // Sums the leading run of uniform modules into `uniform`; returns the index of the first other.
+  std::size_t uniformPrefix(const ForceInput& in, Eigen::Vector3f& uniform) const;
+
   std::vector<std::unique_ptr<ForceModule>> modules_;
   bool anyPinned_ = false;
   bool advects_ = false;

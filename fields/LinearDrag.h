@@ -14,6 +14,11 @@ class LinearDrag final : public ForceModule {
   std::string_view typeName() const override { return "drag"; }
   bool interleavesTicks() const override { return true; }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
+  bool linearDrag(float& k, Eigen::Vector3f& air) const override {
+    k = k_;
+    air = air_;
+    return true;
+  }
 
  private:
   float k_;
