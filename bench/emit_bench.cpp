@@ -446,6 +446,9 @@ std::unique_ptr<tickfx::ParticleSystem> makeSystem(const tickfx::EmitterSettings
       settings, std::vector<tickfx::EmitterSettings>{emitter}, std::move(forces));
 }
 
+// Ticks a frame in the steady cases that run fused frames.
+constexpr std::int64_t kFusedTicks = 4;
+
 // False when a population is not what it should be.
 bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<Figure>& figures,
                double& checksum) {
@@ -469,12 +472,32 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
   std::printf("  alive after %lld ticks: %zu with the emitter (%.0f expected), %zu without\n",
               static_cast<long long>(2 * kStepRateHz), alive, expected, still->pool().size());
 
+  // The same two populations advanced in frames of kFusedTicks ticks: fused frames, whose deaths
+  // are removed once a frame (ParticleSystem's class comment).
+  auto emittingFused = makeSystem(steadyEmitter(rate, 0), maxParticles);
+  auto stillFused = makeSystem(steadyEmitter(0.0, alive), maxParticles);
+  emittingFused->stepTicks(2 * kStepRateHz);
+  stillFused->stepTicks(2 * kStepRateHz);
+
+  // step() tick by tick: stepTicks(batch) would fuse the whole batch into one frame.
+  const auto ticksOf = [](tickfx::ParticleSystem& system) {
+    return [&system](std::int64_t ticks) {
+      for (std::int64_t i = 0; i < ticks; ++i) system.step();
+    };
+  };
+  const auto framesOf = [](tickfx::ParticleSystem& system) {
+    return [&system](std::int64_t ticks) {
+      for (; ticks > 0; ticks -= kFusedTicks) system.stepTicks(kFusedTicks);
+    };
+  };
   std::vector<bench::Case> cases;
-  cases.emplace_back("tick with the rate emitter",
-                     [&](std::int64_t ticks) { emitting->stepTicks(ticks); });
-  cases.emplace_back("tick without emission", [&](std::int64_t ticks) { still->stepTicks(ticks); });
-  cases.emplace_back("tick without emission, copy",
-                     [&](std::int64_t ticks) { control->stepTicks(ticks); });
+  cases.emplace_back("tick with the rate emitter", ticksOf(*emitting));
+  cases.emplace_back("tick without emission", ticksOf(*still));
+  cases.emplace_back("tick without emission, copy", ticksOf(*control));
+  cases.emplace_back("frames of 4 ticks with the rate emitter", framesOf(*emittingFused));
+  cases.back().ticksPerFrame = kFusedTicks;
+  cases.emplace_back("frames of 4 ticks without emission", framesOf(*stillFused));
+  cases.back().ticksPerFrame = kFusedTicks;
   bench::timeCases(cases, timing);
 
   const auto populationOk = [](const tickfx::ParticleSystem& s, double lo, double hi) {
@@ -489,7 +512,7 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
                  static_cast<unsigned long long>(emitting->pool().droppedSpawns()), expected);
     ok = false;
   }
-  for (const auto* s : {still.get(), control.get()}) {
+  for (const auto* s : {still.get(), control.get(), stillFused.get()}) {
     const auto a = static_cast<double>(alive);
     if (!populationOk(*s, a, a)) {
       std::fprintf(stderr, "error: %zu particles alive without emission, expected %zu\n",
@@ -563,8 +586,18 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
                 pop.c_str(), 100.0 * emitAlone / with, 1e3 * emitAlone,
                 sci(perTick / emitAlone).c_str(), 1e3 * (with - without - emitAlone));
   figures.push_back({buf});
+  const double withFused = bench::median(cases[3].secondsPerTick);
+  const double withoutFused = bench::median(cases[4].secondsPerTick);
+  std::snprintf(buf, sizeof buf,
+                "steady %s emission cost, frames of %lld ticks: %.1f %% of the tick (%.4g ms a "
+                "tick, %.4g ms without emission; fused frames remove the dead once a frame)",
+                pop.c_str(), static_cast<long long>(kFusedTicks),
+                100.0 * (withFused - withoutFused) / withFused, 1e3 * withFused,
+                1e3 * withoutFused);
+  figures.push_back({buf});
   checksum += bench::positionSum(emitting->pool()) + bench::positionSum(still->pool()) +
-              bench::positionSum(control->pool());
+              bench::positionSum(control->pool()) + bench::positionSum(emittingFused->pool()) +
+              bench::positionSum(stillFused->pool());
   return ok;
 }
 
