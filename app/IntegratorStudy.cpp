@@ -63,6 +63,37 @@ void simulate(std::string_view integratorName, ForceSet& forces, std::int64_t st
   }
 }
 
+// The forces of the three experiments, along x.
+ForceSet constantAccelerationForces() {
+  ForceSet forces;
+  forces.add(
+      std::make_unique<Gravity>(Eigen::Vector3f(static_cast<float>(kStudyGravity), 0.0f, 0.0f)));
+  return forces;
+}
+
+ForceSet oscillatorForces() {
+  ForceSet forces;
+  forces.add(std::make_unique<AnchorSpring>(Eigen::Vector3f::Zero(),
+                                            static_cast<float>(kStudySpringStiffness)));
+  return forces;
+}
+
+ForceSet windForces(double frequencyHz) {
+  PeriodicWind::Settings wind;
+  wind.direction = Eigen::Vector3f(1.0f, 0.0f, 0.0f);
+  wind.base = 0.0f;
+  wind.amplitude = static_cast<float>(kStudyWindAmplitude);
+  wind.frequency = frequencyHz;
+  wind.phase = 0.0;
+  ForceSet forces;
+  forces.add(std::make_unique<PeriodicWind>(wind));
+  return forces;
+}
+
+double energyOf(double p, double v) {
+  return 0.5 * kStudyMass * v * v + 0.5 * kStudySpringStiffness * p * p;
+}
+
 // ---- text output ----------------------------------------------------------------------------
 
 // to_chars is specified as printf in the C locale, so a CSV never gets a decimal comma.
@@ -181,9 +212,7 @@ std::vector<ConstantAccelerationResult> runConstantAcceleration(
   std::vector<float> sampled(sampleTicks.size(), 0.0f);
   const std::int64_t lastTick =
       sampleTicks.empty() ? 0 : *std::max_element(sampleTicks.begin(), sampleTicks.end());
-  ForceSet forces;
-  forces.add(
-      std::make_unique<Gravity>(Eigen::Vector3f(static_cast<float>(kStudyGravity), 0.0f, 0.0f)));
+  ForceSet forces = constantAccelerationForces();
   simulate(integrator, forces, stepRateHz, lastTick, 0.0f, 0.0f,
            [&](std::int64_t tick, float p, float /*v*/) {
              for (std::size_t i = 0; i < sampleTicks.size(); ++i) {
@@ -209,9 +238,7 @@ std::vector<ConstantAccelerationResult> runConstantAcceleration(
 OscillatorResult runOscillator(std::string_view integrator, std::int64_t stepRateHz,
                                double duration) {
   const std::int64_t ticks = wholeTicks(duration, stepRateHz);
-  ForceSet forces;
-  forces.add(std::make_unique<AnchorSpring>(Eigen::Vector3f::Zero(),
-                                            static_cast<float>(kStudySpringStiffness)));
+  ForceSet forces = oscillatorForces();
   float p = static_cast<float>(kStudyOscillatorStart), v = 0.0f;
   simulate(integrator, forces, stepRateHz, ticks, p, v, [&](std::int64_t, float pk, float vk) {
     p = pk;
@@ -226,22 +253,14 @@ OscillatorResult runOscillator(std::string_view integrator, std::int64_t stepRat
   r.exact = exactOscillatorPosition(r.time);
   r.error = r.position - r.exact;
   r.velocity = v;
-  r.energy = 0.5 * kStudyMass * r.velocity * r.velocity +
-             0.5 * kStudySpringStiffness * r.position * r.position;
+  r.energy = energyOf(r.position, r.velocity);
   return r;
 }
 
 WindResult runWind(std::string_view integrator, std::int64_t stepRateHz, double frequencyHz,
                    double duration) {
   const std::int64_t ticks = wholeTicks(duration, stepRateHz);
-  PeriodicWind::Settings wind;
-  wind.direction = Eigen::Vector3f(1.0f, 0.0f, 0.0f);
-  wind.base = 0.0f;
-  wind.amplitude = static_cast<float>(kStudyWindAmplitude);
-  wind.frequency = frequencyHz;
-  wind.phase = 0.0;
-  ForceSet forces;
-  forces.add(std::make_unique<PeriodicWind>(wind));
+  ForceSet forces = windForces(frequencyHz);
   float p = 0.0f;
   simulate(integrator, forces, stepRateHz, ticks, 0.0f, 0.0f,
            [&](std::int64_t, float pk, float) { p = pk; });
@@ -364,6 +383,66 @@ std::string windCsv(const StudyResults& results) {
                 csvNumber(r.time), csvNumber(r.position), csvNumber(r.exact), csvNumber(r.error)});
   }
   return text;
+}
+
+std::vector<std::filesystem::path> writeStudySeriesCsv(const StudyPlan& plan,
+                                                       const std::filesystem::path& dir) {
+  std::string gravity = "integrator,step_rate_hz,t,position,exact,error\n";
+  std::string oscillator = "integrator,step_rate_hz,t,position,velocity,energy\n";
+  std::string wind = "integrator,step_rate_hz,frequency_hz,t,position,exact\n";
+  const auto seconds = [](std::int64_t tick, std::int64_t rate) {
+    return static_cast<double>(tick) / static_cast<double>(rate);
+  };
+  for (const std::string& integrator :
+       plan.integrators.empty() ? integratorNames() : plan.integrators) {
+    for (const std::int64_t rate : plan.stepRatesHz) {
+      ForceSet forces = constantAccelerationForces();
+      const auto row = [&](std::int64_t tick, float p) {
+        const double t = seconds(tick, rate), exact = exactConstantAccelerationPosition(t);
+        gravity += csvRow({integrator, csvInteger(rate), csvNumber(t), csvNumber(p),
+                           csvNumber(exact), csvNumber(p - exact)});
+      };
+      row(0, 0.0f);
+      simulate(integrator, forces, rate, wholeTicks(kSeriesConstantAccelerationSeconds, rate),
+               0.0f, 0.0f, [&](std::int64_t tick, float p, float) { row(tick, p); });
+    }
+    for (const std::int64_t rate : plan.oscillatorStepRatesHz) {
+      ForceSet forces = oscillatorForces();
+      const auto row = [&](std::int64_t tick, float p, float v) {
+        oscillator += csvRow({integrator, csvInteger(rate), csvNumber(seconds(tick, rate)),
+                              csvNumber(p), csvNumber(v), csvNumber(energyOf(p, v))});
+      };
+      const auto start = static_cast<float>(kStudyOscillatorStart);
+      row(0, start, 0.0f);
+      simulate(integrator, forces, rate, wholeTicks(plan.oscillatorDuration, rate), start, 0.0f,
+               row);
+    }
+  }
+  const double frequency = plan.windFrequenciesHz.empty() ? 16.0 : plan.windFrequenciesHz.back();
+  for (const std::int64_t rate : kSeriesWindStepRatesHz) {
+    ForceSet forces = windForces(frequency);
+    const std::string integrator = "semi_implicit_euler";
+    const auto row = [&](std::int64_t tick, float p) {
+      const double t = seconds(tick, rate);
+      wind += csvRow({integrator, csvInteger(rate), csvNumber(frequency), csvNumber(t),
+                      csvNumber(p), csvNumber(exactWindPosition(frequency, t))});
+    };
+    row(0, 0.0f);
+    simulate(integrator, forces, rate, wholeTicks(plan.windDuration, rate), 0.0f, 0.0f,
+             [&](std::int64_t tick, float p, float) { row(tick, p); });
+  }
+  std::filesystem::create_directories(dir);
+  const std::vector<std::pair<std::filesystem::path, std::string>> files = {
+      {dir / "series_constant_acceleration.csv", gravity},
+      {dir / "series_oscillator.csv", oscillator},
+      {dir / "series_wind.csv", wind},
+  };
+  std::vector<std::filesystem::path> written;
+  for (const auto& [path, text] : files) {
+    writeFile(path, text);
+    written.push_back(path);
+  }
+  return written;
 }
 
 std::vector<std::filesystem::path> writeStudyCsv(const StudyResults& results,

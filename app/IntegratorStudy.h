@@ -143,4 +143,23 @@ std::string windCsv(const StudyResults& results);
 std::vector<std::filesystem::path> writeStudyCsv(const StudyResults& results,
                                                  const std::filesystem::path& dir);
 
+/// Seconds of constant acceleration the series cover (the errors have grown visibly by then).
+inline constexpr double kSeriesConstantAccelerationSeconds = 2.0;
+/// Step rates of the wind series: the aliasing rate of the source material against a fine one.
+inline constexpr std::int64_t kSeriesWindStepRatesHz[] = {20, 1000};
+
+/// Every tick of the runs the study's figures plot (`tickfx study --plots`), as CSV, from each
+/// run's start (t = 0) on:
+///   series_constant_acceleration.csv  integrator,step_rate_hz,t,position,exact,error
+///       every integrator at every plan rate, for kSeriesConstantAccelerationSeconds;
+///   series_oscillator.csv             integrator,step_rate_hz,t,position,velocity,energy
+///       every integrator at the plan's oscillator rates, for the plan's oscillator duration;
+///   series_wind.csv                   integrator,step_rate_hz,frequency_hz,t,position,exact
+///       semi-implicit Euler at kSeriesWindStepRatesHz, the plan's last wind frequency, for the
+///       plan's wind duration.
+/// Writes them into `dir` (created if missing) and returns their paths in that order; throws as
+/// writeStudyCsv() does.
+std::vector<std::filesystem::path> writeStudySeriesCsv(const StudyPlan& plan,
+                                                       const std::filesystem::path& dir);
+
 }  // namespace tickfx

@@ -568,6 +568,72 @@ TEST_F(Cli, StudyWritesOneCsvPerExperiment) {
   EXPECT_NEAR(error, 2.4525, 2e-3);
 }
 
+// Width and height from a PNG's IHDR chunk; {0, 0} for anything that does not start as a PNG.
+std::pair<std::uint32_t, std::uint32_t> pngSize(const std::string& bytes) {
+  if (bytes.size() < 24 || bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0 ||
+      bytes.compare(12, 4, "IHDR") != 0) {
+    return {0, 0};
+  }
+  const auto be32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(bytes[at + i]);
+    return v;
+  };
+  return {be32(16), be32(20)};
+}
+
+TEST_F(Cli, StudyPlotsDrawTheFiguresFromEveryTickOfTheRuns) {
+  const Result r = run("study --out " + path("study") + " --plots " + path("plots"));
+  ASSERT_EQ(r.exit, 0) << r.err;
+  // Figure sizes at 100 dpi: 5 step rates of two panels, 2 oscillator rates of three, one row.
+  const std::vector<std::tuple<const char*, std::uint32_t, std::uint32_t>> figures = {
+      {"constant_acceleration.png", 1200, 1600}, {"oscillator.png", 1500, 840},
+      {"wind.png", 1300, 450}};
+  for (const auto& [name, width, height] : figures) {
+    const auto size = pngSize(readAll(path(std::string("plots/") + name)));
+    EXPECT_EQ(size.first, width) << name;
+    EXPECT_EQ(size.second, height) << name;
+    EXPECT_NE(r.out.find("wrote " + path(std::string("plots/") + name)), std::string::npos)
+        << r.out;
+  }
+  EXPECT_FALSE(fs::exists(path("plots/wind.png.partial.png")));
+  // Every tick from the start: explicit Euler's first tick at 20 Hz has not moved (p += v·dt with
+  // v = 0) and lags the exact fall by 9.81 · 0.05² / 2 m.
+  const std::string series = readAll(path("plots/series_constant_acceleration.csv"));
+  EXPECT_EQ(series.rfind("integrator,step_rate_hz,t,position,exact,error\n", 0), 0u);
+  EXPECT_NE(series.find("\nexplicit_euler,20,0,0,-0,0\n"), std::string::npos);  // -½·g·0²
+  EXPECT_NE(series.find("\nexplicit_euler,20,0.05,0,-0.0122625,0.0122625\n"), std::string::npos);
+  const std::string wind = readAll(path("plots/series_wind.csv"));
+  EXPECT_NE(wind.find("\nsemi_implicit_euler,20,16,2,"), std::string::npos);
+  EXPECT_NE(wind.find("\nsemi_implicit_euler,1000,16,2,"), std::string::npos);
+}
+
+TEST_F(Cli, StudyPlotsSayWhatToInstallWithoutPythonOrMatplotlib) {
+  // No interpreter at all.
+  ::setenv("TICKFX_PYTHON", path("no/python3").c_str(), 1);
+  Result r = run("study --out " + path("study") + " --plots " + path("plots"));
+  EXPECT_EQ(r.exit, 1);
+  EXPECT_EQ(r.err, "tickfx study: error: cannot run " + path("no/python3") +
+                       " (No such file or directory): plotting needs Python 3 with matplotlib "
+                       "(Debian: apt-get install python3-matplotlib)\n");
+  EXPECT_FALSE(fs::exists(path("plots/wind.png")));
+  // Python without its site packages, where Debian keeps matplotlib.
+  const std::string bare = path("bare-python3");
+  {
+    std::ofstream script(bare);
+    script << "#!/bin/sh\nexec /usr/bin/python3 -S \"$@\"\n";
+  }
+  fs::permissions(bare, fs::perms::owner_all);
+  ::setenv("TICKFX_PYTHON", bare.c_str(), 1);
+  r = run("study --out " + path("study") + " --plots " + path("plots"));
+  ::unsetenv("TICKFX_PYTHON");
+  EXPECT_EQ(r.exit, 1);
+  EXPECT_EQ(r.err, "matplotlib for Python 3 is not installed\ntickfx study: error: " + bare +
+                       " has no matplotlib: plotting needs Python 3 with matplotlib (Debian: "
+                       "apt-get install python3-matplotlib)\n");
+  EXPECT_FALSE(fs::exists(path("plots/constant_acceleration.png")));
+}
+
 // Bad effect files through the command line: exit code 2, the first message exactly (file, line,
 // column, key path, what is wrong and what is expected), and no output folder created. The io
 // tests check every message of these and more cases through the library.
