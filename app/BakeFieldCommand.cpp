@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "app/Commands.h"
+#include "app/ProgressLine.h"
 #include "io/effect/EditDistance.h"
 #include "io/effect/VectorFieldSource.h"
 
@@ -295,10 +296,13 @@ int bakeFieldCommand(Arguments& args) {
   const BakeSettings settings = io::bakeSettings(bake, gridName);
   const std::filesystem::path parent = std::filesystem::path(*out).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
+  ProgressLine progress("frames");
   for (int f = first; f <= last; ++f) {
     const std::string path = frames ? sequenceFramePath(*out, f, digits) : *out;
     const double time = frames ? (f - first) / rate : 0.0;
+    progress.update(f - first, count, static_cast<double>(f - first) / count, path);
     bakeField(field, settings, path, time);
+    progress.finish();  // the line below replaces it
     std::printf("%s: %s field, grid '%s', %.0f voxels of %s m%s\n", path.c_str(), kind.c_str(),
                 gridName.c_str(), perFrame, numberText(h).c_str(),
                 frames ? (", t = " + numberText(time) + " s").c_str() : "");

@@ -10,6 +10,7 @@
 #include "app/Commands.h"
 #include "app/DeterminismCheck.h"
 #include "app/HashLogRun.h"
+#include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
 #include "io/FrameTimes.h"
 #include "io/effect/EffectBuilder.h"
@@ -283,7 +284,12 @@ int determinismCommand(Arguments& args) {
               "hash at 1 s", "hash at 2 s", "hash at the end", "wall s");
 
   std::vector<DriveTrace> traces;
-  for (const DriveCase& drive : standardDriveCases(total, threads, recorded)) {
+  const std::vector<DriveCase> drives = standardDriveCases(total, threads, recorded);
+  ProgressLine progress("schedules");
+  for (const DriveCase& drive : drives) {
+    const auto done = static_cast<std::int64_t>(traces.size());
+    progress.update(done, static_cast<std::int64_t>(drives.size()),
+                    static_cast<double>(done) / static_cast<double>(drives.size()), drive.label);
     try {
       traces.push_back(traceDrive(effect, drive));
     } catch (const io::BuildError& e) {  // a vector field's file that does not load: bad input
@@ -291,6 +297,7 @@ int determinismCommand(Arguments& args) {
       return kExitUsage;
     }
     const DriveTrace& t = traces.back();
+    progress.finish();  // the row below replaces the line
     std::printf("%-18s %7d %7zu  %-16s  %-16s  %-16s %8.3f%s\n", t.label.c_str(), t.threads,
                 t.ticks.size(), hashAt(t, rate).c_str(), hashAt(t, 2 * rate).c_str(),
                 hashAt(t, lastTick).c_str(), t.wallSeconds,

@@ -403,8 +403,8 @@ std::vector<std::filesystem::path> writeStudySeriesCsv(const StudyPlan& plan,
                            csvNumber(exact), csvNumber(p - exact)});
       };
       row(0, 0.0f);
-      simulate(integrator, forces, rate, wholeTicks(kSeriesConstantAccelerationSeconds, rate),
-               0.0f, 0.0f, [&](std::int64_t tick, float p, float) { row(tick, p); });
+      simulate(integrator, forces, rate, wholeTicks(kSeriesConstantAccelerationSeconds, rate), 0.0f,
+               0.0f, [&](std::int64_t tick, float p, float) { row(tick, p); });
     }
     for (const std::int64_t rate : plan.oscillatorStepRatesHz) {
       ForceSet forces = oscillatorForces();

@@ -348,7 +348,8 @@ int runCommand(Arguments& args) {
   }
 
   const auto wallStart = std::chrono::steady_clock::now();
-  ProgressLine progress;
+  ProgressLine progress("frames");
+  const Flicks resumedAt = elapsed;         // the bar and the time left count this run's part alone
   std::int64_t lastFrame = firstFrame - 1;  // the last frame simulated
   const std::optional<std::filesystem::path> cacheDir =
       formats.empty() ? std::nullopt : std::optional(outDir);
@@ -391,8 +392,14 @@ int runCommand(Arguments& args) {
                             io::CheckpointInfo{effectHash, f, elapsed});
       }
       lastFrame = f;
-      progress.update(f, secondsFromFlicks(elapsed), secondsFromFlicks(schedule.total()),
-                      system->pool().size());
+      char detail[96];
+      std::snprintf(detail, sizeof detail, "t = %.3f of %.3f s, %zu particles",
+                    secondsFromFlicks(elapsed), secondsFromFlicks(schedule.total()),
+                    system->pool().size());
+      progress.update(f - firstFrame + 1, -1,
+                      static_cast<double>(elapsed - resumedAt) /
+                          static_cast<double>(std::max<Flicks>(1, schedule.total() - resumedAt)),
+                      detail);
     }
     writer.finish();
     if (const int signal = InterruptCatcher::caught()) {

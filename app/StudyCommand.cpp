@@ -43,8 +43,8 @@ void drawPlots(const std::string& dir) {
   pid_t pid = 0;
   const int spawned = ::posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv.data(), environ);
   if (spawned != 0) {
-    throw std::runtime_error("cannot run " + python + " (" + std::strerror(spawned) + "): " +
-                             kPlotsHelp);
+    throw std::runtime_error("cannot run " + python + " (" + std::strerror(spawned) +
+                             "): " + kPlotsHelp);
   }
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {

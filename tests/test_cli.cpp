@@ -587,7 +587,8 @@ TEST_F(Cli, StudyPlotsDrawTheFiguresFromEveryTickOfTheRuns) {
   ASSERT_EQ(r.exit, 0) << r.err;
   // Figure sizes at 100 dpi: 5 step rates of two panels, 2 oscillator rates of three, one row.
   const std::vector<std::tuple<const char*, std::uint32_t, std::uint32_t>> figures = {
-      {"constant_acceleration.png", 1200, 1600}, {"oscillator.png", 1500, 840},
+      {"constant_acceleration.png", 1200, 1600},
+      {"oscillator.png", 1500, 840},
       {"wind.png", 1300, 450}};
   for (const auto& [name, width, height] : figures) {
     const auto size = pngSize(readAll(path(std::string("plots/") + name)));
