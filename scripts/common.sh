@@ -10,7 +10,7 @@ TICKFX_PACKAGES=(
   libeigen3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenvdb-dev libopenvdb-tools libboost-dev libboost-iostreams-dev zlib1g-dev
-  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libpng-dev
 )
 
 # What scripts/test's aarch64 stage adds: Debian's cross compiler, qemu-user, and the arm64 builds

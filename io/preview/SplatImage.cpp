@@ -1,0 +1,147 @@
+#include "io/preview/SplatImage.h"
+
+#include <png.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+#include "io/AtomicFile.h"
+
+namespace tickfx::io {
+namespace {
+
+constexpr int kBandRows = 16;
+
+// The splat's cover of a pixel centre at distance `d`: 1 inside, 0 outside, linear over the
+// pixel across its edge.
+float cover(float d, float radius) { return std::clamp(radius + 0.5f - d, 0.0f, 1.0f); }
+
+}  // namespace
+
+SplatImage::SplatImage(int width, int height, Rgb background) : width_(width), height_(height) {
+  if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide) {
+    throw std::invalid_argument("an image of " + std::to_string(width) + "x" +
+                                std::to_string(height) + " pixels (expected 1 to " +
+                                std::to_string(kMaxSide) + " a side)");
+  }
+  rgb_.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3);
+  for (std::size_t i = 0; i < rgb_.size(); i += 3) {
+    for (int c = 0; c < 3; ++c) rgb_[i + static_cast<std::size_t>(c)] = background[c];
+  }
+}
+
+void SplatImage::draw(std::vector<Splat> splats) {
+  // Farthest first; a stable sort keeps the given order among equal depths.
+  std::stable_sort(splats.begin(), splats.end(),
+                   [](const Splat& a, const Splat& b) { return a.depth > b.depth; });
+  // Each band's splats, in drawing order: a splat goes to every band its disc reaches.
+  const int bands = (height_ + kBandRows - 1) / kBandRows;
+  std::vector<std::vector<std::uint32_t>> inBand(static_cast<std::size_t>(bands));
+  for (std::size_t i = 0; i < splats.size(); ++i) {
+    const Splat& s = splats[i];
+    if (!(s.radius > 0.0f) || !std::isfinite(s.x) || !std::isfinite(s.y)) continue;
+    const float reach = s.radius + 0.5f;
+    if (s.x + reach < 0.0f || s.x - reach > static_cast<float>(width_)) continue;
+    const int top = std::max(0, static_cast<int>(std::floor(s.y - reach)));
+    const int bottom = std::min(height_ - 1, static_cast<int>(std::floor(s.y + reach)));
+    for (int b = top / kBandRows; b <= bottom / kBandRows && b < bands; ++b) {
+      inBand[static_cast<std::size_t>(b)].push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  tbb::parallel_for(0, bands, [&](int band) {
+    const int y0 = band * kBandRows, y1 = std::min(height_, y0 + kBandRows);
+    for (const std::uint32_t index : inBand[static_cast<std::size_t>(band)]) {
+      const Splat& s = splats[index];
+      const float reach = s.radius + 0.5f;
+      const int xa = std::max(0, static_cast<int>(std::floor(s.x - reach)));
+      const int xb = std::min(width_ - 1, static_cast<int>(std::floor(s.x + reach)));
+      const int ya = std::max(y0, static_cast<int>(std::floor(s.y - reach)));
+      const int yb = std::min(y1 - 1, static_cast<int>(std::floor(s.y + reach)));
+      for (int y = ya; y <= yb; ++y) {
+        const float dy = static_cast<float>(y) + 0.5f - s.y;
+        for (int x = xa; x <= xb; ++x) {
+          const float dx = static_cast<float>(x) + 0.5f - s.x;
+          const float a = cover(std::sqrt(dx * dx + dy * dy), s.radius);
+          if (a <= 0.0f) continue;
+          float* p = &rgb_[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                            static_cast<std::size_t>(x)) *
+                           3];
+          for (int c = 0; c < 3; ++c) p[c] = p[c] + (static_cast<float>(s.colour[c]) - p[c]) * a;
+        }
+      }
+    }
+  });
+}
+
+void SplatImage::set(int x, int y, Rgb colour) {
+  if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+  float* p = &rgb_[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                    static_cast<std::size_t>(x)) *
+                   3];
+  for (int c = 0; c < 3; ++c) p[c] = colour[c];
+}
+
+Rgb SplatImage::at(int x, int y) const {
+  const float* p = &rgb_[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                          static_cast<std::size_t>(x)) *
+                         3];
+  Rgb out{};
+  for (int c = 0; c < 3; ++c) {
+    out[c] = static_cast<std::uint8_t>(std::clamp(std::lround(p[c]), 0L, 255L));
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> SplatImage::png() const {
+  std::vector<std::uint8_t> rows(static_cast<std::size_t>(width_) * height_ * 3);
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      const Rgb c = at(x, y);
+      std::copy(c.begin(), c.end(),
+                rows.begin() + (static_cast<std::ptrdiff_t>(y) * width_ + x) * 3);
+    }
+  }
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr) {
+    png_destroy_write_struct(&png, &info);
+    throw std::runtime_error("libpng could not start a PNG");
+  }
+  std::vector<std::uint8_t> out;
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    throw std::runtime_error("libpng could not encode the image");
+  }
+  png_set_write_fn(
+      png, &out,
+      [](png_structp p, png_bytep data, png_size_t size) {
+        auto* bytes = static_cast<std::vector<std::uint8_t>*>(png_get_io_ptr(p));
+        bytes->insert(bytes->end(), data, data + size);
+      },
+      nullptr);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width_), static_cast<png_uint_32>(height_), 8,
+               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < height_; ++y) {
+    png_write_row(png, rows.data() + static_cast<std::size_t>(y) * width_ * 3);
+  }
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return out;
+}
+
+void SplatImage::writePng(const std::filesystem::path& path) const {
+  const std::vector<std::uint8_t> bytes = png();
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+}  // namespace tickfx::io
