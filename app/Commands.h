@@ -15,5 +15,6 @@ int checkCommand(Arguments& args);
 int studyCommand(Arguments& args);
 int determinismCommand(Arguments& args);
 int bakeFieldCommand(Arguments& args);
+int previewCommand(Arguments& args);
 
 }  // namespace tickfx::app

@@ -25,6 +25,7 @@ constexpr const char* kUsage =
     "                     compare the state after every tick\n"
     "  bake-field KIND --out FILE.vdb  bake an analytic vector field (uniform, vortex, shear,\n"
     "                     curl-noise) into an OpenVDB file, or a sequence of them\n"
+    "  preview EFFECT.toml  render an effect's frames to PNG\n"
     "\n"
     "`tickfx COMMAND --help` describes a command. Exit codes: 0 ok, 2 usage or effect errors,\n"
     "1 failure at run time.\n";
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
     if (command == "study") return studyCommand(args);
     if (command == "determinism") return determinismCommand(args);
     if (command == "bake-field") return bakeFieldCommand(args);
+    if (command == "preview") return previewCommand(args);
     std::fprintf(stderr, "tickfx: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return kExitUsage;
   } catch (const UsageError& e) {

@@ -21,7 +21,7 @@ TICKFX_PACKAGES=(
 TICKFX_AARCH64_PACKAGES=(
   g++-aarch64-linux-gnu qemu-user
   libtbb-dev:arm64 libtomlplusplus-dev:arm64 libblosc-dev:arm64 libimath-dev:arm64
-  libboost-iostreams-dev:arm64 zlib1g-dev:arm64 libopenvdb10.0:arm64
+  libboost-iostreams-dev:arm64 zlib1g-dev:arm64 libopenvdb10.0:arm64 libpng-dev:arm64
 )
 
 # The architectures named by PKG:ARCH arguments that dpkg does not know yet, one a line.

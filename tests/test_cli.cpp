@@ -635,6 +635,60 @@ TEST_F(Cli, StudyPlotsSayWhatToInstallWithoutPythonOrMatplotlib) {
   EXPECT_FALSE(fs::exists(path("plots/constant_acceleration.png")));
 }
 
+TEST_F(Cli, PreviewRendersTheFramesAskedForAsPngs) {
+  const std::string args =
+      "preview samples/fountain.toml --frames 30..40 --every 5 --size 320x180 --out ";
+  const Result r = run(args + path("a"));
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(r.out, "samples/fountain.toml: 3 frames rendered to " + path("a") +
+                       " (320x180), frames 30..40 every 5\n");
+  for (const char* name : {"frame_0030.png", "frame_0035.png", "frame_0040.png"}) {
+    const auto size = pngSize(readAll(path(std::string("a/") + name)));
+    EXPECT_EQ(size, (std::pair<std::uint32_t, std::uint32_t>{320, 180})) << name;
+  }
+  EXPECT_FALSE(fs::exists(path("a/frame_0031.png")));
+  EXPECT_FALSE(fs::exists(path("a/frame_0045.png")));
+  EXPECT_EQ(std::distance(fs::directory_iterator(path("a")), fs::directory_iterator{}), 3);
+  // The same bytes from another run, and a frame rendered alone is the frame of the sequence.
+  ASSERT_EQ(run(args + path("b")).exit, 0);
+  ASSERT_EQ(
+      run("preview samples/fountain.toml --frames 35..35 --size 320x180 --out " + path("c")).exit,
+      0);
+  const std::string frame = readAll(path("a/frame_0035.png"));
+  EXPECT_EQ(readAll(path("b/frame_0035.png")), frame);
+  // The camera frames the whole run, whatever frames are drawn: the same picture.
+  EXPECT_EQ(readAll(path("c/frame_0035.png")), frame);
+  // Particles are drawn: a frame of the risen fountain is not the empty background.
+  EXPECT_GT(frame.size(), readAll(path("a/frame_0030.png")).size() / 4);
+}
+
+TEST_F(Cli, PreviewRefusesBadInputWithNothingWritten) {
+  const std::string fountain = "preview samples/fountain.toml --out " + path("never") + " ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {fountain + "--color bogus",
+       "tickfx preview: --color: 'bogus' (expected speed, age or id)\n"},
+      {fountain + "--size 0x720",
+       "tickfx preview: --size: '0x720' is not WxH with whole numbers from 1 to 16384\n"},
+      {fountain + "--size 1000000x720",
+       "tickfx preview: --size: '1000000x720' is not WxH with whole numbers from 1 to 16384\n"},
+      {fountain + "--frames 0..3",
+       "tickfx preview: --frames: '0..3' is not a range A..B of this effect's frames (1..120)\n"},
+      {fountain + "--every 0",
+       "tickfx preview: --every: '0' is not a whole number in [1, 1000000]\n"},
+  };
+  for (const auto& [args, message] : cases) {
+    const Result r = run(args);
+    EXPECT_EQ(r.exit, 2) << args;
+    EXPECT_EQ(r.err, message) << args;
+    EXPECT_FALSE(fs::exists(path("never"))) << args;
+  }
+  // An output folder that cannot be made: a file stands where it would go.
+  { std::ofstream(path("file")) << "x"; }
+  const Result r = run("preview samples/fountain.toml --out " + path("file/sub"));
+  EXPECT_EQ(r.exit, 2);
+  EXPECT_EQ(r.err, path("file/sub") + ": error: cannot make the output folder (Not a directory)\n");
+}
+
 // Bad effect files through the command line: exit code 2, the first message exactly (file, line,
 // column, key path, what is wrong and what is expected), and no output folder created. The io
 // tests check every message of these and more cases through the library.
