@@ -12,6 +12,7 @@
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
 #include "io/FrameTimes.h"
+#include "io/cache/FrameCaches.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLoader.h"
 #include "io/preview/ColourMap.h"
@@ -119,10 +120,9 @@ struct RunExtent {
   bool empty() const { return !(lo.x() <= hi.x()); }
 };
 
+// Named as the caches of `tickfx run` are: frame_0001.png beside frame_0001.csv.
 std::filesystem::path framePath(const std::filesystem::path& dir, std::int64_t frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%04" PRId64 ".png", frame);
-  return dir / name;
+  return io::cacheFilePath(dir, frame, "png");
 }
 
 }  // namespace

@@ -93,6 +93,32 @@ inline EmitterSettings referenceEmitter() {
   return e;
 }
 
+/// A crowd that keeps the scheduling busy: 20 000 particles at once (several blocks of rows and
+/// many tiles), 3001 a second after (new rows every tick, starting mid-tile), dying from 0.2 to
+/// 0.6 s after birth (deaths every tick once the first expire).
+inline EmitterSettings crowdEmitter() {
+  EmitterSettings e;
+  e.shape = SphereShape{0.5, false};
+  e.bursts = {{0.0, 20000}};
+  e.rate = 3001.0;
+  e.speed = 3.0;
+  e.spreadDegrees = 40.0;
+  e.lifetime = 0.4;
+  e.lifetimeJitter = 0.5;
+  return e;
+}
+
+/// Gravity then a periodic wind of 4 m/s² at 3 Hz: the uniform modules of the scheduling tests.
+inline ForceSet gravityAndWind() {
+  ForceSet forces;
+  forces.add(std::make_unique<Gravity>());
+  PeriodicWind::Settings wind;
+  wind.amplitude = 4.0f;
+  wind.frequency = 3.0;
+  forces.add(std::make_unique<PeriodicWind>(wind));
+  return forces;
+}
+
 inline ForceSet referenceForces() {
   ForceSet f;
   f.add(std::make_unique<Gravity>(Eigen::Vector3f(0.0f, -9.81f, 0.0f)));

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "CoreTestSupport.h"
 #include "fields/AnalyticField.h"
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
@@ -27,25 +28,17 @@ constexpr std::int64_t kRate = 60;
 // A frame of `ticks` ticks at kRate.
 Flicks frameOf(std::int64_t ticks) { return ticks * (kFlicksPerSecond / kRate); }
 
+// The scheduling tests' crowd, with a burst in the middle of a frame and shorter lives (deaths
+// inside frames from the first ones on).
 EmitterSettings busyEmitter() {
-  EmitterSettings e;
-  e.shape = SphereShape{0.5, false};
-  e.bursts = {{0.0, 20000}, {0.3, 9000}};  // several blocks; a burst in the middle of a frame
-  e.rate = 3001.0;                         // births every tick, starting mid-block
-  e.speed = 3.0;
-  e.spreadDegrees = 40.0;
-  e.lifetime = 0.2;  // deaths every tick once the first ones expire, inside frames
-  e.lifetimeJitter = 0.5;
+  EmitterSettings e = test::crowdEmitter();
+  e.bursts.push_back({0.3, 9000});
+  e.lifetime = 0.2;
   return e;
 }
 
 ForceSet localForces() {
-  ForceSet forces;
-  forces.add(std::make_unique<Gravity>());
-  PeriodicWind::Settings wind;
-  wind.amplitude = 4.0f;
-  wind.frequency = 3.0;
-  forces.add(std::make_unique<PeriodicWind>(wind));
+  ForceSet forces = test::gravityAndWind();
   forces.add(std::make_unique<LinearDrag>(0.3f, Eigen::Vector3f(1.0f, 0.0f, 0.0f)));
   forces.add(std::make_unique<AnchorSpring>(Eigen::Vector3f(0.0f, 2.0f, 0.0f), 2.0f, 0.1f));
   return forces;

@@ -5,6 +5,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "CoreTestSupport.h"
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
@@ -30,29 +31,16 @@ std::uint64_t runHash(const std::string& integrator, int threads, bool split) {
   settings.integrator = integrator;
   settings.seed = 99;
   settings.threads = threads;
-  EmitterSettings e;
-  e.shape = SphereShape{0.5, false};
-  e.bursts = {{0.0, 20000}};  // several blocks of rows and many tiles
-  e.rate = 3001.0;            // new rows every tick, starting mid-tile
-  e.speed = 3.0;
-  e.spreadDegrees = 40.0;
-  e.lifetime = 0.4;  // deaths every tick once the first ones expire
-  e.lifetimeJitter = 0.5;
-  ForceSet forces;
-  forces.add(std::make_unique<Gravity>());
-  PeriodicWind::Settings wind;
-  wind.amplitude = 4.0f;
-  wind.frequency = 3.0;
-  forces.add(std::make_unique<PeriodicWind>(wind));
+  ForceSet forces = test::gravityAndWind();
   forces.add(std::make_unique<LinearDrag>(0.3f, Eigen::Vector3f(1.0f, 0.0f, 0.0f)));
   forces.add(std::make_unique<AnchorSpring>(Eigen::Vector3f(0.0f, 2.0f, 0.0f), 2.0f, 0.1f));
   if (split) forces.add(std::make_unique<NonLocalNothing>());
-  ParticleSystem system(settings, {e}, std::move(forces));
+  ParticleSystem system(settings, {test::crowdEmitter()}, std::move(forces));
   system.stepTicks(30);
   return stateHash(system.pool());
 }
 
-// Gravity, wind and one drag, or gravity alone: what semi-implicit Euler forms in its update loop
+// Gravity and wind, with or without a drag: what semi-implicit Euler forms in its update loop
 // (ForceSet::uniformAndDrag). With a module that adds nothing but claims to read other rows, the
 // same forces take the force pass and the split passes instead.
 std::uint64_t uniformAndDragHash(int threads, bool drag, bool generic) {
@@ -60,23 +48,10 @@ std::uint64_t uniformAndDragHash(int threads, bool drag, bool generic) {
   settings.stepRateHz = 60;
   settings.seed = 17;
   settings.threads = threads;
-  EmitterSettings e;
-  e.shape = SphereShape{0.5, false};
-  e.bursts = {{0.0, 20000}};
-  e.rate = 3001.0;
-  e.speed = 3.0;
-  e.spreadDegrees = 40.0;
-  e.lifetime = 0.4;
-  e.lifetimeJitter = 0.5;
-  ForceSet forces;
-  forces.add(std::make_unique<Gravity>());
-  PeriodicWind::Settings wind;
-  wind.amplitude = 4.0f;
-  wind.frequency = 3.0;
-  forces.add(std::make_unique<PeriodicWind>(wind));
+  ForceSet forces = test::gravityAndWind();
   if (drag) forces.add(std::make_unique<LinearDrag>(0.3f, Eigen::Vector3f(1.0f, -0.5f, 0.0f)));
   if (generic) forces.add(std::make_unique<NonLocalNothing>());
-  ParticleSystem system(settings, {e}, std::move(forces));
+  ParticleSystem system(settings, {test::crowdEmitter()}, std::move(forces));
   for (int tick = 0; tick < 40; ++tick) system.step();
   return stateHash(system.pool());
 }
