@@ -17,6 +17,7 @@
 #include "io/effect/EffectLoader.h"
 #include "io/preview/ColourMap.h"
 #include "io/preview/PinholeCamera.h"
+#include "io/preview/PixelFont.h"
 #include "io/preview/SplatImage.h"
 
 namespace tickfx::app {
@@ -24,7 +25,8 @@ namespace {
 
 const char* const kPreviewHelp =
     "usage: tickfx preview EFFECT.toml [--out DIR] [--size WxH] [--frames A..B] [--every N]\n"
-    "                      [--color speed|age|id] [--point-size PIXELS] [--set KEY=VALUE]...\n"
+    "                      [--color speed|age|id] [--point-size PIXELS] [--sheet]\n"
+    "                      [--set KEY=VALUE]...\n"
     "\n"
     "Runs the effect over its [output] length and frame rate and renders frames to PNG\n"
     "(DIR/frame_0001.png, ...; default out/preview), each written whole or not at all. The camera\n"
@@ -36,6 +38,10 @@ const char* const kPreviewHelp =
     "  --frames A..B      only frames A to B (1-based; default all)\n"
     "  --every N          every Nth frame from A (default 1)\n"
     "  --point-size P     splat diameter in pixels (default 3)\n"
+    "  --sheet            also DIR/sheet.png: the frames rendered (at most 64, evenly picked) in "
+    "a\n"
+    "                     grid of cells a quarter the size, each labelled with its frame\n"
+    "Each frame has the effect's name, the frame, its time and the particle count in a corner.\n"
     "Exit codes: 0 ok, 2 bad arguments or effect (nothing written), 1 failure at run time.\n";
 
 struct Size {
@@ -120,6 +126,17 @@ struct RunExtent {
   bool empty() const { return !(lo.x() <= hi.x()); }
 };
 
+constexpr io::Rgb kBackground{24, 24, 28};
+constexpr std::int64_t kSheetCells = 64;
+
+// Burns `text` into the image's top-left corner, light on a dark box.
+void burnLabel(io::SplatImage& image, const std::string& text, int scale) {
+  const int pad = 2 * scale;
+  io::fillRect(image, 0, 0, io::textWidth(text, scale) + 2 * pad,
+               io::kGlyphHeight * scale + 2 * pad, {0, 0, 0});
+  io::drawText(image, pad, pad, text, {235, 235, 235}, scale);
+}
+
 // Named as the caches of `tickfx run` are: frame_0001.png beside frame_0001.csv.
 std::filesystem::path framePath(const std::filesystem::path& dir, std::int64_t frame) {
   return io::cacheFilePath(dir, frame, "png");
@@ -141,6 +158,7 @@ int previewCommand(Arguments& args) {
       parseInteger(args.value("--every").value_or("1"), "preview: --every", 1, 1'000'000);
   const long long pointSize =
       parseInteger(args.value("--point-size").value_or("3"), "preview: --point-size", 1, 100);
+  const bool wantSheet = args.flag("--sheet");
   const std::string effectPath =
       args.positionals(1, "one effect file: tickfx preview EFFECT.toml")[0];
 
@@ -207,6 +225,41 @@ int previewCommand(Arguments& args) {
 
   // Second pass: the same ticks again (the state at a frame is a pure function of the effect),
   // rendering the frames asked for.
+  const std::string name = std::filesystem::path(effectPath).stem().string();
+  const auto render = [&](const io::PinholeCamera& view, const FrameState& state, float radius) {
+    std::vector<io::Splat> splats;
+    splats.reserve(state.values.size());
+    for (std::size_t i = 0; i < state.values.size(); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      const auto q = view.project(
+          Eigen::Vector3d(state.positions.x[r], state.positions.y[r], state.positions.z[r]));
+      if (!q) continue;
+      splats.push_back({static_cast<float>(q->x), static_cast<float>(q->y),
+                        static_cast<float>(q->depth), radius,
+                        io::viridis((state.values[i] - extent.valueLo) / span)});
+    }
+    io::SplatImage image(view.width(), view.height(), kBackground);
+    image.draw(std::move(splats));
+    return image;
+  };
+  // The sheet: every rendered frame (every sheetStride-th past 64), in cells a quarter the size.
+  const std::int64_t rendered = (last - first) / every + 1;
+  const std::int64_t sheetStride = (rendered + kSheetCells - 1) / kSheetCells;
+  const std::int64_t cells = (rendered + sheetStride - 1) / sheetStride;
+  const int cellWidth = std::max(1, size.width / 4), cellHeight = std::max(1, size.height / 4);
+  const int columns = static_cast<int>(std::min<std::int64_t>(4, cells));
+  const int rows = static_cast<int>((cells + columns - 1) / columns);
+  std::optional<io::SplatImage> sheet;
+  std::optional<io::PinholeCamera> cellCamera;
+  if (wantSheet) {
+    if (static_cast<std::int64_t>(rows) * cellHeight > io::SplatImage::kMaxSide) {
+      throw UsageError("preview: --sheet: " + std::to_string(cells) +
+                       " frames make a sheet too tall (use a smaller --size or a larger --every)");
+    }
+    sheet.emplace(columns * cellWidth, rows * cellHeight, kBackground);
+    cellCamera.emplace(io::PinholeCamera::framing(extent.lo, extent.hi, Eigen::Vector3d::UnitY(),
+                                                  40.0, cellWidth, cellHeight));
+  }
   system = io::buildOfflineSystem(effect, std::nullopt);
   io::FrameSchedule schedule = io::FrameSchedule::fixedRate(effect.output.fps, length);
   ProgressLine progress("frames");
@@ -217,30 +270,38 @@ int previewCommand(Arguments& args) {
     if (f > last) break;
     if (f < first || (f - first) % every != 0) continue;
     const FrameState state = capture(*system, colouring);
-    std::vector<io::Splat> splats;
-    splats.reserve(state.values.size());
-    for (std::size_t i = 0; i < state.values.size(); ++i) {
-      const auto r = static_cast<Eigen::Index>(i);
-      const auto q = camera.project(
-          Eigen::Vector3d(state.positions.x[r], state.positions.y[r], state.positions.z[r]));
-      if (!q) continue;
-      splats.push_back({static_cast<float>(q->x), static_cast<float>(q->y),
-                        static_cast<float>(q->depth), 0.5f * static_cast<float>(pointSize),
-                        io::viridis((state.values[i] - extent.valueLo) / span)});
-    }
-    io::SplatImage image(size.width, size.height, {24, 24, 28});
-    image.draw(std::move(splats));
+    io::SplatImage image = render(camera, state, 0.5f * static_cast<float>(pointSize));
+    char label[160];
+    std::snprintf(label, sizeof label, "%s  frame %" PRId64 "  t = %.3f s  %zu particles",
+                  name.c_str(), f, system->shownSeconds(), state.values.size());
+    burnLabel(image, label, size.width >= 640 ? 2 : 1);
     image.writePng(framePath(out, f));
+    const std::int64_t index = (f - first) / every;
+    if (sheet && index % sheetStride == 0) {
+      const std::int64_t cell = index / sheetStride;
+      io::SplatImage small = render(*cellCamera, state, 0.5f * static_cast<float>(pointSize));
+      burnLabel(small, "frame " + std::to_string(f), 1);
+      const int x0 = static_cast<int>(cell % columns) * cellWidth;
+      const int y0 = static_cast<int>(cell / columns) * cellHeight;
+      for (int y = 0; y < cellHeight; ++y) {
+        for (int x = 0; x < cellWidth; ++x) sheet->set(x0 + x, y0 + y, small.at(x, y));
+      }
+    }
     ++written;
     progress.update(f - first + 1, last - first + 1,
                     static_cast<double>(f - first + 1) / static_cast<double>(last - first + 1),
                     framePath(out, f).string());
   }
+  if (sheet) sheet->writePng(out / "sheet.png");
   progress.finish();
   std::printf("%s: %" PRId64 " frames rendered to %s (%dx%d), frames %" PRId64 "..%" PRId64
               " every %lld\n",
               effectPath.c_str(), written, out.string().c_str(), size.width, size.height, first,
               last, every);
+  if (sheet) {
+    std::printf("sheet: %s (%" PRId64 " frames, %dx%d cells)\n", (out / "sheet.png").c_str(), cells,
+                cellWidth, cellHeight);
+  }
   return kExitOk;
 }
 

@@ -660,6 +660,15 @@ TEST_F(Cli, PreviewRendersTheFramesAskedForAsPngs) {
   EXPECT_EQ(readAll(path("c/frame_0035.png")), frame);
   // Particles are drawn: a frame of the risen fountain is not the empty background.
   EXPECT_GT(frame.size(), readAll(path("a/frame_0030.png")).size() / 4);
+  // A sheet of the three frames: one row of cells a quarter the size.
+  const Result sheet = run(args + path("s") + " --sheet");
+  ASSERT_EQ(sheet.exit, 0) << sheet.err;
+  EXPECT_EQ(pngSize(readAll(path("s/sheet.png"))),
+            (std::pair<std::uint32_t, std::uint32_t>{3 * 80, 45}));
+  EXPECT_NE(sheet.out.find("sheet: " + path("s/sheet.png") + " (3 frames, 80x45 cells)\n"),
+            std::string::npos)
+      << sheet.out;
+  EXPECT_EQ(readAll(path("s/frame_0035.png")), frame);  // the frames are as without a sheet
 }
 
 TEST_F(Cli, PreviewRefusesBadInputWithNothingWritten) {

@@ -10,6 +10,7 @@
 
 #include "io/preview/ColourMap.h"
 #include "io/preview/PinholeCamera.h"
+#include "io/preview/PixelFont.h"
 #include "io/preview/SplatImage.h"
 
 namespace tickfx::io {
@@ -172,6 +173,49 @@ TEST(SplatImage, RefusesImagesOfNoOrTooManyPixels) {
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(), "an image of 0x720 pixels (expected 1 to 16384 a side)");
   }
+}
+
+// The pixels an image holds of `colour`, as "x,y" in row order.
+std::vector<std::pair<int, int>> inked(const SplatImage& image, Rgb colour) {
+  std::vector<std::pair<int, int>> out;
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      if (image.at(x, y) == colour) out.emplace_back(x, y);
+    }
+  }
+  return out;
+}
+
+TEST(PixelFont, DrawsEachGlyphsPixelsAtItsScale) {
+  const Rgb white{255, 255, 255};
+  SplatImage one(12, 8, kBlack);
+  drawText(one, 0, 0, "1", white, 1);
+  // "1": the stem down the middle, a flag to its left, a foot three wide.
+  const std::vector<std::pair<int, int>> expected = {{2, 0}, {1, 1}, {2, 1}, {2, 2}, {2, 3},
+                                                     {2, 4}, {2, 5}, {1, 6}, {2, 6}, {3, 6}};
+  EXPECT_EQ(inked(one, white), expected);
+  // Scale 2: each font pixel a 2 × 2 square, the glyph's top pixel at (4..5, 0..1).
+  SplatImage two(24, 16, kBlack);
+  drawText(two, 0, 0, "1", white, 2);
+  EXPECT_EQ(inked(two, white).size(), 4 * expected.size());
+  EXPECT_EQ(two.at(4, 0), white);
+  EXPECT_EQ(two.at(5, 1), white);
+  EXPECT_EQ(two.at(3, 0), kBlack);
+  // Upper case as lower case, anything unknown as '?', pixels past the edge skipped.
+  SplatImage upper(40, 8, kBlack), lower(40, 8, kBlack), unknown(6, 8, kBlack),
+      question(6, 8, kBlack);
+  drawText(upper, 0, 0, "FRAME", white, 1);
+  drawText(lower, 0, 0, "frame", white, 1);
+  EXPECT_EQ(inked(upper, white), inked(lower, white));
+  drawText(unknown, 0, 0, "~", white, 1);
+  drawText(question, 0, 0, "?", white, 1);
+  EXPECT_EQ(inked(unknown, white), inked(question, white));
+  EXPECT_FALSE(inked(question, white).empty());
+  SplatImage edge(3, 3, kBlack);
+  drawText(edge, -2, -2, "88", white, 1);  // partly outside: no crash, some ink
+  EXPECT_FALSE(inked(edge, white).empty());
+  EXPECT_EQ(textWidth("abc", 2), 34);
+  EXPECT_EQ(textWidth("", 2), 0);
 }
 
 TEST(Viridis, RunsFromDarkPurpleToYellow) {
