@@ -66,6 +66,34 @@ long long parseInteger(const std::string& text, const std::string& option, long 
   return value;
 }
 
+std::pair<long long, long long> parseRange(const std::string& text, long long min, long long max,
+                                           const UsageError& refusal) {
+  const std::size_t dots = text.find("..");
+  if (dots == std::string::npos) throw refusal;
+  try {
+    const long long a = parseInteger(text.substr(0, dots), "", min, max);
+    return {a, parseInteger(text.substr(dots + 2), "", a, max)};
+  } catch (const UsageError&) {
+    throw refusal;
+  }
+}
+
+std::array<double, 3> parseTriple(const std::string& text, const UsageError& refusal) {
+  std::array<double, 3> v{};
+  std::size_t start = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::size_t comma = k < 2 ? text.find(',', start) : text.size();
+    if (comma == std::string::npos) throw refusal;
+    try {
+      v[k] = parseNumber(text.substr(start, comma - start), "", -1e9, 1e9);
+    } catch (const UsageError&) {
+      throw refusal;
+    }
+    start = comma + 1;
+  }
+  return v;
+}
+
 double parseNumber(const std::string& text, const std::string& option, double min, double max) {
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);

@@ -1,9 +1,11 @@
 // A small, strict command-line reader: every argument must be consumed, or it is an error.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tickfx::app {
@@ -42,6 +44,12 @@ long long parseInteger(const std::string& text, const std::string& option, long 
                        long long max);
 /// Parses a finite number in [min, max]; UsageError naming `option` otherwise.
 double parseNumber(const std::string& text, const std::string& option, double min, double max);
+
+/// Parses "A..B", whole numbers with min <= A <= B <= max; throws `refusal` otherwise.
+std::pair<long long, long long> parseRange(const std::string& text, long long min, long long max,
+                                           const UsageError& refusal);
+/// Parses "x,y,z", three finite numbers; throws `refusal` otherwise.
+std::array<double, 3> parseTriple(const std::string& text, const UsageError& refusal);
 
 /// "a, b or c" with `last` = " or ": the words of a usage message's list of choices.
 std::string joinWords(const std::vector<std::string>& words, const std::string& last);

@@ -123,16 +123,7 @@ std::pair<int, int> parseFrames(const std::string& text) {
   const std::string expected = "bake-field: --frames: '" + text +
                                "' is not a frame range A..B (whole numbers from -1000000 to "
                                "1000000, A <= B)";
-  const std::size_t dots = text.find("..");
-  if (dots == std::string::npos) throw UsageError(expected);
-  long long a = 0, b = 0;
-  try {
-    a = parseInteger(text.substr(0, dots), "--frames", -kMaxFrame, kMaxFrame);
-    b = parseInteger(text.substr(dots + 2), "--frames", -kMaxFrame, kMaxFrame);
-  } catch (const UsageError&) {
-    throw UsageError(expected);
-  }
-  if (b < a) throw UsageError(expected);
+  const auto [a, b] = parseRange(text, -kMaxFrame, kMaxFrame, UsageError(expected));
   if (b - a + 1 > kMaxFrames) {
     throw UsageError("bake-field: --frames: " + std::to_string(b - a + 1) +
                      " frames are too many (expected at most 10000)");

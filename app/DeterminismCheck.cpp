@@ -6,6 +6,7 @@
 
 #include "io/FrameTimes.h"
 #include "io/effect/EffectBuilder.h"
+#include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {
@@ -66,6 +67,32 @@ DriveTrace traceDrive(const io::EffectSettings& effect, const DriveCase& drive,
   trace.wallSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return trace;
+}
+
+io::FrameData stateAfterTick(const io::EffectSettings& effect, const DriveCase& drive,
+                             std::int64_t tick) {
+  const auto system = io::buildOfflineSystem(effect, drive.threads);
+  io::FrameData state;
+  bool reached = false;
+  system->setTickObserver([&](const ParticleSystem& s) {
+    if (s.tickCount() != tick) return;
+    const ParticlePool& pool = s.pool();
+    const auto n = static_cast<Eigen::Index>(pool.size());
+    state.resize(pool.size(), {});
+    state.timeSeconds = s.timeSeconds();
+    state.id.assign(pool.id().begin(), pool.id().begin() + n);
+    for (int c = 0; c < 3; ++c) {
+      state.position[c] = pool.position()[c].head(n);
+      state.velocity[c] = pool.velocity()[c].head(n);
+    }
+    state.age = pool.age().head(n);
+    state.life = pool.lifetime().head(n);
+    state.mass = pool.mass().head(n);
+    reached = true;
+  });
+  for (std::size_t f = 0; f < drive.frames.size() && !reached; ++f)
+    system->advance(drive.frames[f]);
+  return state;
 }
 
 Divergence firstDivergence(const std::vector<DriveTrace>& traces) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "io/cache/FrameData.h"
 #include "io/effect/EffectSettings.h"
 #include "particles/Clock.h"
 
@@ -41,6 +42,12 @@ struct DriveTrace {
 /// after each tick in `onlyTicks` when it is not empty.
 DriveTrace traceDrive(const io::EffectSettings& effect, const DriveCase& drive,
                       const std::vector<std::int64_t>& onlyTicks = {});
+
+/// The state right after tick `tick` of `effect` driven by `drive`: the pool's own columns (not a
+/// frame's interpolation), rows in id order, timeSeconds the tick's time. Empty when the drive
+/// ends before that tick.
+io::FrameData stateAfterTick(const io::EffectSettings& effect, const DriveCase& drive,
+                             std::int64_t tick);
 
 /// Where a set of traces over the same ticks first disagree.
 struct Divergence {

@@ -5,10 +5,13 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "app/Commands.h"
 #include "app/DeterminismCheck.h"
+#include "app/DifferenceImage.h"
 #include "app/HashLogRun.h"
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
@@ -22,7 +25,7 @@ namespace {
 
 constexpr const char* kDeterminismHelp =
     "usage: tickfx determinism EFFECT.toml [--seconds S] [--threads LIST] [--frame-times FILE]\n"
-    "                          [--set key.path=value]...\n"
+    "                          [--diff-image OUT.png] [--set key.path=value]...\n"
     "\n"
     "Runs EFFECT.toml for S seconds (default 5) driven by 24, 25, 30, 30000/1001, 60 and 144 fps,\n"
     "three seeded jitter sequences and a sequence of recorded frame times (FILE, or a built-in\n"
@@ -31,6 +34,9 @@ constexpr const char* kDeterminismHelp =
     "tick\n"
     "and prints the hashes at 1 s, 2 s and S. Exit code 0 when every run agrees at every tick,\n"
     "1 otherwise (naming the first tick where they part), 2 for usage or effect errors.\n"
+    "--diff-image OUT.png, when runs part, renders the state after that tick of the first run\n"
+    "(1280x720 PNG), each particle coloured by the distance to its position (by id) in the first\n"
+    "run that differs, both named in the image; nothing is written when every run agrees.\n"
     "\n"
     "usage: tickfx determinism EFFECT.toml --record FILE [--seconds S] [--fps F]\n"
     "                          [--snapshot-at TICKS] [--set key.path=value]...\n"
@@ -192,7 +198,7 @@ int logCommand(Arguments& args, const std::vector<std::string>& overrides,
                const std::optional<std::string>& record,
                const std::optional<std::string>& compare) {
   if (record && compare) throw UsageError("determinism: give --record or --compare, not both");
-  for (const char* option : {"--threads", "--frame-times"}) {
+  for (const char* option : {"--threads", "--frame-times", "--diff-image"}) {
     if (args.value(option)) {
       throw UsageError(std::string("determinism: ") + option +
                        " does not go with --record or --compare");
@@ -257,8 +263,17 @@ int determinismCommand(Arguments& args) {
       parseNumber(args.value("--seconds").value_or("5"), "determinism: --seconds", 0.001, 3600.0);
   const std::vector<int> threads = parseThreadList(args.value("--threads").value_or("1,2,3,8"));
   const auto frameTimes = args.value("--frame-times");
+  const std::optional<std::filesystem::path> diffImage = args.value("--diff-image");
   const std::string path =
       args.positionals(1, "one effect file: tickfx determinism EFFECT.toml")[0];
+  if (diffImage) {
+    try {
+      io::requireWritable(*diffImage);
+    } catch (const io::WriteError& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      return kExitUsage;
+    }
+  }
 
   const io::LoadResult load = io::loadEffectFile(path, overrides);
   for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
@@ -313,6 +328,7 @@ int determinismCommand(Arguments& args) {
         " ticks (state-hash %s)\n",
         traces.size(), lastTick,
         traces.front().hashes.empty() ? "-" : hashToHex(traces.front().hashes.back()).c_str());
+    if (diffImage) std::printf("no difference image: the runs agree\n");
     return kExitOk;
   }
   std::printf("verdict: runs part at tick %" PRId64 " (t = %.6g s):", d.tick,
@@ -324,6 +340,21 @@ int determinismCommand(Arguments& args) {
   std::printf(
       "rerun two of them with `tickfx run ... --trace FILE` and compare the files to see the state "
       "there\n");
+  if (diffImage) {
+    const std::size_t other = d.runs.front();
+    const auto name = [&](std::size_t r) {
+      return "'" + drives[r].label + ", " + std::to_string(drives[r].threads) + " thread(s)'";
+    };
+    const io::FrameData a = stateAfterTick(effect, drives.front(), d.tick);
+    const io::FrameData b = stateAfterTick(effect, drives[other], d.tick);
+    DifferenceSummary summary;
+    renderDifference(a, b, name(0), name(other), d.tick, 1280, 720, &summary).writePng(*diffImage);
+    std::printf("difference image: %s (tick %" PRId64
+                ", %s against %s: %zu particles differ, by "
+                "up to %.6g m)\n",
+                diffImage->c_str(), d.tick, name(0).c_str(), name(other).c_str(), summary.differing,
+                summary.largest);
+  }
   return kExitFailure;
 }
 

@@ -1,48 +1,73 @@
-// tickfx preview: an effect's frames rendered to PNG, without a DCC.
+// tickfx preview: an effect's frames, or a folder of caches, rendered to PNG without a DCC.
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "app/Commands.h"
+#include "app/PreviewSource.h"
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
-#include "io/FrameTimes.h"
 #include "io/cache/FrameCaches.h"
-#include "io/effect/EffectBuilder.h"
-#include "io/effect/EffectLoader.h"
-#include "io/preview/ColourMap.h"
+#include "io/preview/ColourBy.h"
+#include "io/preview/FfmpegMovie.h"
+#include "io/preview/FrameRenderer.h"
+#include "io/preview/GifFlipbook.h"
 #include "io/preview/PinholeCamera.h"
-#include "io/preview/PixelFont.h"
-#include "io/preview/SplatImage.h"
+#include "io/preview/SceneGuides.h"
 
 namespace tickfx::app {
 namespace {
 
 const char* const kPreviewHelp =
-    "usage: tickfx preview EFFECT.toml [--out DIR] [--size WxH] [--frames A..B] [--every N]\n"
-    "                      [--color speed|age|id] [--point-size PIXELS] [--sheet]\n"
-    "                      [--set KEY=VALUE]...\n"
+    "usage: tickfx preview EFFECT.toml|CACHE_DIR [--out DIR] [--size WxH] [--frames A..B]\n"
+    "                      [--every N] [--color speed|age|nage|id|ATTRIBUTE|Cd]\n"
+    "                      [--point-size PIXELS | --radius METRES] [--camera X,Y,Z]\n"
+    "                      [--lookat X,Y,Z] [--fov DEGREES] [--up y|z] [--no-guides]\n"
+    "                      [--sheet] [--gif] [--mp4] [--set KEY=VALUE]...\n"
     "\n"
-    "Runs the effect over its [output] length and frame rate and renders frames to PNG\n"
-    "(DIR/frame_0001.png, ...; default out/preview), each written whole or not at all. The camera\n"
-    "looks at the particles' bounds over the whole run, from in front, above and to the right,\n"
-    "with 10 % to spare, so every particle of every frame is in the picture and the camera holds\n"
-    "still. Particles are round splats, nearer over farther, coloured through viridis by speed\n"
-    "(m/s, the default), age (s) or id, over the range of the whole run.\n"
+    "Renders frames to PNG (DIR/frame_0001.png, ...; default out/preview), each written whole or\n"
+    "not at all: an effect run over its [output] length and frame rate, or the caches of a folder\n"
+    "(frame_N.vdb, .ply or .csv, as tickfx run writes them). Unless --camera is given, the camera\n"
+    "looks at the particles' bounds over the whole run from in front, above and to the right, "
+    "with\n"
+    "10 % of their size to spare on every side, so every particle of every frame is in the "
+    "picture\n"
+    "and the camera holds still. Particles are round splats, nearer over farther, coloured "
+    "through\n"
+    "viridis over the whole run's range (shown in a legend) or by their own Cd. A ground grid of\n"
+    "1 m squares (coarser for effects wider than 100 m) and 1 m axis marks (x red, y green, z\n"
+    "blue) show scale and up; a structure's springs are drawn as lines.\n"
     "  --size WxH         pixels (default 1280x720; 1 to 16384 a side)\n"
-    "  --frames A..B      only frames A to B (1-based; default all)\n"
+    "  --frames A..B      only frames A to B (default all)\n"
     "  --every N          every Nth frame from A (default 1)\n"
+    "  --color C          speed (m/s, the default), age (s), nage (age / life), id, life, mass,\n"
+    "                     a custom attribute of the caches, or Cd (their own colours)\n"
     "  --point-size P     splat diameter in pixels (default 3)\n"
+    "  --radius R         splat radius in metres instead; a frame with pscale uses pscale\n"
+    "  --camera X,Y,Z     the camera's position (metres), looking at the bounds' centre or at\n"
+    "  --lookat X,Y,Z     this point\n"
+    "  --fov DEGREES      vertical field of view (default 40)\n"
+    "  --up y|z           the world's up axis (default y)\n"
+    "  --no-guides        no grid, axis marks or legend\n"
     "  --sheet            also DIR/sheet.png: the frames rendered (at most 64, evenly picked) in "
     "a\n"
     "                     grid of cells a quarter the size, each labelled with its frame\n"
-    "Each frame has the effect's name, the frame, its time and the particle count in a corner.\n"
-    "Exit codes: 0 ok, 2 bad arguments or effect (nothing written), 1 failure at run time.\n";
+    "  --gif              also DIR/flipbook.gif: the frames rendered, looping\n"
+    "  --mp4              also DIR/flipbook.mp4, through ffmpeg ($TICKFX_FFMPEG or ffmpeg on "
+    "PATH;\n"
+    "                     Debian: apt-get install ffmpeg)\n"
+    "Each frame has the name, the frame, its time and the particle count in its top-left corner.\n"
+    "Exit codes: 0 ok, 2 bad arguments or input (nothing written), 1 failure at run time.\n";
+
+constexpr io::Rgb kBackground{24, 24, 28};
+constexpr std::int64_t kSheetCells = 64;
+constexpr double kFramingMargin = 0.1;
 
 struct Size {
   int width = 1280;
@@ -64,83 +89,65 @@ Size parseSize(const std::string& text) {
   }
 }
 
-enum class Colouring { Speed, Age, Id };
-
-Colouring parseColouring(const std::string& name) {
-  if (name == "speed") return Colouring::Speed;
-  if (name == "age") return Colouring::Age;
-  if (name == "id") return Colouring::Id;
-  throw UsageError("preview: --color: '" + name + "' (expected " +
-                   joinWords({"speed", "age", "id"}, " or ") + ")");
+io::UpAxis parseUp(const std::string& text) {
+  if (text == "y") return io::UpAxis::Y;
+  if (text == "z") return io::UpAxis::Z;
+  throw UsageError("preview: --up: '" + text + "' (expected y or z)");
 }
 
-// One frame's particles: positions, and the value each is coloured by.
-struct FrameState {
-  Vec3Column positions;
-  std::vector<double> values;
-};
-
-FrameState capture(const ParticleSystem& system, Colouring colouring) {
-  FrameState s;
-  system.renderPositions(s.positions);
-  const std::size_t n = system.pool().size();
-  s.values.resize(n);
-  if (colouring == Colouring::Speed) {
-    Vec3Column v;
-    system.renderVelocities(v);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto r = static_cast<Eigen::Index>(i);
-      s.values[i] =
-          std::sqrt(double(v.x[r]) * v.x[r] + double(v.y[r]) * v.y[r] + double(v.z[r]) * v.z[r]);
-    }
-  } else if (colouring == Colouring::Age) {
-    FloatColumn a;
-    system.renderAges(a);
-    for (std::size_t i = 0; i < n; ++i) s.values[i] = a[static_cast<Eigen::Index>(i)];
-  } else {
-    for (std::size_t i = 0; i < n; ++i) {
-      s.values[i] = static_cast<double>(system.pool().id()[static_cast<Eigen::Index>(i)]);
-    }
-  }
-  return s;
+Eigen::Vector3d parsePoint(const std::string& option, const std::optional<std::string>& text) {
+  const auto v = parseTriple(
+      *text, UsageError("preview: " + option + ": '" + *text +
+                        "' is not a point X,Y,Z (metres, three numbers from -1e9 to 1e9)"));
+  return {v[0], v[1], v[2]};
 }
 
-// What the camera and the colour map need from the whole run: the particles' bounds and the
-// range of the colouring value.
+// The particles' bounds and the colouring value's range over the whole run.
 struct RunExtent {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   double valueLo = std::numeric_limits<double>::infinity();
   double valueHi = -valueLo;
 
-  void add(const FrameState& s) {
-    for (Eigen::Index i = 0; i < s.positions.x.size(); ++i) {
-      const Eigen::Vector3d p(s.positions.x[i], s.positions.y[i], s.positions.z[i]);
+  void add(const io::FrameData& frame, const std::vector<double>& values) {
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      const Eigen::Vector3d p(frame.position.x[r], frame.position.y[r], frame.position.z[r]);
       if (!p.allFinite()) continue;
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
-      valueLo = std::min(valueLo, s.values[static_cast<std::size_t>(i)]);
-      valueHi = std::max(valueHi, s.values[static_cast<std::size_t>(i)]);
+      if (i < values.size() && std::isfinite(values[i])) {
+        valueLo = std::min(valueLo, values[i]);
+        valueHi = std::max(valueHi, values[i]);
+      }
     }
   }
-  bool empty() const { return !(lo.x() <= hi.x()); }
 };
 
-constexpr io::Rgb kBackground{24, 24, 28};
-constexpr std::int64_t kSheetCells = 64;
+// The output folder: made before anything runs, and removed again when a later refusal leaves
+// it empty, so that bad input writes nothing.
+class OutputFolder {
+ public:
+  explicit OutputFolder(std::filesystem::path dir) : dir_(std::move(dir)) {
+    std::error_code error;
+    const bool existed = std::filesystem::exists(dir_, error);
+    std::filesystem::create_directories(dir_, error);
+    if (error) {
+      throw std::runtime_error(dir_.string() + ": error: cannot make the output folder (" +
+                               error.message() + ")");
+    }
+    made_ = !existed;
+  }
+  void abandon() const {
+    std::error_code ignored;
+    if (made_ && std::filesystem::is_empty(dir_, ignored)) std::filesystem::remove(dir_, ignored);
+  }
+  const std::filesystem::path& path() const { return dir_; }
 
-// Burns `text` into the image's top-left corner, light on a dark box.
-void burnLabel(io::SplatImage& image, const std::string& text, int scale) {
-  const int pad = 2 * scale;
-  io::fillRect(image, 0, 0, io::textWidth(text, scale) + 2 * pad,
-               io::kGlyphHeight * scale + 2 * pad, {0, 0, 0});
-  io::drawText(image, pad, pad, text, {235, 235, 235}, scale);
-}
-
-// Named as the caches of `tickfx run` are: frame_0001.png beside frame_0001.csv.
-std::filesystem::path framePath(const std::filesystem::path& dir, std::int64_t frame) {
-  return io::cacheFilePath(dir, frame, "png");
-}
+ private:
+  std::filesystem::path dir_;
+  bool made_ = false;
+};
 
 }  // namespace
 
@@ -150,100 +157,149 @@ int previewCommand(Arguments& args) {
     return kExitOk;
   }
   const std::vector<std::string> overrides = args.values("--set");
-  const std::filesystem::path out = args.value("--out").value_or("out/preview");
+  const std::filesystem::path outDir = args.value("--out").value_or("out/preview");
   const Size size = parseSize(args.value("--size").value_or("1280x720"));
-  const Colouring colouring = parseColouring(args.value("--color").value_or("speed"));
+  const std::string colourName = args.value("--color").value_or("speed");
   const auto framesOption = args.value("--frames");
   const long long every =
       parseInteger(args.value("--every").value_or("1"), "preview: --every", 1, 1'000'000);
-  const long long pointSize =
-      parseInteger(args.value("--point-size").value_or("3"), "preview: --point-size", 1, 100);
+  const auto pointSizeOption = args.value("--point-size");
+  const auto radiusOption = args.value("--radius");
+  const auto eyeOption = args.value("--camera");
+  const auto lookatOption = args.value("--lookat");
+  const double fov = parseNumber(args.value("--fov").value_or("40"), "preview: --fov", 1.0, 170.0);
+  const io::UpAxis up = parseUp(args.value("--up").value_or("y"));
+  const bool guides = !args.flag("--no-guides");
   const bool wantSheet = args.flag("--sheet");
-  const std::string effectPath =
-      args.positionals(1, "one effect file: tickfx preview EFFECT.toml")[0];
+  const bool wantGif = args.flag("--gif");
+  const bool wantMp4 = args.flag("--mp4");
+  const std::string input =
+      args.positionals(1, "one effect file or cache folder: tickfx preview EFFECT.toml")[0];
 
-  const io::LoadResult load = io::loadEffectFile(effectPath, overrides);
-  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
-  if (!load.ok()) return kExitUsage;
-  const io::EffectSettings& effect = *load.effect;
-  const std::int64_t count = effect.output.frameCount();
-  std::int64_t first = 1, last = count;
-  if (framesOption) {
-    const std::string range = "preview: --frames: '" + *framesOption +
-                              "' is not a range A..B of this effect's frames (1.." +
-                              std::to_string(count) + ")";
-    const std::size_t dots = framesOption->find("..");
-    if (dots == std::string::npos) throw UsageError(range);
+  io::SplatSize splatSize;
+  if (pointSizeOption && radiusOption) {
+    throw UsageError("preview: --point-size and --radius each set the splat size: give one");
+  }
+  if (pointSizeOption) {
+    splatSize.diameterPixels =
+        static_cast<double>(parseInteger(*pointSizeOption, "preview: --point-size", 1, 100));
+  }
+  if (radiusOption)
+    splatSize.radiusMetres = parseNumber(*radiusOption, "preview: --radius", 1e-6, 1e6);
+  if (lookatOption && !eyeOption) {
+    throw UsageError("preview: --lookat needs --camera (without it the camera frames the run)");
+  }
+  const std::optional<Eigen::Vector3d> eye =
+      eyeOption ? std::optional(parsePoint("--camera", eyeOption)) : std::nullopt;
+  const std::optional<Eigen::Vector3d> target =
+      lookatOption ? std::optional(parsePoint("--lookat", lookatOption)) : std::nullopt;
+  const auto cameraAt = [&](const Eigen::Vector3d& look, int width, int height) {
     try {
-      first = parseInteger(framesOption->substr(0, dots), "--frames", 1, count);
-      last = parseInteger(framesOption->substr(dots + 2), "--frames", first, count);
-    } catch (const UsageError&) {
-      throw UsageError(range);
+      return io::PinholeCamera(*eye, look, io::upVector(up), fov, width, height);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("preview: --camera: ") + e.what());
     }
-  }
-  const Flicks length = io::lengthOfFrames(effect.output.fps, count, "output length");
-
-  // Building loads the effect's fields: a file that does not load is bad input.
-  std::unique_ptr<ParticleSystem> system;
-  try {
-    system = io::buildOfflineSystem(effect, std::nullopt);
-  } catch (const io::BuildError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitUsage;
-  }
-  // The output folder takes files before anything runs.
-  try {
-    std::error_code error;
-    std::filesystem::create_directories(out, error);
-    if (error) {
-      std::fprintf(stderr, "%s: error: cannot make the output folder (%s)\n", out.c_str(),
-                   error.message().c_str());
-      return kExitUsage;
-    }
-    io::requireWritable(framePath(out, first));
-  } catch (const io::WriteError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitUsage;
-  }
-
-  // First pass: the whole run's extent, for a camera that holds still and one colour range.
-  RunExtent extent;
-  {
-    io::FrameSchedule schedule = io::FrameSchedule::fixedRate(effect.output.fps, length);
-    ProgressLine progress("frames (framing)");
-    while (const std::optional<Flicks> d = schedule.next()) {
-      system->advance(*d);
-      extent.add(capture(*system, colouring));
-      progress.update(schedule.framesDone(), count,
-                      static_cast<double>(schedule.framesDone()) / static_cast<double>(count), "");
-    }
-  }
-  if (extent.empty()) extent.lo = extent.hi = Eigen::Vector3d::Zero();
-  const io::PinholeCamera camera = io::PinholeCamera::framing(
-      extent.lo, extent.hi, Eigen::Vector3d::UnitY(), 40.0, size.width, size.height);
-  const double span = extent.valueHi > extent.valueLo ? extent.valueHi - extent.valueLo : 1.0;
-
-  // Second pass: the same ticks again (the state at a frame is a pure function of the effect),
-  // rendering the frames asked for.
-  const std::string name = std::filesystem::path(effectPath).stem().string();
-  const auto render = [&](const io::PinholeCamera& view, const FrameState& state, float radius) {
-    std::vector<io::Splat> splats;
-    splats.reserve(state.values.size());
-    for (std::size_t i = 0; i < state.values.size(); ++i) {
-      const auto r = static_cast<Eigen::Index>(i);
-      const auto q = view.project(
-          Eigen::Vector3d(state.positions.x[r], state.positions.y[r], state.positions.z[r]));
-      if (!q) continue;
-      splats.push_back({static_cast<float>(q->x), static_cast<float>(q->y),
-                        static_cast<float>(q->depth), radius,
-                        io::viridis((state.values[i] - extent.valueLo) / span)});
-    }
-    io::SplatImage image(view.width(), view.height(), kBackground);
-    image.draw(std::move(splats));
-    return image;
   };
+  if (eye && target) cameraAt(*target, size.width, size.height);  // refused before running
+  std::optional<std::filesystem::path> ffmpeg;
+  if (wantMp4) {
+    ffmpeg = io::findFfmpeg();
+    if (!ffmpeg) {
+      throw UsageError(
+          "preview: --mp4 needs ffmpeg, which is not installed (Debian: apt-get install ffmpeg; "
+          "--gif needs nothing more)");
+    }
+  }
+
+  const std::unique_ptr<PreviewSource> source = openPreviewSource(input, overrides);
+  if (!source) return kExitUsage;
+  const bool folder = std::filesystem::is_directory(input);
+  if (folder && !overrides.empty()) {
+    throw UsageError("preview: --set changes an effect file; " + input + " is a cache folder");
+  }
+  const io::ColourBy colour = [&] {
+    try {
+      return io::ColourBy::parse(colourName, source->sample());
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("preview: --color: ") + e.what());
+    }
+  }();
+  const std::vector<std::int64_t>& available = source->frames();
+  std::int64_t first = available.front(), last = available.back();
+  if (framesOption) {
+    const UsageError refused("preview: --frames: '" + *framesOption +
+                             "' is not a range A..B of this " + (folder ? "folder's" : "effect's") +
+                             " frames (" + std::to_string(first) + ".." + std::to_string(last) +
+                             ")");
+    std::tie(first, last) = parseRange(*framesOption, first, last, refused);
+  }
+  const auto wanted = [&](std::int64_t f) {
+    return f >= first && f <= last && (f - first) % every == 0;
+  };
+
+  std::optional<OutputFolder> out;
+  try {
+    out.emplace(outDir);
+    io::requireWritable(io::cacheFilePath(outDir, first, "png"));
+  } catch (const std::runtime_error& e) {  // WriteError too
+    std::fprintf(stderr, "%s\n", e.what());
+    if (out) out->abandon();
+    return kExitUsage;
+  }
+
+  // First walk: the whole run's extent, for a camera that holds still and one colour range.
+  RunExtent extent;
+  std::int64_t rendered = 0;
+  {
+    ProgressLine progress("frames (framing)");
+    const auto total = static_cast<std::int64_t>(available.size());
+    std::int64_t done = 0;
+    source->walk(
+        available.back(), [](std::int64_t) { return true; },
+        [&](const io::FrameData& frame, const IdPairs&) {
+          extent.add(frame, colour.values(frame));
+          rendered += wanted(frame.frame) ? 1 : 0;
+          ++done;
+          progress.update(done, total, static_cast<double>(done) / static_cast<double>(total), "");
+        });
+  }
+  if (!(extent.lo.x() <= extent.hi.x())) extent.lo = extent.hi = Eigen::Vector3d::Zero();
+  if (!(extent.valueLo <= extent.valueHi)) extent.valueLo = extent.valueHi = 0.0;
+  const Eigen::Vector3d centre = 0.5 * (extent.lo + extent.hi);
+  const auto cameraFor = [&](int width, int height) {
+    return eye ? cameraAt(target.value_or(centre), width, height)
+               : io::PinholeCamera::framing(extent.lo, extent.hi, io::upVector(up), fov, width,
+                                            height, kFramingMargin);
+  };
+  std::optional<io::PinholeCamera> camera;
+  try {
+    camera.emplace(cameraFor(size.width, size.height));
+  } catch (const UsageError&) {
+    out->abandon();
+    throw;
+  }
+
+  io::RenderSettings settings;
+  settings.background = kBackground;
+  settings.size = splatSize;
+  if (guides) {
+    settings.grid = io::GroundGrid::under(extent.lo, extent.hi, up);
+    settings.axisLength = settings.grid->spacing;
+  }
+  const bool legend = guides && !colour.ownColours();
+  // The grid's spacing in the caption: the scale at a glance.
+  char gridNote[48] = "";
+  if (settings.grid)
+    std::snprintf(gridNote, sizeof gridNote, "  grid %g m", settings.grid->spacing);
+  const int textScale = size.width >= 640 ? 2 : 1;
+  const auto render = [&](const io::PinholeCamera& view, const io::FrameData& frame,
+                          const IdPairs& lines) {
+    return io::renderFrame(view, frame, colour.colours(frame, extent.valueLo, extent.valueHi),
+                           lines, settings);
+  };
+
   // The sheet: every rendered frame (every sheetStride-th past 64), in cells a quarter the size.
-  const std::int64_t rendered = (last - first) / every + 1;
+  rendered = std::max<std::int64_t>(rendered, 1);
   const std::int64_t sheetStride = (rendered + kSheetCells - 1) / kSheetCells;
   const std::int64_t cells = (rendered + sheetStride - 1) / sheetStride;
   const int cellWidth = std::max(1, size.width / 4), cellHeight = std::max(1, size.height / 4);
@@ -253,34 +309,43 @@ int previewCommand(Arguments& args) {
   std::optional<io::PinholeCamera> cellCamera;
   if (wantSheet) {
     if (static_cast<std::int64_t>(rows) * cellHeight > io::SplatImage::kMaxSide) {
+      out->abandon();
       throw UsageError("preview: --sheet: " + std::to_string(cells) +
                        " frames make a sheet too tall (use a smaller --size or a larger --every)");
     }
     sheet.emplace(columns * cellWidth, rows * cellHeight, kBackground);
-    cellCamera.emplace(io::PinholeCamera::framing(extent.lo, extent.hi, Eigen::Vector3d::UnitY(),
-                                                  40.0, cellWidth, cellHeight));
+    cellCamera.emplace(cameraFor(cellWidth, cellHeight));
   }
-  system = io::buildOfflineSystem(effect, std::nullopt);
-  io::FrameSchedule schedule = io::FrameSchedule::fixedRate(effect.output.fps, length);
+  std::optional<io::GifFlipbook> gif;
+  if (wantGif) {
+    gif.emplace(size.width, size.height, io::GifFlipbook::delayFor(source->fps()));
+  }
+  std::optional<io::FfmpegMovie> movie;
+  if (ffmpeg)
+    movie.emplace(*ffmpeg, outDir / "flipbook.mp4", size.width, size.height, source->fps());
+
+  // Second walk: the frames asked for.
   ProgressLine progress("frames");
   std::int64_t written = 0;
-  while (const std::optional<Flicks> d = schedule.next()) {
-    system->advance(*d);
-    const std::int64_t f = schedule.framesDone();
-    if (f > last) break;
-    if (f < first || (f - first) % every != 0) continue;
-    const FrameState state = capture(*system, colouring);
-    io::SplatImage image = render(camera, state, 0.5f * static_cast<float>(pointSize));
-    char label[160];
-    std::snprintf(label, sizeof label, "%s  frame %" PRId64 "  t = %.3f s  %zu particles",
-                  name.c_str(), f, system->shownSeconds(), state.values.size());
-    burnLabel(image, label, size.width >= 640 ? 2 : 1);
-    image.writePng(framePath(out, f));
-    const std::int64_t index = (f - first) / every;
-    if (sheet && index % sheetStride == 0) {
-      const std::int64_t cell = index / sheetStride;
-      io::SplatImage small = render(*cellCamera, state, 0.5f * static_cast<float>(pointSize));
-      burnLabel(small, "frame " + std::to_string(f), 1);
+  source->walk(last, wanted, [&](const io::FrameData& frame, const IdPairs& lines) {
+    const std::int64_t f = frame.frame;
+    io::SplatImage image = render(*camera, frame, lines);
+    char time[48] = "";
+    if (source->knowsTimes()) std::snprintf(time, sizeof time, "  t = %.3f s", frame.timeSeconds);
+    char label[256];
+    std::snprintf(label, sizeof label, "%s  frame %" PRId64 "%s  %zu particles%s",
+                  source->name().c_str(), f, time, frame.size(), gridNote);
+    io::drawCaption(image, label, textScale);
+    if (legend) {
+      io::drawLegend(image, colour.title(), extent.valueLo, extent.valueHi, textScale);
+    }
+    image.writePng(io::cacheFilePath(outDir, f, "png"));
+    if (gif) gif->add(image);
+    if (movie) movie->add(image);
+    if (sheet && written % sheetStride == 0) {
+      const std::int64_t cell = written / sheetStride;
+      io::SplatImage small = render(*cellCamera, frame, lines);
+      io::drawCaption(small, "frame " + std::to_string(f), 1);
       const int x0 = static_cast<int>(cell % columns) * cellWidth;
       const int y0 = static_cast<int>(cell / columns) * cellHeight;
       for (int y = 0; y < cellHeight; ++y) {
@@ -288,20 +353,32 @@ int previewCommand(Arguments& args) {
       }
     }
     ++written;
-    progress.update(f - first + 1, last - first + 1,
-                    static_cast<double>(f - first + 1) / static_cast<double>(last - first + 1),
-                    framePath(out, f).string());
-  }
-  if (sheet) sheet->writePng(out / "sheet.png");
+    progress.update(written, rendered, static_cast<double>(written) / static_cast<double>(rendered),
+                    io::cacheFilePath(outDir, f, "png").string());
+  });
   progress.finish();
-  std::printf("%s: %" PRId64 " frames rendered to %s (%dx%d), frames %" PRId64 "..%" PRId64
-              " every %lld\n",
-              effectPath.c_str(), written, out.string().c_str(), size.width, size.height, first,
-              last, every);
-  if (sheet) {
-    std::printf("sheet: %s (%" PRId64 " frames, %dx%d cells)\n", (out / "sheet.png").c_str(), cells,
-                cellWidth, cellHeight);
+  if (sheet) sheet->writePng(outDir / "sheet.png");
+  if (gif) gif->write(outDir / "flipbook.gif");
+  if (movie) {
+    try {
+      movie->finish();
+    } catch (const std::runtime_error& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      return kExitFailure;
+    }
   }
+  std::printf(
+      "%s: %" PRId64 " frames rendered to %s (%dx%d), frames %" PRId64 "..%" PRId64 " every %lld\n",
+      input.c_str(), written, outDir.string().c_str(), size.width, size.height, first, last, every);
+  if (sheet) {
+    std::printf("sheet: %s (%" PRId64 " frames, %dx%d cells)\n", (outDir / "sheet.png").c_str(),
+                cells, cellWidth, cellHeight);
+  }
+  if (gif) {
+    std::printf("flipbook: %s (%zu frames, %d/100 s each)\n", (outDir / "flipbook.gif").c_str(),
+                gif->frameCount(), io::GifFlipbook::delayFor(source->fps()));
+  }
+  if (movie) std::printf("movie: %s\n", (outDir / "flipbook.mp4").c_str());
   return kExitOk;
 }
 

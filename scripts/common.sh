@@ -10,7 +10,7 @@ TICKFX_PACKAGES=(
   libeigen3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenvdb-dev libopenvdb-tools libboost-dev libboost-iostreams-dev zlib1g-dev
-  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libpng-dev
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libpng-dev libgif-dev
 )
 
 # What scripts/test's aarch64 stage adds: Debian's cross compiler, qemu-user, and the arm64 builds
@@ -22,6 +22,7 @@ TICKFX_AARCH64_PACKAGES=(
   g++-aarch64-linux-gnu qemu-user
   libtbb-dev:arm64 libtomlplusplus-dev:arm64 libblosc-dev:arm64 libimath-dev:arm64
   libboost-iostreams-dev:arm64 zlib1g-dev:arm64 libopenvdb10.0:arm64 libpng-dev:arm64
+  libgif-dev:arm64
 )
 
 # The architectures named by PKG:ARCH arguments that dpkg does not know yet, one a line.

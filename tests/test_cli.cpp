@@ -474,6 +474,22 @@ TEST_F(Cli, DeterminismPrintsTheTableAndAVerdict) {
   EXPECT_EQ(run("determinism samples/fountain.toml --threads 0").exit, 2);
 }
 
+TEST_F(Cli, DeterminismWritesNoDifferenceImageWhenTheRunsAgree) {
+  const std::string args = "determinism samples/fountain.toml --seconds 0.1 --threads 1,2 ";
+  const Result r = run(args + "--diff-image " + path("diff.png"));
+  EXPECT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(r.out.find("\nno difference image: the runs agree\n"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(path("diff.png")));
+  // A place it could not be written is refused before anything runs.
+  const Result bad = run(args + "--diff-image " + path("no/diff.png"));
+  EXPECT_EQ(bad.exit, 2);
+  EXPECT_EQ(bad.err,
+            path("no/diff.png") + ": error: cannot write (no directory " + path("no") + ")\n");
+  EXPECT_EQ(bad.out, "");
+  EXPECT_EQ(run("determinism samples/fountain.toml --compare x.log --diff-image d.png").err,
+            "tickfx determinism: --diff-image does not go with --record or --compare\n");
+}
+
 // A regression guard, as above, tick by tick; the trace's own format is checked for real.
 TEST_F(Cli, TracesOfTwoFrameRatesAreIdenticalTickForTickRegressionGuard) {
   ASSERT_EQ(
@@ -675,7 +691,20 @@ TEST_F(Cli, PreviewRefusesBadInputWithNothingWritten) {
   const std::string fountain = "preview samples/fountain.toml --out " + path("never") + " ";
   const std::vector<std::pair<std::string, std::string>> cases = {
       {fountain + "--color bogus",
-       "tickfx preview: --color: 'bogus' (expected speed, age or id)\n"},
+       "tickfx preview: --color: 'bogus' (expected speed, age, nage, id, life or mass)\n"},
+      {fountain + "--lookat 0,0,0",
+       "tickfx preview: --lookat needs --camera (without it the "
+       "camera frames the run)\n"},
+      {fountain + "--camera 1,2,3 --lookat 1,2,3",
+       "tickfx preview: --camera: the camera is on the point it looks at\n"},
+      {fountain + "--camera 0,5,0 --lookat 0,0,0",
+       "tickfx preview: --camera: the camera's up is along its view\n"},
+      {fountain + "--camera 1,2",
+       "tickfx preview: --camera: '1,2' is not a point X,Y,Z (metres, "
+       "three numbers from -1e9 to 1e9)\n"},
+      {fountain + "--up x", "tickfx preview: --up: 'x' (expected y or z)\n"},
+      {fountain + "--point-size 3 --radius 0.1",
+       "tickfx preview: --point-size and --radius each set the splat size: give one\n"},
       {fountain + "--size 0x720",
        "tickfx preview: --size: '0x720' is not WxH with whole numbers from 1 to 16384\n"},
       {fountain + "--size 1000000x720",
@@ -691,11 +720,101 @@ TEST_F(Cli, PreviewRefusesBadInputWithNothingWritten) {
     EXPECT_EQ(r.err, message) << args;
     EXPECT_FALSE(fs::exists(path("never"))) << args;
   }
+  // No ffmpeg: --mp4 says what to install, before running anything.
+  ::setenv("TICKFX_FFMPEG", path("no/ffmpeg").c_str(), 1);
+  const Result mp4 = run(fountain + "--mp4");
+  ::unsetenv("TICKFX_FFMPEG");
+  EXPECT_EQ(mp4.exit, 2);
+  EXPECT_EQ(mp4.err,
+            "tickfx preview: --mp4 needs ffmpeg, which is not installed (Debian: apt-get install "
+            "ffmpeg; --gif needs nothing more)\n");
+  // A folder with no frame caches in it.
+  fs::create_directories(path("empty"));
+  { std::ofstream(path("empty/notes.txt")) << "x"; }
+  const Result empty = run("preview " + path("empty") + " --out " + path("never"));
+  EXPECT_EQ(empty.exit, 2);
+  EXPECT_EQ(empty.err, path("empty") +
+                           ": error: no frame caches here (expected frame_0001.vdb, .ply or .csv, "
+                           "as tickfx run writes them)\n");
+  EXPECT_FALSE(fs::exists(path("never")));
   // An output folder that cannot be made: a file stands where it would go.
   { std::ofstream(path("file")) << "x"; }
   const Result r = run("preview samples/fountain.toml --out " + path("file/sub"));
   EXPECT_EQ(r.exit, 2);
   EXPECT_EQ(r.err, path("file/sub") + ": error: cannot make the output folder (Not a directory)\n");
+}
+
+TEST_F(Cli, PreviewRendersACacheFolderAndItsAttributes) {
+  ASSERT_EQ(
+      run("run samples/fountain.toml --frames 12 --fps 24 --format ply --out " + path("fountain"))
+          .exit,
+      0);
+  const std::string args = "preview " + path("fountain") + " --size 160x90 --out ";
+  const Result r = run(args + path("p") + " --frames 10..12 --color mass");
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_EQ(r.out, path("fountain") + ": 3 frames rendered to " + path("p") +
+                       " (160x90), frames 10..12 every 1\n");
+  EXPECT_EQ(pngSize(readAll(path("p/frame_0012.png"))),
+            (std::pair<std::uint32_t, std::uint32_t>{160, 90}));
+  EXPECT_FALSE(fs::exists(path("p/frame_0009.png")));
+  // The folder's frames are those of the run: the same picture from the effect and its caches.
+  ASSERT_EQ(run("preview samples/fountain.toml --size 160x90 --color mass --out " + path("e") +
+                " --set output.seconds=0.5")
+                .exit,
+            0);
+  EXPECT_EQ(readAll(path("e/frame_0012.png")), readAll(path("p/frame_0012.png")));
+  // An attribute the caches do not have is refused, naming those they do.
+  const Result bad = run(args + path("never") + " --color Cd");
+  EXPECT_EQ(bad.exit, 2);
+  EXPECT_EQ(bad.err,
+            "tickfx preview: --color: 'Cd' (expected speed, age, nage, id, life or mass)\n");
+  EXPECT_FALSE(fs::exists(path("never")));
+  // A looping GIF of the frames rendered: GIF89a, the frame size, the NETSCAPE loop.
+  const Result gif = run(args + path("g") + " --gif --every 4");
+  ASSERT_EQ(gif.exit, 0) << gif.err;
+  EXPECT_NE(gif.out.find("flipbook: " + path("g/flipbook.gif") + " (3 frames, 4/100 s each)\n"),
+            std::string::npos)
+      << gif.out;
+  const std::string bytes = readAll(path("g/flipbook.gif"));
+  ASSERT_GT(bytes.size(), 13u);
+  EXPECT_EQ(bytes.substr(0, 6), "GIF89a");
+  EXPECT_EQ(static_cast<unsigned char>(bytes[6]) | static_cast<unsigned char>(bytes[7]) << 8, 160);
+  EXPECT_EQ(static_cast<unsigned char>(bytes[8]) | static_cast<unsigned char>(bytes[9]) << 8, 90);
+  EXPECT_NE(bytes.find("NETSCAPE2.0"), std::string::npos);
+}
+
+TEST_F(Cli, PreviewPipesItsFramesToFfmpegForAMovie) {
+  // A stand-in for ffmpeg: keeps what it is sent as the movie, and its arguments.
+  const std::string fake = path("ffmpeg");
+  {
+    std::ofstream script(fake);
+    script << "#!/bin/sh\nfor last; do :; done\necho \"$@\" > \"$last.args\"\ncat > \"$last\"\n";
+  }
+  fs::permissions(fake, fs::perms::owner_all);
+  ::setenv("TICKFX_FFMPEG", fake.c_str(), 1);
+  const std::string args =
+      "preview samples/fountain.toml --size 160x90 --frames 20..22 --mp4 --out " + path("m");
+  const Result r = run(args);
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(r.out.find("movie: " + path("m/flipbook.mp4") + "\n"), std::string::npos) << r.out;
+  // Three frames of 160 × 90 RGB, at the effect's 24 fps, into a temporary renamed into place.
+  EXPECT_EQ(fs::file_size(path("m/flipbook.mp4")), 3u * 160 * 90 * 3);
+  const std::string given = readAll(path("m/flipbook.mp4.partial.mp4.args"));
+  EXPECT_NE(given.find("-f rawvideo -pix_fmt rgb24 -s 160x90 -r 24 -i -"), std::string::npos)
+      << given;
+  EXPECT_FALSE(fs::exists(path("m/flipbook.mp4.partial.mp4")));
+  // An ffmpeg that fails leaves no movie and says so.
+  {
+    std::ofstream script(fake);
+    script << "#!/bin/sh\ncat > /dev/null\nexit 3\n";
+  }
+  const Result failed = run(args + "2");
+  ::unsetenv("TICKFX_FFMPEG");
+  EXPECT_EQ(failed.exit, 1);
+  EXPECT_EQ(failed.err,
+            path("m2/flipbook.mp4") + ": error: ffmpeg failed (exit status 3); no movie written\n");
+  EXPECT_FALSE(fs::exists(path("m2/flipbook.mp4")));
+  EXPECT_FALSE(fs::exists(path("m2/flipbook.mp4.partial.mp4")));
 }
 
 // Bad effect files through the command line: exit code 2, the first message exactly (file, line,

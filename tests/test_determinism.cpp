@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "app/DeterminismCheck.h"
+#include "app/DifferenceImage.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
@@ -198,6 +199,57 @@ TEST(FirstDivergence, ADifferentSeedIsCaughtAtTheFirstTickWithParticles) {
   const Divergence d = firstDivergence(traces);
   EXPECT_EQ(d.tick, 1) << "the fountain emits in its first tick";
   EXPECT_EQ(d.runs, std::vector<std::size_t>{1});
+}
+
+TEST(StateAfterTick, IsTheSameStateWhateverTheFramesAndThreads) {
+  const io::EffectSettings effect = load(fs::path(TICKFX_SOURCE_DIR) / "samples/fountain.toml");
+  const Flicks half = kFlicksPerSecond / 2;
+  const io::FrameData a =
+      stateAfterTick(effect, {"24 fps", io::fixedRateFrames({24, 1}, half), 1}, 37);
+  const io::FrameData b = stateAfterTick(effect, {"jitter 2", io::jitteredFrames(2, half), 2}, 37);
+  ASSERT_GT(a.size(), 100u);  // 2000 particles a second for 37/120 s
+  EXPECT_EQ(io::frameHash(a), io::frameHash(b));
+  EXPECT_DOUBLE_EQ(a.timeSeconds, 37.0 / 120.0);
+  EXPECT_EQ(stateAfterTick(effect, {"24 fps", io::fixedRateFrames({24, 1}, half), 1}, 61).size(),
+            0u)
+      << "half a second is 60 ticks: there is no tick 61";
+}
+
+TEST(DifferenceImage, ColoursEachParticleByTheDistanceToItsTwin) {
+  io::EffectSettings effect = load(fs::path(TICKFX_SOURCE_DIR) / "samples/fountain.toml");
+  const DriveCase drive{"60 fps", io::fixedRateFrames({60, 1}, kFlicksPerSecond / 2), 1};
+  const io::FrameData a = stateAfterTick(effect, drive, 40);
+  DifferenceSummary same;
+  const io::SplatImage agreeing = renderDifference(a, a, "'a'", "'b'", 40, 320, 180, &same);
+  EXPECT_EQ(same.differing, 0u);
+  EXPECT_EQ(same.largest, 0.0);
+  // Another seed: the same ids, elsewhere.
+  effect.simulation.seed += 1;
+  const io::FrameData b = stateAfterTick(effect, drive, 40);
+  ASSERT_EQ(b.id, a.id);
+  DifferenceSummary parted;
+  const io::SplatImage differing = renderDifference(a, b, "'a'", "'b'", 40, 320, 180, &parted);
+  EXPECT_EQ(parted.differing, a.size());
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    largest = std::max(largest, Eigen::Vector3d(a.position.x[r] - b.position.x[r],
+                                                a.position.y[r] - b.position.y[r],
+                                                a.position.z[r] - b.position.z[r])
+                                    .norm());
+  }
+  EXPECT_EQ(parted.largest, largest);
+  EXPECT_GT(largest, 0.01);
+  EXPECT_NE(differing.png(), agreeing.png());
+  // A particle only one state has counts as differing.
+  io::FrameData fewer = a;
+  fewer.resize(a.size() - 1, {});
+  fewer.id.assign(a.id.begin(), a.id.end() - 1);
+  for (int c = 0; c < 3; ++c) fewer.position[c] = a.position[c].head(a.position.x.size() - 1);
+  DifferenceSummary one;
+  renderDifference(a, fewer, "'a'", "'b'", 40, 64, 36, &one);
+  EXPECT_EQ(one.differing, 1u);
+  EXPECT_EQ(one.largest, 0.0);
 }
 
 }  // namespace

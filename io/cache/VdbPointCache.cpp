@@ -523,6 +523,8 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
       if (!isStandard(names[pos]) && leaf->constAttributeArray(pos).hasValueType<float>())
         customPos.push_back(pos);
     }
+    // Houdini's colour, a vec3s, as tickfx names it in a pool: three floats Cd_r, Cd_g, Cd_b.
+    const std::size_t cdPos = find("Cd", openvdb::Vec3f());
     if (first) {
       found.hasVelocity = vPos != vdbp::AttributeSet::INVALID_POS;
       found.hasId =
@@ -531,7 +533,10 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
       found.hasLife = lifePos != vdbp::AttributeSet::INVALID_POS;
       found.hasMass = massPos != vdbp::AttributeSet::INVALID_POS;
       for (std::size_t pos : customPos) customNames.push_back(names[pos]);
-      custom.resize(customPos.size());
+      if (cdPos != vdbp::AttributeSet::INVALID_POS) {
+        for (const char* channel : {"Cd_r", "Cd_g", "Cd_b"}) customNames.emplace_back(channel);
+      }
+      custom.resize(customNames.size());
       first = false;
     }
 
@@ -579,10 +584,19 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
     readAll(agePos, age, 0.0f);
     readAll(lifePos, life, std::numeric_limits<float>::infinity());
     readAll(massPos, mass, 1.0f);
-    if (customPos.size() != custom.size()) {
+    const std::size_t cdColumns = cdPos != vdbp::AttributeSet::INVALID_POS ? 3 : 0;
+    if (customPos.size() + cdColumns != custom.size()) {
       throw std::runtime_error(where(file) + ": leaves with different attributes");
     }
     for (std::size_t a = 0; a < customPos.size(); ++a) readAll(customPos[a], custom[a], 0.0f);
+    if (cdColumns > 0) {
+      std::vector<openvdb::Vec3f> cd;
+      readAll(cdPos, cd, openvdb::Vec3f(0.0f));
+      for (int c = 0; c < 3; ++c) {
+        std::vector<float>& column = custom[customPos.size() + static_cast<std::size_t>(c)];
+        for (const openvdb::Vec3f& v : cd) column.push_back(v[c]);
+      }
+    }
     if (position.size() != id.size()) {
       throw std::runtime_error(where(file) + ": a leaf's offsets do not match its attributes");
     }

@@ -66,7 +66,8 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
 /// keeps OpenVDB's order (leaf by leaf, voxel by voxel, and within a voxel as written), ids being
 /// then the row numbers 0, 1, .... Optional attributes: v (vec3s; absent: 0), id (int64 or int32),
 /// age (absent: 0), life (absent: +inf), mass (absent: 1); every other float attribute becomes a
-/// custom attribute, in the file's order; attributes of other types are ignored. The frame number
+/// custom attribute, in the file's order, then Houdini's colour Cd (vec3s) the three custom
+/// attributes Cd_r, Cd_g and Cd_b; attributes of other types are ignored. The frame number
 /// and time come from tickfx_frame and tickfx_time (absent: 0). `contents`, when given, receives
 /// the metadata and which attributes were present.
 /// Throws std::runtime_error naming the file and the grid ("PATH: grid 'points': ...") when the

@@ -60,4 +60,20 @@ std::optional<Projected> PinholeCamera::project(const Eigen::Vector3d& p) const 
   return Projected{0.5 * width_ + s * d.dot(right_), 0.5 * height_ - s * d.dot(up_), depth};
 }
 
+std::optional<std::pair<Projected, Projected>> PinholeCamera::projectSegment(
+    const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  const double da = (a - eye_).dot(forward_), db = (b - eye_).dot(forward_);
+  if (!(da >= kNear) && !(db >= kNear)) return std::nullopt;
+  // Cut the segment where it crosses a plane just past the near one (twice kNear, so that the
+  // rounded cut is surely in front), so a line running past the camera keeps its visible part.
+  const auto cut = [&](const Eigen::Vector3d& from, double dFrom, const Eigen::Vector3d& to,
+                       double dTo) {
+    return Eigen::Vector3d(from + (to - from) * ((2.0 * kNear - dFrom) / (dTo - dFrom)));
+  };
+  const std::optional<Projected> pa = project(da >= kNear ? a : cut(a, da, b, db));
+  const std::optional<Projected> pb = project(db >= kNear ? b : cut(b, db, a, da));
+  if (!pa || !pb) return std::nullopt;
+  return std::pair{*pa, *pb};
+}
+
 }  // namespace tickfx::io

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <utility>
 
 namespace tickfx::io {
 
@@ -33,6 +34,10 @@ class PinholeCamera {
 
   /// Where `p` lands, or nothing when it is not in front of the camera (depth below kNear).
   std::optional<Projected> project(const Eigen::Vector3d& p) const;
+  /// The part of the segment [a, b] in front of the camera (depth at least kNear), projected;
+  /// nothing when none of it is.
+  std::optional<std::pair<Projected, Projected>> projectSegment(const Eigen::Vector3d& a,
+                                                                const Eigen::Vector3d& b) const;
   /// Pixels one metre spans, across the view, at `depth` metres.
   double pixelsPerMetre(double depth) const { return focal_ / depth; }
 

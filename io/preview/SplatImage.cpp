@@ -78,6 +78,42 @@ void SplatImage::draw(std::vector<Splat> splats) {
   });
 }
 
+void SplatImage::drawLine(double x0, double y0, double x1, double y1, Rgb colour, float opacity) {
+  if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) return;
+  // Walk the longer axis a pixel at a time and share each step's cover between the two pixels
+  // the line passes between (Wu's way).
+  const bool steep = std::abs(y1 - y0) > std::abs(x1 - x0);
+  if (steep) {
+    std::swap(x0, y0);
+    std::swap(x1, y1);
+  }
+  if (x1 < x0) {
+    std::swap(x0, x1);
+    std::swap(y0, y1);
+  }
+  const int along = steep ? height_ : width_, across = steep ? width_ : height_;
+  const double slope = x1 > x0 ? (y1 - y0) / (x1 - x0) : 0.0;
+  if (x1 < 0.0 || x0 >= static_cast<double>(along)) return;
+  const int first = static_cast<int>(std::max(0.0, std::floor(x0)));
+  const int last = static_cast<int>(std::min(static_cast<double>(along - 1), std::floor(x1)));
+  const auto blend = [&](int u, int v, float a) {
+    if (v < 0 || v >= across || !(a > 0.0f)) return;
+    const int x = steep ? v : u, y = steep ? u : v;
+    float* p = &rgb_[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
+                      static_cast<std::size_t>(x)) *
+                     3];
+    for (int c = 0; c < 3; ++c) p[c] = p[c] + (static_cast<float>(colour[c]) - p[c]) * a;
+  };
+  for (int u = first; u <= last; ++u) {
+    const double v = y0 + slope * (static_cast<double>(u) + 0.5 - x0) - 0.5;
+    if (!(v > -2.0 && v < static_cast<double>(across) + 1.0)) continue;
+    const double below = std::floor(v);
+    const auto frac = static_cast<float>(v - below);
+    blend(u, static_cast<int>(below), opacity * (1.0f - frac));
+    blend(u, static_cast<int>(below) + 1, opacity * frac);
+  }
+}
+
 void SplatImage::set(int x, int y, Rgb colour) {
   if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
   float* p = &rgb_[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +

@@ -34,6 +34,11 @@ class SplatImage {
   /// depend on the thread count.
   void draw(std::vector<Splat> splats);
 
+  /// Draws an antialiased line one pixel wide from (x0, y0) to (x1, y1) (pixel coordinates as
+  /// Splat's), blended over the image with `opacity` in [0, 1]; the parts outside the image are
+  /// skipped. Serial: guides and springs are few next to the particles.
+  void drawLine(double x0, double y0, double x1, double y1, Rgb colour, float opacity);
+
   /// Sets one pixel (frames, legends).
   void set(int x, int y, Rgb colour);
   Rgb at(int x, int y) const;

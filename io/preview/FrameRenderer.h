@@ -1,0 +1,43 @@
+// One frame of particles rendered as a preview: guides, springs as lines, then the splats.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "io/cache/FrameData.h"
+#include "io/preview/PinholeCamera.h"
+#include "io/preview/SceneGuides.h"
+#include "io/preview/SplatImage.h"
+
+namespace tickfx::io {
+
+/// How big a splat is. A frame with a `pscale` attribute (Houdini's radius, metres) is drawn at
+/// that size unless `ignorePscale`; otherwise every particle is `radiusMetres` across the view
+/// when given, else `diameterPixels` on screen. No splat is drawn narrower than one pixel.
+struct SplatSize {
+  double diameterPixels = 3.0;
+  std::optional<double> radiusMetres;
+  bool ignorePscale = false;
+};
+
+/// What renderFrame draws besides the particles.
+struct RenderSettings {
+  Rgb background{24, 24, 28};
+  SplatSize size;
+  std::optional<GroundGrid> grid;    // the ground grid, or none
+  std::optional<double> axisLength;  // axis marks of this many metres, or none
+  Rgb lineColour{150, 150, 165};     // springs
+};
+
+/// Renders `frame` as `camera` sees it: the grid and axis marks, then `lines` (pairs of ids, such
+/// as a structure's springs; pairs naming an id not in the frame are skipped), then each row as a
+/// round splat of `colours[row]`, nearer over farther. The bytes depend only on the arguments,
+/// not on the thread count.
+SplatImage renderFrame(const PinholeCamera& camera, const FrameData& frame,
+                       const std::vector<Rgb>& colours,
+                       const std::vector<std::pair<std::uint64_t, std::uint64_t>>& lines,
+                       const RenderSettings& settings);
+
+}  // namespace tickfx::io
