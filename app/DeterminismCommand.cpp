@@ -342,8 +342,10 @@ int determinismCommand(Arguments& args) {
       "there\n");
   if (diffImage) {
     const std::size_t other = d.runs.front();
+    // Named without quotes: the image's pixel font has none.
     const auto name = [&](std::size_t r) {
-      return "'" + drives[r].label + ", " + std::to_string(drives[r].threads) + " thread(s)'";
+      return drives[r].label + " on " + std::to_string(drives[r].threads) +
+             (drives[r].threads == 1 ? " thread" : " threads");
     };
     const io::FrameData a = stateAfterTick(effect, drives.front(), d.tick);
     const io::FrameData b = stateAfterTick(effect, drives[other], d.tick);

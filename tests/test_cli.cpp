@@ -674,6 +674,12 @@ TEST_F(Cli, PreviewRendersTheFramesAskedForAsPngs) {
   EXPECT_EQ(readAll(path("b/frame_0035.png")), frame);
   // The camera frames the whole run, whatever frames are drawn: the same picture.
   EXPECT_EQ(readAll(path("c/frame_0035.png")), frame);
+  // The same bytes from a simulation on one thread and on two.
+  for (const char* threads : {"1", "2"}) {
+    const std::string dir = path(std::string("t") + threads);
+    ASSERT_EQ(run(args + dir + " --set simulation.threads=" + threads).exit, 0);
+    EXPECT_EQ(readAll(dir + "/frame_0035.png"), frame) << threads << " thread(s)";
+  }
   // Particles are drawn: a frame of the risen fountain is not the empty background.
   EXPECT_GT(frame.size(), readAll(path("a/frame_0030.png")).size() / 4);
   // A sheet of the three frames: one row of cells a quarter the size.

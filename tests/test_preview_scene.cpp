@@ -8,15 +8,19 @@
 #include <string>
 #include <vector>
 
+#include "io/FrameTimes.h"
 #include "io/cache/CacheFolder.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectParser.h"
 #include "io/preview/ColourBy.h"
 #include "io/preview/ColourMap.h"
 #include "io/preview/FrameRenderer.h"
 #include "io/preview/PinholeCamera.h"
 #include "io/preview/SceneGuides.h"
 #include "io/preview/SplatImage.h"
+#include "particles/ParticleSystem.h"
 
 namespace tickfx::io {
 namespace {
@@ -181,6 +185,43 @@ TEST(FrameRenderer, DrawsSpringsAsLinesBetweenTheirEnds) {
   EXPECT_NE(image.at(20, 32), kBlack);  // on the line, between the two splats
   EXPECT_EQ(image.at(32, 26), kBlack);  // between (0, 0, 0) and (0, 1, 0): no spring there
   EXPECT_THROW(renderFrame(camera, f, {kRed}, {}, settings), std::invalid_argument);
+}
+
+// Every particle of every frame of each sample lands inside the image of the camera framed on the
+// whole run, at the preview's default size and at a tall one.
+TEST(PinholeCamera, FramingASampleKeepsEveryParticleOfEveryFrameInside) {
+  for (const char* sample : {"fountain.toml", "flag.toml", "burst.toml"}) {
+    const LoadResult load = loadEffectFile(fs::path(TICKFX_SOURCE_DIR) / "samples" / sample);
+    ASSERT_TRUE(load.ok()) << sample;
+    std::vector<Eigen::Vector3d> points;
+    const auto system = buildOfflineSystem(*load.effect, std::nullopt);
+    FrameSchedule schedule = FrameSchedule::fixedRate(
+        load.effect->output.fps,
+        lengthOfFrames(load.effect->output.fps, load.effect->output.frameCount(), "length"));
+    while (const auto d = schedule.next()) {
+      system->advance(*d);
+      const FrameData f = captureFrame(*system, schedule.framesDone(), 0.0);
+      for (Eigen::Index r = 0; r < f.position.x.size(); ++r) {
+        points.emplace_back(f.position.x[r], f.position.y[r], f.position.z[r]);
+      }
+    }
+    ASSERT_GT(points.size(), 1000u) << sample;
+    Eigen::Vector3d lo = points[0], hi = points[0];
+    for (const auto& p : points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    for (const auto& [w, h] : {std::pair{1280, 720}, std::pair{300, 900}}) {
+      const PinholeCamera camera =
+          PinholeCamera::framing(lo, hi, Eigen::Vector3d::UnitY(), 40.0, w, h, 0.1);
+      for (const auto& p : points) {
+        const auto q = camera.project(p);
+        ASSERT_TRUE(q.has_value()) << sample;
+        ASSERT_TRUE(q->x > 0.0 && q->x < w && q->y > 0.0 && q->y < h)
+            << sample << " " << w << "x" << h << ": (" << q->x << ", " << q->y << ")";
+      }
+    }
+  }
 }
 
 class CacheFolderTest : public ::testing::Test {
