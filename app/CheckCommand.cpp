@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "app/Commands.h"
+#include "app/LoadEffect.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
 
@@ -22,8 +23,7 @@ int checkCommand(Arguments& args) {
   }
   const std::vector<std::string> overrides = args.values("--set");
   const std::string path = args.positionals(1, "one effect file: tickfx check EFFECT.toml")[0];
-  const io::LoadResult load = io::loadEffectFile(path, overrides);
-  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
+  const io::LoadResult load = loadEffectReporting(path, overrides);
   if (!load.ok()) {
     std::fprintf(stderr, "%s: %zu error(s)\n", path.c_str(), load.diagnostics.size());
     return kExitUsage;

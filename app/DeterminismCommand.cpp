@@ -13,6 +13,7 @@
 #include "app/DeterminismCheck.h"
 #include "app/DifferenceImage.h"
 #include "app/HashLogRun.h"
+#include "app/LoadEffect.h"
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
 #include "io/FrameTimes.h"
@@ -234,8 +235,7 @@ int logCommand(Arguments& args, const std::vector<std::string>& overrides,
   const std::string path =
       args.positionals(1, std::string("one effect file: tickfx determinism EFFECT.toml ") +
                               (compare ? "--compare FILE" : "--record FILE"))[0];
-  const io::LoadResult load = io::loadEffectFile(path, overrides);
-  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
+  const io::LoadResult load = loadEffectReporting(path, overrides);
   if (!load.ok()) return kExitUsage;
   return compare ? compareCommand(*load.effect, load.fingerprint, options.logPath)
                  : recordCommand(*load.effect, path, load.fingerprint, options);
@@ -275,8 +275,7 @@ int determinismCommand(Arguments& args) {
     }
   }
 
-  const io::LoadResult load = io::loadEffectFile(path, overrides);
-  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
+  const io::LoadResult load = loadEffectReporting(path, overrides);
   if (!load.ok()) return kExitUsage;
   const io::EffectSettings& effect = *load.effect;
   const Flicks total = flicksFromSeconds(seconds);

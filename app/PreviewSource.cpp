@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "app/LoadEffect.h"
 #include "io/FrameTimes.h"
 #include "io/cache/CacheFolder.h"
 #include "io/effect/EffectBuilder.h"
@@ -127,8 +128,7 @@ std::unique_ptr<PreviewSource> openPreviewSource(const std::string& path,
       return nullptr;
     }
   }
-  const io::LoadResult load = io::loadEffectFile(path, overrides);
-  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
+  const io::LoadResult load = loadEffectReporting(path, overrides);
   if (!load.ok()) return nullptr;
   try {
     return std::make_unique<EffectFrames>(*load.effect,

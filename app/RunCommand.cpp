@@ -12,6 +12,7 @@
 
 #include "app/Commands.h"
 #include "app/Interrupt.h"
+#include "app/LoadEffect.h"
 #include "app/ProgressLine.h"
 #include "io/AtomicFile.h"
 #include "io/FrameTimes.h"
@@ -239,8 +240,7 @@ int runCommand(Arguments& args) {
   const std::string effectPath = args.positionals(1, "one effect file: tickfx run EFFECT.toml")[0];
 
   // Everything that can be wrong with the request is found before anything is written.
-  const io::LoadResult load = io::loadEffectFile(effectPath, overrides);
-  for (const io::Diagnostic& d : load.diagnostics) std::fprintf(stderr, "%s\n", d.format().c_str());
+  const io::LoadResult load = loadEffectReporting(effectPath, overrides);
   if (!load.ok()) return kExitUsage;
   const io::EffectSettings& effect = *load.effect;
 
