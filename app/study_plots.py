@@ -54,6 +54,14 @@ def save(figure, directory, name):
     return path
 
 
+def titled(axes, title, xlabel, ylabel):
+    """Titles an axes, names both axes with their units, and draws a light grid."""
+    axes.set_title(title)
+    axes.set_xlabel(xlabel)
+    axes.set_ylabel(ylabel)
+    axes.grid(True, alpha=0.3)
+
+
 def constant_acceleration(directory):
     table = rows(directory, "series_constant_acceleration.csv")
     by_rate = runs(table, "step_rate_hz")
@@ -69,13 +77,8 @@ def constant_acceleration(directory):
                 exact_drawn = True
             left.plot(t, column(run, "position"), label=NAMES.get(integrator, integrator))
             right.plot(t, column(run, "error"), label=NAMES.get(integrator, integrator))
-        left.set_title(f"dt = 1/{rate} s: position")
-        right.set_title(f"dt = 1/{rate} s: error (simulated - exact)")
-        left.set_ylabel("position (m)")
-        right.set_ylabel("error (m)")
-        for a in (left, right):
-            a.set_xlabel("time (s)")
-            a.grid(True, alpha=0.3)
+        titled(left, f"dt = 1/{rate} s: position", "time (s)", "position (m)")
+        titled(right, f"dt = 1/{rate} s: error (simulated - exact)", "time (s)", "error (m)")
         right.legend(fontsize="small")
     figure.tight_layout(rect=(0, 0, 1, 0.98))
     return save(figure, directory, "constant_acceleration.png")
@@ -97,23 +100,15 @@ def oscillator(directory):
             position.plot(t, column(run, "position"), label=label)
             energy.plot(t, column(run, "energy"), label=label)
             phase.plot(column(run, "position"), column(run, "velocity"), label=label)
-        position.set_title(f"dt = 1/{rate} s: position")
-        position.set_xlabel("time (s)")
-        position.set_ylabel("position (m)")
-        energy.set_title(f"dt = 1/{rate} s: energy")
-        energy.set_xlabel("time (s)")
-        energy.set_ylabel("energy (J)")
+        titled(position, f"dt = 1/{rate} s: position", "time (s)", "position (m)")
+        titled(energy, f"dt = 1/{rate} s: energy", "time (s)", "energy (J)")
         energy.axhline(0.5, color="black", linewidth=3, alpha=0.3, label="exact")
         energy.set_yscale("log")
-        phase.set_title(f"dt = 1/{rate} s: phase portrait")
-        phase.set_xlabel("position (m)")
-        phase.set_ylabel("velocity (m/s)")
+        titled(phase, f"dt = 1/{rate} s: phase portrait", "position (m)", "velocity (m/s)")
         circle = plt.Circle((0, 0), 1.0, fill=False, color="black", linewidth=3, alpha=0.3,
                             label="exact")
         phase.add_patch(circle)
         phase.set_aspect("equal", adjustable="datalim")
-        for a in (position, energy, phase):
-            a.grid(True, alpha=0.3)
         energy.legend(fontsize="small")
     figure.tight_layout(rect=(0, 0, 1, 0.96))
     return save(figure, directory, "oscillator.png")
@@ -137,12 +132,10 @@ def wind(directory):
         p = column(run, "position")
         position.plot(t, p, marker="." if int(rate) < 100 else None, label=f"{rate} Hz")
         error.plot(t, [a - b for a, b in zip(p, column(run, "exact"))], label=f"{rate} Hz")
-    position.set_title(f"position: the {frequency} Hz wind seen at each step rate")
-    error.set_title("error (simulated - exact)")
-    for a, unit in ((position, "position (m)"), (error, "error (m)")):
-        a.set_xlabel("time (s)")
-        a.set_ylabel(unit)
-        a.grid(True, alpha=0.3)
+    titled(position, f"position: the {frequency} Hz wind seen at each step rate", "time (s)",
+          "position (m)")
+    titled(error, "error (simulated - exact)", "time (s)", "error (m)")
+    for a in (position, error):
         a.legend(fontsize="small")
     figure.tight_layout(rect=(0, 0, 1, 0.95))
     return save(figure, directory, "wind.png")
