@@ -80,6 +80,11 @@ void Vec3Column::conservativeResize(Eigen::Index rows) {
   z.conservativeResize(rows);
 }
 
+void Vec3Column::copyRows(const Vec3Column& from, std::size_t begin, std::size_t end) {
+  const auto i = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
+  for (int c = 0; c < 3; ++c) (*this)[c].segment(i, n) = from[c].segment(i, n);
+}
+
 ParticlePool::ParticlePool(std::size_t maxParticles) : maxParticles_(maxParticles) {
   if (maxParticles >= (std::size_t{1} << 32)) {
     // Row indices are 32-bit in the compaction and in the spring tables.

@@ -27,6 +27,8 @@ struct Vec3Column {
 
   void resize(Eigen::Index rows);
   void conservativeResize(Eigen::Index rows);
+  /// Copies rows [begin, end) of `from` into the same rows here, component by component.
+  void copyRows(const Vec3Column& from, std::size_t begin, std::size_t end);
 };
 
 /// Everything a new particle starts with. Units: metres, metres per second, seconds, kilograms.

@@ -132,22 +132,17 @@ struct ParticleSystem::FrameStart {
     if (withPrevious) grow(previous);
     if (pool.keepsAcceleration()) grow(acceleration);
   }
-  // Copies rows [b, e) from `from` to `to`, column by column.
-  static void copy(const Vec3Column& from, Vec3Column& to, std::size_t b, std::size_t e) {
-    const auto i = static_cast<Eigen::Index>(b), n = static_cast<Eigen::Index>(e - b);
-    for (int c = 0; c < 3; ++c) to[c].segment(i, n) = from[c].segment(i, n);
-  }
-  // copy() with stores that bypass the cache where the machine has them, for a pool larger than
-  // the caches: the copy is read back only when a frame goes non-finite, so caching it would
-  // first read the lines it overwrites (a third more memory traffic for the frame's first tick)
-  // and evict the rows being stepped. A smaller pool and its copy stay in cache, where plain
+  // Vec3Column::copyRows with stores that bypass the cache where the machine has them, for a pool
+  // larger than the caches: the copy is read back only when a frame goes non-finite, so caching it
+  // would first read the lines it overwrites (a third more memory traffic for the frame's first
+  // tick) and evict the rows being stepped. A smaller pool and its copy stay in cache, where plain
   // stores are cheaper than a trip to memory.
   bool streamed = false;
 
   void store(const Vec3Column& from, Vec3Column& to, std::size_t b, std::size_t e) {
 #if defined(__SSE2__)
     if (!streamed) {
-      copy(from, to, b, e);
+      to.copyRows(from, b, e);
       return;
     }
     for (int c = 0; c < 3; ++c) {
@@ -160,7 +155,7 @@ struct ParticleSystem::FrameStart {
     }
     _mm_sfence();  // ordered before the frame's end, like any other store
 #else
-    copy(from, to, b, e);
+    to.copyRows(from, b, e);
 #endif
   }
   // The state a tick reads: the previous position only for a scheme that reads it (the others
@@ -174,10 +169,10 @@ struct ParticleSystem::FrameStart {
     if (pool.keepsAcceleration()) store(pool.acceleration(), acceleration, b, e);
   }
   void restore(ParticlePool& pool, std::size_t b, std::size_t e) const {
-    copy(position, pool.position(), b, e);
-    copy(velocity, pool.velocity(), b, e);
-    if (withPrevious) copy(previous, pool.previousPosition(), b, e);
-    if (pool.keepsAcceleration()) copy(acceleration, pool.acceleration(), b, e);
+    pool.position().copyRows(position, b, e);
+    pool.velocity().copyRows(velocity, b, e);
+    if (withPrevious) pool.previousPosition().copyRows(previous, b, e);
+    if (pool.keepsAcceleration()) pool.acceleration().copyRows(acceleration, b, e);
   }
 };
 
@@ -240,7 +235,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
     }
     for (std::int64_t j = block.firstTick; j < ticks; ++j) {
       if (keepVelocities && j == ticks - 1) {
-        FrameStart::copy(pool_.velocity(), previousVelocity_, block.begin, block.end);
+        previousVelocity_.copyRows(pool_.velocity(), block.begin, block.end);
       }
       // A block is fresh from the row the pool had stepped (the first tick) or whole (a birth
       // tick), then stepped.
