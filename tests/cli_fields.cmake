@@ -3,9 +3,6 @@
 # writes a scalar grid with OpenVDB itself (VDB_TEST_DATA, see CMakeLists.txt); everything
 # goes into a temporary directory.
 if(TARGET tickfx_cli AND TARGET tickfx_vdb)
-  tickfx_add_test(test_cli_fields ${CMAKE_CURRENT_SOURCE_DIR}/test_cli_fields.cpp
+  tickfx_add_cli_test(test_cli_fields ${CMAKE_CURRENT_SOURCE_DIR}/test_cli_fields.cpp
     LIBS tickfx::vdb VDB_TEST_DATA)
-  target_compile_definitions(test_cli_fields PRIVATE
-    TICKFX_CLI="$<TARGET_FILE:tickfx_cli>" TICKFX_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  add_dependencies(test_cli_fields tickfx_cli)
 endif()

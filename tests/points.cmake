@@ -11,12 +11,9 @@ if(TARGET tickfx_io)
     LIBS tickfx::io VDB_TEST_DATA)
 endif()
 if(TARGET tickfx_cli)
-  tickfx_add_test(test_points_cli ${CMAKE_CURRENT_SOURCE_DIR}/test_points_cli.cpp
+  tickfx_add_cli_test(test_points_cli ${CMAKE_CURRENT_SOURCE_DIR}/test_points_cli.cpp
     LIBS tickfx::io)
-  target_compile_definitions(test_points_cli PRIVATE
-    TICKFX_CLI="$<TARGET_FILE:tickfx_cli>" TICKFX_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    TICKFX_VERSION="${PROJECT_VERSION}")
-  add_dependencies(test_points_cli tickfx_cli)
+  target_compile_definitions(test_points_cli PRIVATE TICKFX_VERSION="${PROJECT_VERSION}")
   # vdb_print (Debian package libopenvdb-tools, one of scripts/common.sh's packages) lists the
   # caches. Its test is always built: without the tool it fails and names the package, instead of
   # dropping out of the suite unseen.
