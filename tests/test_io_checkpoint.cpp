@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
+#include "LittleEndianBytes.h"
 #include "fields/Gravity.h"
 #include "io/cache/Checkpoint.h"
 #include "io/effect/EffectParser.h"
@@ -119,19 +120,9 @@ void writeBytes(const fs::path& path, const std::string& bytes) {
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
-std::uint64_t loadU64(const std::string& bytes, std::size_t at) {
-  std::uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
-  return v;
-}
-
-void storeU64(std::string& bytes, std::size_t at, std::uint64_t v) {
-  for (int i = 0; i < 8; ++i) bytes[at + i] = static_cast<char>((v >> (8 * i)) & 0xff);
-}
-
-void storeU32(std::string& bytes, std::size_t at, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<char>((v >> (8 * i)) & 0xff);
-}
+using test::loadU64;
+using test::storeU32;
+using test::storeU64;
 
 // Makes an edited file self-consistent again (length and checksum), so that only the edit is
 // wrong with it.

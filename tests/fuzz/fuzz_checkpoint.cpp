@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../LittleEndianBytes.h"
 #include "FuzzScratch.h"
 #include "io/Fingerprint.h"
 #include "io/cache/Checkpoint.h"
@@ -91,9 +92,7 @@ std::uint64_t everythingRestored(const tickfx::ParticleSystem& system) {
   return h;
 }
 
-void storeU64(std::string& bytes, std::size_t at, std::uint64_t v) {
-  for (int i = 0; i < 8; ++i) bytes[at + i] = static_cast<char>((v >> (8 * i)) & 0xff);
-}
+using tickfx::test::storeU64;
 
 }  // namespace
 
