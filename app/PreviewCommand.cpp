@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -327,6 +328,7 @@ int previewCommand(Arguments& args) {
   // Second walk: the frames asked for.
   ProgressLine progress("frames");
   std::int64_t written = 0;
+  std::future<void> encoding;
   source->walk(last, wanted, [&](const io::FrameData& frame, const IdPairs& lines) {
     const std::int64_t f = frame.frame;
     io::SplatImage image = render(*camera, frame, lines);
@@ -339,9 +341,15 @@ int previewCommand(Arguments& args) {
     if (legend) {
       io::drawLegend(image, colour.title(), extent.valueLo, extent.valueHi, textScale);
     }
-    image.writePng(io::cacheFilePath(outDir, f, "png"));
-    if (gif) gif->add(image);
-    if (movie) movie->add(image);
+    // The previous frame's PNG (and flipbook frame) is encoded on a thread of its own while this
+    // one simulates and renders: one frame in flight, so files and flipbook frames keep their
+    // order.
+    if (encoding.valid()) encoding.get();
+    encoding = std::async(std::launch::async, [&, f, done = std::move(image)] {
+      done.writePng(io::cacheFilePath(outDir, f, "png"));
+      if (gif) gif->add(done);
+      if (movie) movie->add(done);
+    });
     if (sheet && written % sheetStride == 0) {
       const std::int64_t cell = written / sheetStride;
       io::SplatImage small = render(*cellCamera, frame, lines);
@@ -356,6 +364,7 @@ int previewCommand(Arguments& args) {
     progress.update(written, rendered, static_cast<double>(written) / static_cast<double>(rendered),
                     io::cacheFilePath(outDir, f, "png").string());
   });
+  if (encoding.valid()) encoding.get();
   progress.finish();
   if (sheet) sheet->writePng(outDir / "sheet.png");
   if (gif) gif->write(outDir / "flipbook.gif");

@@ -21,6 +21,13 @@ constexpr int kBandRows = 16;
 // pixel across its edge.
 float cover(float d, float radius) { return std::clamp(radius + 0.5f - d, 0.0f, 1.0f); }
 
+// A blended value as a byte: rounded to nearest, halves up (std::lround's rounding for the
+// non-negative values an image holds; NaN, never produced, as 0), without lround's library call.
+std::uint8_t toByte(float v) {
+  const double held = v > 0.0f ? std::min(static_cast<double>(v), 255.0) : 0.0;
+  return static_cast<std::uint8_t>(held + 0.5);
+}
+
 }  // namespace
 
 SplatImage::SplatImage(int width, int height, Rgb background) : width_(width), height_(height) {
@@ -126,22 +133,17 @@ Rgb SplatImage::at(int x, int y) const {
   const float* p = &rgb_[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
                           static_cast<std::size_t>(x)) *
                          3];
-  Rgb out{};
-  for (int c = 0; c < 3; ++c) {
-    out[c] = static_cast<std::uint8_t>(std::clamp(std::lround(p[c]), 0L, 255L));
-  }
-  return out;
+  return {toByte(p[0]), toByte(p[1]), toByte(p[2])};
 }
 
 std::vector<std::uint8_t> SplatImage::png() const {
-  std::vector<std::uint8_t> rows(static_cast<std::size_t>(width_) * height_ * 3);
-  for (int y = 0; y < height_; ++y) {
-    for (int x = 0; x < width_; ++x) {
-      const Rgb c = at(x, y);
-      std::copy(c.begin(), c.end(),
-                rows.begin() + (static_cast<std::ptrdiff_t>(y) * width_ + x) * 3);
-    }
-  }
+  // Each value rounded as at() rounds it, rows in parallel (each row's bytes are its own).
+  std::vector<std::uint8_t> rows(rgb_.size());
+  tbb::parallel_for(0, height_, [&](int y) {
+    const std::size_t begin = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 3;
+    const std::size_t end = begin + static_cast<std::size_t>(width_) * 3;
+    for (std::size_t i = begin; i < end; ++i) rows[i] = toByte(rgb_[i]);
+  });
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {
@@ -163,6 +165,11 @@ std::vector<std::uint8_t> SplatImage::png() const {
   png_set_IHDR(png, info, static_cast<png_uint_32>(width_), static_cast<png_uint_32>(height_), 8,
                PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
+  // One filter for every row (Sub: a run of flat background becomes zeros) instead of libpng's
+  // trial of all five a row, and zlib's level 3 instead of 6: a fountain preview frame encodes
+  // in about a quarter of the time, in a fifth more bytes (render_bench measures the stage).
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+  png_set_compression_level(png, 3);
   png_write_info(png, info);
   for (int y = 0; y < height_; ++y) {
     png_write_row(png, rows.data() + static_cast<std::size_t>(y) * width_ * 3);
