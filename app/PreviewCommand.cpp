@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <future>
 #include <limits>
 #include <optional>
@@ -150,6 +151,155 @@ class OutputFolder {
   bool made_ = false;
 };
 
+// Everything the command line asks for, read and checked before anything runs.
+struct PreviewOptions {
+  std::string input;
+  std::vector<std::string> overrides;
+  std::filesystem::path out;
+  Size size;
+  std::string colour;
+  std::optional<std::string> frames;
+  long long every = 1;
+  io::SplatSize splatSize;
+  std::optional<Eigen::Vector3d> eye, target;
+  double fov = 40.0;
+  io::UpAxis up = io::UpAxis::Y;
+  bool guides = true;
+  bool sheet = false;
+  bool gif = false;
+  std::optional<std::filesystem::path> ffmpeg;  // --mp4
+
+  // The camera at --camera looking at `look`; a camera that sees nothing is a usage error.
+  io::PinholeCamera cameraAt(const Eigen::Vector3d& look, int width, int height) const {
+    try {
+      return io::PinholeCamera(*eye, look, io::upVector(up), fov, width, height);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("preview: --camera: ") + e.what());
+    }
+  }
+};
+
+PreviewOptions readOptions(Arguments& args) {
+  PreviewOptions o;
+  o.overrides = args.values("--set");
+  o.out = args.value("--out").value_or("out/preview");
+  o.size = parseSize(args.value("--size").value_or("1280x720"));
+  o.colour = args.value("--color").value_or("speed");
+  o.frames = args.value("--frames");
+  o.every = parseInteger(args.value("--every").value_or("1"), "preview: --every", 1, 1'000'000);
+  const auto pointSize = args.value("--point-size");
+  const auto radius = args.value("--radius");
+  const auto eye = args.value("--camera");
+  const auto lookat = args.value("--lookat");
+  o.fov = parseNumber(args.value("--fov").value_or("40"), "preview: --fov", 1.0, 170.0);
+  o.up = parseUp(args.value("--up").value_or("y"));
+  o.guides = !args.flag("--no-guides");
+  o.sheet = args.flag("--sheet");
+  o.gif = args.flag("--gif");
+  const bool mp4 = args.flag("--mp4");
+  o.input = args.positionals(1, "one effect file or cache folder: tickfx preview EFFECT.toml")[0];
+
+  if (pointSize && radius) {
+    throw UsageError("preview: --point-size and --radius each set the splat size: give one");
+  }
+  if (pointSize) {
+    o.splatSize.diameterPixels =
+        static_cast<double>(parseInteger(*pointSize, "preview: --point-size", 1, 100));
+  }
+  if (radius) o.splatSize.radiusMetres = parseNumber(*radius, "preview: --radius", 1e-6, 1e6);
+  if (lookat && !eye) {
+    throw UsageError("preview: --lookat needs --camera (without it the camera frames the run)");
+  }
+  if (eye) o.eye = parsePoint("--camera", eye);
+  if (lookat) o.target = parsePoint("--lookat", lookat);
+  if (o.eye && o.target) o.cameraAt(*o.target, o.size.width, o.size.height);
+  if (mp4) {
+    o.ffmpeg = io::findFfmpeg();
+    if (!o.ffmpeg) {
+      throw UsageError(
+          "preview: --mp4 needs ffmpeg, which is not installed (Debian: apt-get install ffmpeg; "
+          "--gif needs nothing more)");
+    }
+  }
+  return o;
+}
+
+// The contact sheet: every rendered frame (every stride-th past 64) in cells a quarter the size,
+// four a row.
+class ContactSheet {
+ public:
+  ContactSheet(std::int64_t rendered, Size size) {
+    rendered = std::max<std::int64_t>(rendered, 1);
+    stride_ = (rendered + kSheetCells - 1) / kSheetCells;
+    cells_ = (rendered + stride_ - 1) / stride_;
+    cellWidth_ = std::max(1, size.width / 4);
+    cellHeight_ = std::max(1, size.height / 4);
+    columns_ = static_cast<int>(std::min<std::int64_t>(4, cells_));
+    const std::int64_t rows = (cells_ + columns_ - 1) / columns_;
+    if (rows * cellHeight_ > io::SplatImage::kMaxSide) {
+      throw UsageError("preview: --sheet: " + std::to_string(cells_) +
+                       " frames make a sheet too tall (use a smaller --size or a larger --every)");
+    }
+    image_.emplace(columns_ * cellWidth_, static_cast<int>(rows) * cellHeight_, kBackground);
+  }
+
+  // Whether the index-th rendered frame has a cell.
+  bool takes(std::int64_t index) const { return index % stride_ == 0; }
+  // Copies `cell` (cellWidth × cellHeight) into the index-th rendered frame's cell.
+  void place(std::int64_t index, const io::SplatImage& cell) {
+    const std::int64_t at = index / stride_;
+    const int x0 = static_cast<int>(at % columns_) * cellWidth_;
+    const int y0 = static_cast<int>(at / columns_) * cellHeight_;
+    for (int y = 0; y < cellHeight_; ++y) {
+      for (int x = 0; x < cellWidth_; ++x) image_->set(x0 + x, y0 + y, cell.at(x, y));
+    }
+  }
+  const io::SplatImage& image() const { return *image_; }
+  std::int64_t cells() const { return cells_; }
+  int cellWidth() const { return cellWidth_; }
+  int cellHeight() const { return cellHeight_; }
+
+ private:
+  std::int64_t stride_ = 1, cells_ = 1;
+  int cellWidth_ = 1, cellHeight_ = 1, columns_ = 1;
+  std::optional<io::SplatImage> image_;
+};
+
+// The first walk: the whole run's extent (for a camera that holds still and one colour range),
+// and how many frames `wanted` takes.
+RunExtent scanRun(PreviewSource& source, const io::ColourBy& colour,
+                  const std::function<bool(std::int64_t)>& wanted, std::int64_t& rendered) {
+  RunExtent extent;
+  ProgressLine progress("frames (framing)");
+  const auto total = static_cast<std::int64_t>(source.frames().size());
+  std::int64_t done = 0;
+  source.walk(
+      source.frames().back(), [](std::int64_t) { return true; },
+      [&](const io::FrameData& frame, const IdPairs&) {
+        extent.add(frame, colour.values(frame));
+        rendered += wanted(frame.frame) ? 1 : 0;
+        ++done;
+        progress.update(done, total, static_cast<double>(done) / static_cast<double>(total), "");
+      });
+  if (!(extent.lo.x() <= extent.hi.x())) extent.lo = extent.hi = Eigen::Vector3d::Zero();
+  if (!(extent.valueLo <= extent.valueHi)) extent.valueLo = extent.valueHi = 0.0;
+  return extent;
+}
+
+// "NAME  frame F  t = T s  N particles  grid G m": what each frame says in its corner.
+std::string captionOf(const PreviewSource& source, const io::FrameData& frame,
+                      const io::RenderSettings& settings) {
+  char time[48] = "";
+  if (source.knowsTimes()) std::snprintf(time, sizeof time, "  t = %.3f s", frame.timeSeconds);
+  // The grid's spacing: the scale at a glance.
+  char grid[48] = "";
+  if (settings.grid) std::snprintf(grid, sizeof grid, "  grid %g m", settings.grid->spacing);
+  char caption[320];
+  std::snprintf(caption, sizeof caption, "%s  frame %" PRId64 "%s  %zu particles%s",
+                source.name().c_str(), frame.frame, time, frame.size(), grid);
+  return caption;
+}
+
 }  // namespace
 
 int previewCommand(Arguments& args) {
@@ -157,86 +307,35 @@ int previewCommand(Arguments& args) {
     std::fputs(kPreviewHelp, stdout);
     return kExitOk;
   }
-  const std::vector<std::string> overrides = args.values("--set");
-  const std::filesystem::path outDir = args.value("--out").value_or("out/preview");
-  const Size size = parseSize(args.value("--size").value_or("1280x720"));
-  const std::string colourName = args.value("--color").value_or("speed");
-  const auto framesOption = args.value("--frames");
-  const long long every =
-      parseInteger(args.value("--every").value_or("1"), "preview: --every", 1, 1'000'000);
-  const auto pointSizeOption = args.value("--point-size");
-  const auto radiusOption = args.value("--radius");
-  const auto eyeOption = args.value("--camera");
-  const auto lookatOption = args.value("--lookat");
-  const double fov = parseNumber(args.value("--fov").value_or("40"), "preview: --fov", 1.0, 170.0);
-  const io::UpAxis up = parseUp(args.value("--up").value_or("y"));
-  const bool guides = !args.flag("--no-guides");
-  const bool wantSheet = args.flag("--sheet");
-  const bool wantGif = args.flag("--gif");
-  const bool wantMp4 = args.flag("--mp4");
-  const std::string input =
-      args.positionals(1, "one effect file or cache folder: tickfx preview EFFECT.toml")[0];
-
-  io::SplatSize splatSize;
-  if (pointSizeOption && radiusOption) {
-    throw UsageError("preview: --point-size and --radius each set the splat size: give one");
-  }
-  if (pointSizeOption) {
-    splatSize.diameterPixels =
-        static_cast<double>(parseInteger(*pointSizeOption, "preview: --point-size", 1, 100));
-  }
-  if (radiusOption)
-    splatSize.radiusMetres = parseNumber(*radiusOption, "preview: --radius", 1e-6, 1e6);
-  if (lookatOption && !eyeOption) {
-    throw UsageError("preview: --lookat needs --camera (without it the camera frames the run)");
-  }
-  const std::optional<Eigen::Vector3d> eye =
-      eyeOption ? std::optional(parsePoint("--camera", eyeOption)) : std::nullopt;
-  const std::optional<Eigen::Vector3d> target =
-      lookatOption ? std::optional(parsePoint("--lookat", lookatOption)) : std::nullopt;
-  const auto cameraAt = [&](const Eigen::Vector3d& look, int width, int height) {
-    try {
-      return io::PinholeCamera(*eye, look, io::upVector(up), fov, width, height);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("preview: --camera: ") + e.what());
-    }
-  };
-  if (eye && target) cameraAt(*target, size.width, size.height);  // refused before running
-  std::optional<std::filesystem::path> ffmpeg;
-  if (wantMp4) {
-    ffmpeg = io::findFfmpeg();
-    if (!ffmpeg) {
-      throw UsageError(
-          "preview: --mp4 needs ffmpeg, which is not installed (Debian: apt-get install ffmpeg; "
-          "--gif needs nothing more)");
-    }
-  }
-
-  const std::unique_ptr<PreviewSource> source = openPreviewSource(input, overrides);
+  const PreviewOptions options = readOptions(args);
+  const std::unique_ptr<PreviewSource> source = openPreviewSource(options.input, options.overrides);
   if (!source) return kExitUsage;
-  const bool folder = std::filesystem::is_directory(input);
-  if (folder && !overrides.empty()) {
-    throw UsageError("preview: --set changes an effect file; " + input + " is a cache folder");
+  const bool folder = std::filesystem::is_directory(options.input);
+  if (folder && !options.overrides.empty()) {
+    throw UsageError("preview: --set changes an effect file; " + options.input +
+                     " is a cache folder");
   }
   const io::ColourBy colour = [&] {
     try {
-      return io::ColourBy::parse(colourName, source->sample());
+      return io::ColourBy::parse(options.colour, source->sample());
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("preview: --color: ") + e.what());
     }
   }();
-  const std::vector<std::int64_t>& available = source->frames();
-  std::int64_t first = available.front(), last = available.back();
-  if (framesOption) {
-    const UsageError refused("preview: --frames: '" + *framesOption +
+  std::int64_t first = source->frames().front(), last = source->frames().back();
+  if (options.frames) {
+    const UsageError refused("preview: --frames: '" + *options.frames +
                              "' is not a range A..B of this " + (folder ? "folder's" : "effect's") +
                              " frames (" + std::to_string(first) + ".." + std::to_string(last) +
                              ")");
-    std::tie(first, last) = parseRange(*framesOption, first, last, refused);
+    std::tie(first, last) = parseRange(*options.frames, first, last, refused);
   }
+  const long long every = options.every;
   const auto wanted = [&](std::int64_t f) {
     return f >= first && f <= last && (f - first) % every == 0;
   };
+  const std::filesystem::path& outDir = options.out;
+  const Size size = options.size;
 
   std::optional<OutputFolder> out;
   try {
@@ -248,33 +347,22 @@ int previewCommand(Arguments& args) {
     return kExitUsage;
   }
 
-  // First walk: the whole run's extent, for a camera that holds still and one colour range.
-  RunExtent extent;
   std::int64_t rendered = 0;
-  {
-    ProgressLine progress("frames (framing)");
-    const auto total = static_cast<std::int64_t>(available.size());
-    std::int64_t done = 0;
-    source->walk(
-        available.back(), [](std::int64_t) { return true; },
-        [&](const io::FrameData& frame, const IdPairs&) {
-          extent.add(frame, colour.values(frame));
-          rendered += wanted(frame.frame) ? 1 : 0;
-          ++done;
-          progress.update(done, total, static_cast<double>(done) / static_cast<double>(total), "");
-        });
-  }
-  if (!(extent.lo.x() <= extent.hi.x())) extent.lo = extent.hi = Eigen::Vector3d::Zero();
-  if (!(extent.valueLo <= extent.valueHi)) extent.valueLo = extent.valueHi = 0.0;
+  const RunExtent extent = scanRun(*source, colour, wanted, rendered);
   const Eigen::Vector3d centre = 0.5 * (extent.lo + extent.hi);
   const auto cameraFor = [&](int width, int height) {
-    return eye ? cameraAt(target.value_or(centre), width, height)
-               : io::PinholeCamera::framing(extent.lo, extent.hi, io::upVector(up), fov, width,
-                                            height, kFramingMargin);
+    return options.eye ? options.cameraAt(options.target.value_or(centre), width, height)
+                       : io::PinholeCamera::framing(extent.lo, extent.hi, io::upVector(options.up),
+                                                    options.fov, width, height, kFramingMargin);
   };
-  std::optional<io::PinholeCamera> camera;
+  std::optional<io::PinholeCamera> camera, cellCamera;
+  std::optional<ContactSheet> sheet;
   try {
     camera.emplace(cameraFor(size.width, size.height));
+    if (options.sheet) {
+      sheet.emplace(rendered, size);
+      cellCamera.emplace(cameraFor(sheet->cellWidth(), sheet->cellHeight()));
+    }
   } catch (const UsageError&) {
     out->abandon();
     throw;
@@ -282,48 +370,24 @@ int previewCommand(Arguments& args) {
 
   io::RenderSettings settings;
   settings.background = kBackground;
-  settings.size = splatSize;
-  if (guides) {
-    settings.grid = io::GroundGrid::under(extent.lo, extent.hi, up);
+  settings.size = options.splatSize;
+  if (options.guides) {
+    settings.grid = io::GroundGrid::under(extent.lo, extent.hi, options.up);
     settings.axisLength = settings.grid->spacing;
   }
-  const bool legend = guides && !colour.ownColours();
-  // The grid's spacing in the caption: the scale at a glance.
-  char gridNote[48] = "";
-  if (settings.grid)
-    std::snprintf(gridNote, sizeof gridNote, "  grid %g m", settings.grid->spacing);
+  const bool legend = options.guides && !colour.ownColours();
   const int textScale = size.width >= 640 ? 2 : 1;
   const auto render = [&](const io::PinholeCamera& view, const io::FrameData& frame,
                           const IdPairs& lines) {
     return io::renderFrame(view, frame, colour.colours(frame, extent.valueLo, extent.valueHi),
                            lines, settings);
   };
-
-  // The sheet: every rendered frame (every sheetStride-th past 64), in cells a quarter the size.
-  rendered = std::max<std::int64_t>(rendered, 1);
-  const std::int64_t sheetStride = (rendered + kSheetCells - 1) / kSheetCells;
-  const std::int64_t cells = (rendered + sheetStride - 1) / sheetStride;
-  const int cellWidth = std::max(1, size.width / 4), cellHeight = std::max(1, size.height / 4);
-  const int columns = static_cast<int>(std::min<std::int64_t>(4, cells));
-  const int rows = static_cast<int>((cells + columns - 1) / columns);
-  std::optional<io::SplatImage> sheet;
-  std::optional<io::PinholeCamera> cellCamera;
-  if (wantSheet) {
-    if (static_cast<std::int64_t>(rows) * cellHeight > io::SplatImage::kMaxSide) {
-      out->abandon();
-      throw UsageError("preview: --sheet: " + std::to_string(cells) +
-                       " frames make a sheet too tall (use a smaller --size or a larger --every)");
-    }
-    sheet.emplace(columns * cellWidth, rows * cellHeight, kBackground);
-    cellCamera.emplace(cameraFor(cellWidth, cellHeight));
-  }
   std::optional<io::GifFlipbook> gif;
-  if (wantGif) {
-    gif.emplace(size.width, size.height, io::GifFlipbook::delayFor(source->fps()));
-  }
+  if (options.gif) gif.emplace(size.width, size.height, io::GifFlipbook::delayFor(source->fps()));
   std::optional<io::FfmpegMovie> movie;
-  if (ffmpeg)
-    movie.emplace(*ffmpeg, outDir / "flipbook.mp4", size.width, size.height, source->fps());
+  if (options.ffmpeg) {
+    movie.emplace(*options.ffmpeg, outDir / "flipbook.mp4", size.width, size.height, source->fps());
+  }
 
   // Second walk: the frames asked for.
   ProgressLine progress("frames");
@@ -332,15 +396,8 @@ int previewCommand(Arguments& args) {
   source->walk(last, wanted, [&](const io::FrameData& frame, const IdPairs& lines) {
     const std::int64_t f = frame.frame;
     io::SplatImage image = render(*camera, frame, lines);
-    char time[48] = "";
-    if (source->knowsTimes()) std::snprintf(time, sizeof time, "  t = %.3f s", frame.timeSeconds);
-    char label[256];
-    std::snprintf(label, sizeof label, "%s  frame %" PRId64 "%s  %zu particles%s",
-                  source->name().c_str(), f, time, frame.size(), gridNote);
-    io::drawCaption(image, label, textScale);
-    if (legend) {
-      io::drawLegend(image, colour.title(), extent.valueLo, extent.valueHi, textScale);
-    }
+    io::drawCaption(image, captionOf(*source, frame, settings), textScale);
+    if (legend) io::drawLegend(image, colour.title(), extent.valueLo, extent.valueHi, textScale);
     // The previous frame's PNG (and flipbook frame) is encoded on a thread of its own while this
     // one simulates and renders: one frame in flight, so files and flipbook frames keep their
     // order.
@@ -350,15 +407,10 @@ int previewCommand(Arguments& args) {
       if (gif) gif->add(done);
       if (movie) movie->add(done);
     });
-    if (sheet && written % sheetStride == 0) {
-      const std::int64_t cell = written / sheetStride;
-      io::SplatImage small = render(*cellCamera, frame, lines);
-      io::drawCaption(small, "frame " + std::to_string(f), 1);
-      const int x0 = static_cast<int>(cell % columns) * cellWidth;
-      const int y0 = static_cast<int>(cell / columns) * cellHeight;
-      for (int y = 0; y < cellHeight; ++y) {
-        for (int x = 0; x < cellWidth; ++x) sheet->set(x0 + x, y0 + y, small.at(x, y));
-      }
+    if (sheet && sheet->takes(written)) {
+      io::SplatImage cell = render(*cellCamera, frame, lines);
+      io::drawCaption(cell, "frame " + std::to_string(f), 1);
+      sheet->place(written, cell);
     }
     ++written;
     progress.update(written, rendered, static_cast<double>(written) / static_cast<double>(rendered),
@@ -366,7 +418,7 @@ int previewCommand(Arguments& args) {
   });
   if (encoding.valid()) encoding.get();
   progress.finish();
-  if (sheet) sheet->writePng(outDir / "sheet.png");
+  if (sheet) sheet->image().writePng(outDir / "sheet.png");
   if (gif) gif->write(outDir / "flipbook.gif");
   if (movie) {
     try {
@@ -376,12 +428,13 @@ int previewCommand(Arguments& args) {
       return kExitFailure;
     }
   }
-  std::printf(
-      "%s: %" PRId64 " frames rendered to %s (%dx%d), frames %" PRId64 "..%" PRId64 " every %lld\n",
-      input.c_str(), written, outDir.string().c_str(), size.width, size.height, first, last, every);
+  std::printf("%s: %" PRId64 " frames rendered to %s (%dx%d), frames %" PRId64 "..%" PRId64
+              " every %lld\n",
+              options.input.c_str(), written, outDir.string().c_str(), size.width, size.height,
+              first, last, every);
   if (sheet) {
     std::printf("sheet: %s (%" PRId64 " frames, %dx%d cells)\n", (outDir / "sheet.png").c_str(),
-                cells, cellWidth, cellHeight);
+                sheet->cells(), sheet->cellWidth(), sheet->cellHeight());
   }
   if (gif) {
     std::printf("flipbook: %s (%zu frames, %d/100 s each)\n", (outDir / "flipbook.gif").c_str(),
