@@ -95,36 +95,33 @@ Reduced reduce(double x) {
   return {r, static_cast<std::int64_t>(k)};
 }
 
+// sin(q·π/2 + r) for |r| ≤ π/4: a quadrant's turn swaps the kernels and their signs. cos(x) is
+// sin(x + π/2), the next quadrant, so every function below takes its values from here.
+double sinInQuadrant(std::int64_t q, double r) {
+  switch (q & 3) {
+    case 0:
+      return sinKernel(r);
+    case 1:
+      return cosKernel(r);
+    case 2:
+      return -sinKernel(r);
+    default:
+      return -cosKernel(r);
+  }
+}
+
 }  // namespace
 
 double sin(double x) {
   if (!std::isfinite(x)) return std::nan("");
   const Reduced red = reduce(x);
-  switch (red.quadrant & 3) {
-    case 0:
-      return sinKernel(red.r);
-    case 1:
-      return cosKernel(red.r);
-    case 2:
-      return -sinKernel(red.r);
-    default:
-      return -cosKernel(red.r);
-  }
+  return sinInQuadrant(red.quadrant, red.r);
 }
 
 double cos(double x) {
   if (!std::isfinite(x)) return std::nan("");
   const Reduced red = reduce(x);
-  switch (red.quadrant & 3) {
-    case 0:
-      return cosKernel(red.r);
-    case 1:
-      return -sinKernel(red.r);
-    case 2:
-      return -cosKernel(red.r);
-    default:
-      return sinKernel(red.r);
-  }
+  return sinInQuadrant(red.quadrant + 1, red.r);
 }
 
 void sincos(double x, double& sine, double& cosine) {
@@ -133,26 +130,8 @@ void sincos(double x, double& sine, double& cosine) {
     return;
   }
   const Reduced red = reduce(x);
-  const double s = sinKernel(red.r);
-  const double c = cosKernel(red.r);
-  switch (red.quadrant & 3) {
-    case 0:
-      sine = s;
-      cosine = c;
-      return;
-    case 1:
-      sine = c;
-      cosine = -s;
-      return;
-    case 2:
-      sine = -s;
-      cosine = -c;
-      return;
-    default:
-      sine = -c;
-      cosine = s;
-      return;
-  }
+  sine = sinInQuadrant(red.quadrant, red.r);
+  cosine = sinInQuadrant(red.quadrant + 1, red.r);
 }
 
 double cbrt(double x) {
