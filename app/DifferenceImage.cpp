@@ -68,7 +68,7 @@ io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
       io::PinholeCamera::framing(lo, hi, io::upVector(io::UpAxis::Y), 40.0, width, height, 0.1);
   io::RenderSettings settings;
   settings.grid = io::GroundGrid::under(lo, hi, io::UpAxis::Y);
-  settings.axisLength = settings.grid->spacing;
+  if (settings.grid) settings.axisLength = settings.grid->spacing;
   settings.size.diameterPixels = 4.0;
   io::SplatImage image = io::renderFrame(camera, a, colours, {}, settings);
   const int scale = width >= 640 ? 2 : 1;

@@ -373,7 +373,7 @@ int previewCommand(Arguments& args) {
   settings.size = options.splatSize;
   if (options.guides) {
     settings.grid = io::GroundGrid::under(extent.lo, extent.hi, options.up);
-    settings.axisLength = settings.grid->spacing;
+    if (settings.grid) settings.axisLength = settings.grid->spacing;
   }
   const bool legend = options.guides && !colour.ownColours();
   const int textScale = size.width >= 640 ? 2 : 1;

@@ -95,16 +95,19 @@ TEST(PinholeCamera, CutsASegmentWhereItPassesBehindTheCamera) {
 }
 
 TEST(GroundGrid, CoversTheFootprintInWholeMetresAndCoarsensWhenWide) {
-  GroundGrid g = GroundGrid::under({-2.5, 0.0, -1.0}, {3.2, 5.0, 4.0}, UpAxis::Y);
+  GroundGrid g = *GroundGrid::under({-2.5, 0.0, -1.0}, {3.2, 5.0, 4.0}, UpAxis::Y);
   EXPECT_EQ(g.spacing, 1.0);
   EXPECT_EQ(g.lo, Eigen::Vector2d(-4.0, -2.0));  // x and z, rounded out, one more
   EXPECT_EQ(g.hi, Eigen::Vector2d(5.0, 5.0));
-  g = GroundGrid::under({-1.0, 0.5, 7.0}, {1.0, 2.0, 9.0}, UpAxis::Z);  // x and y
+  g = *GroundGrid::under({-1.0, 0.5, 7.0}, {1.0, 2.0, 9.0}, UpAxis::Z);  // x and y
   EXPECT_EQ(g.lo, Eigen::Vector2d(-2.0, -1.0));
   EXPECT_EQ(g.hi, Eigen::Vector2d(2.0, 3.0));
-  g = GroundGrid::under({0.0, 0.0, 0.0}, {1000.0, 1.0, 10.0}, UpAxis::Y);
+  g = *GroundGrid::under({0.0, 0.0, 0.0}, {1000.0, 1.0, 10.0}, UpAxis::Y);
   EXPECT_EQ(g.spacing, 100.0);
   EXPECT_EQ(g.hi.x(), 1100.0);
+  // A run that blew up: no grid rather than 10²⁰ lines.
+  EXPECT_FALSE(GroundGrid::under({0.0, 0.0, 0.0}, {1e30, 1.0, 1.0}, UpAxis::Y).has_value());
+  EXPECT_TRUE(GroundGrid::under({0.0, 0.0, 0.0}, {9e13, 1.0, 1.0}, UpAxis::Y).has_value());
 }
 
 TEST(GroundGrid, DrawsItsLinesOnTheGroundAsSeenFromAbove) {
@@ -112,7 +115,7 @@ TEST(GroundGrid, DrawsItsLinesOnTheGroundAsSeenFromAbove) {
   const PinholeCamera camera({0.5, 10.0, 0.5}, {0.5, 0.0, 0.5}, -Eigen::Vector3d::UnitZ(), 40.0,
                              101, 101);
   SplatImage image(101, 101, kBlack);
-  drawGroundGrid(image, camera, GroundGrid::under({-1, 0, -1}, {1, 0, 1}, UpAxis::Y));
+  drawGroundGrid(image, camera, *GroundGrid::under({-1, 0, -1}, {1, 0, 1}, UpAxis::Y));
   const auto origin = camera.project({0.0, 0.0, 0.0});
   const auto between = camera.project({0.5, 0.0, 0.5});
   ASSERT_TRUE(origin && between);

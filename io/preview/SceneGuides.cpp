@@ -47,13 +47,18 @@ Eigen::Vector3d upVector(UpAxis up) {
   return up == UpAxis::Y ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
 }
 
-GroundGrid GroundGrid::under(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, UpAxis up) {
+std::optional<GroundGrid> GroundGrid::under(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                            UpAxis up) {
   const auto [i, j] = groundAxes(up);
   GroundGrid grid;
   grid.up = up;
   const double widest = std::max(hi[i] - lo[i], hi[j] - lo[j]);
+  if (!std::isfinite(widest)) return std::nullopt;
   // Whole decades, so that every line still falls on a whole metre.
-  while (widest / grid.spacing + 2.0 > kMaxLines && grid.spacing < 1e9) grid.spacing *= 10.0;
+  while (widest / grid.spacing + 2.0 > kMaxLines) {
+    grid.spacing *= 10.0;
+    if (grid.spacing > 1e12) return std::nullopt;
+  }
   const auto out = [&](double v, double side) {
     return (side < 0 ? std::floor(v / grid.spacing) : std::ceil(v / grid.spacing)) * grid.spacing +
            side * grid.spacing;

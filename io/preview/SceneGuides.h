@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string_view>
 
 #include "io/preview/PinholeCamera.h"
@@ -29,8 +30,10 @@ struct GroundGrid {
 
   /// A grid under the box [lo, hi] (metres): 1 m apart over the box's footprint rounded out to
   /// whole metres and one more each side; 10 m, 100 m, ... apart when 1 m would draw more than
-  /// kMaxLines lines along an axis.
-  static GroundGrid under(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, UpAxis up);
+  /// kMaxLines lines along an axis. Nothing for a footprint wider than kMaxLines · 10¹² m (a run
+  /// that has blown up) or not finite.
+  static std::optional<GroundGrid> under(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                         UpAxis up);
 };
 
 /// Draws `grid` in a dim grey, the parts in front of the camera.
