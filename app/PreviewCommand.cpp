@@ -31,7 +31,7 @@ const char* const kPreviewHelp =
     "                      [--every N] [--color speed|age|nage|id|ATTRIBUTE|Cd]\n"
     "                      [--point-size PIXELS | --radius METRES] [--camera X,Y,Z]\n"
     "                      [--lookat X,Y,Z] [--fov DEGREES] [--up y|z] [--no-guides]\n"
-    "                      [--sheet] [--gif] [--mp4] [--set KEY=VALUE]...\n"
+    "                      [--sheet] [--gif] [--mp4] [--keep-mb MB] [--set KEY=VALUE]...\n"
     "\n"
     "Renders frames to PNG (DIR/frame_0001.png, ...; default out/preview), each written whole or\n"
     "not at all: an effect run over its [output] length and frame rate, or the caches of a folder\n"
@@ -64,6 +64,9 @@ const char* const kPreviewHelp =
     "  --mp4              also DIR/flipbook.mp4, through ffmpeg ($TICKFX_FFMPEG or ffmpeg on "
     "PATH;\n"
     "                     Debian: apt-get install ffmpeg)\n"
+    "  --keep-mb MB       memory for the frames to render, kept from the framing pass (default\n"
+    "                     1024; past it, or with 0, the effect runs again or the caches are read\n"
+    "                     again: the same pictures)\n"
     "Each frame has the name, the frame, its time and the particle count in its top-left corner.\n"
     "Exit codes: 0 ok, 2 bad arguments or input (nothing written), 1 failure at run time.\n";
 
@@ -168,6 +171,7 @@ struct PreviewOptions {
   bool sheet = false;
   bool gif = false;
   std::optional<std::filesystem::path> ffmpeg;  // --mp4
+  std::size_t keepBytes = std::size_t{1} << 30;
 
   // The camera at --camera looking at `look`; a camera that sees nothing is a usage error.
   io::PinholeCamera cameraAt(const Eigen::Vector3d& look, int width, int height) const {
@@ -196,6 +200,9 @@ PreviewOptions readOptions(Arguments& args) {
   o.guides = !args.flag("--no-guides");
   o.sheet = args.flag("--sheet");
   o.gif = args.flag("--gif");
+  o.keepBytes = static_cast<std::size_t>(parseInteger(args.value("--keep-mb").value_or("1024"),
+                                                      "preview: --keep-mb", 0, 1 << 20))
+                << 20;
   const bool mp4 = args.flag("--mp4");
   o.input = args.positionals(1, "one effect file or cache folder: tickfx preview EFFECT.toml")[0];
 
@@ -265,19 +272,52 @@ class ContactSheet {
   std::optional<io::SplatImage> image_;
 };
 
+// The frames the first walk saw that the second renders, kept while they fit in the budget
+// (--keep-mb), so that the second walk neither runs the effect again nor reads the caches again.
+class KeptFrames {
+ public:
+  explicit KeptFrames(std::size_t budget) : budget_(budget) {}
+
+  void keep(const io::FrameData& frame, const IdPairs& lines) {
+    if (!whole_) return;
+    bytes_ += frame.size() * (sizeof(std::uint64_t) + 12 * sizeof(float) +
+                              frame.attributes.size() * sizeof(float)) +
+              lines.size() * sizeof(IdPairs::value_type);
+    if (bytes_ > budget_) {
+      whole_ = false;
+      frames_.clear();
+      frames_.shrink_to_fit();
+      return;
+    }
+    frames_.emplace_back(frame, lines);
+  }
+  // Whether every frame kept was kept: the second walk can take them from here.
+  bool whole() const { return whole_; }
+  const std::vector<std::pair<io::FrameData, IdPairs>>& frames() const { return frames_; }
+
+ private:
+  std::vector<std::pair<io::FrameData, IdPairs>> frames_;
+  std::size_t budget_, bytes_ = 0;
+  bool whole_ = true;
+};
+
 // The first walk: the whole run's extent (for a camera that holds still and one colour range),
-// and how many frames `wanted` takes.
+// and the frames `wanted` takes, counted and kept where they fit.
 RunExtent scanRun(PreviewSource& source, const io::ColourBy& colour,
-                  const std::function<bool(std::int64_t)>& wanted, std::int64_t& rendered) {
+                  const std::function<bool(std::int64_t)>& wanted, std::int64_t& rendered,
+                  KeptFrames& kept) {
   RunExtent extent;
   ProgressLine progress("frames (framing)");
   const auto total = static_cast<std::int64_t>(source.frames().size());
   std::int64_t done = 0;
   source.walk(
       source.frames().back(), [](std::int64_t) { return true; },
-      [&](const io::FrameData& frame, const IdPairs&) {
+      [&](const io::FrameData& frame, const IdPairs& lines) {
         extent.add(frame, colour.values(frame));
-        rendered += wanted(frame.frame) ? 1 : 0;
+        if (wanted(frame.frame)) {
+          ++rendered;
+          kept.keep(frame, lines);
+        }
         ++done;
         progress.update(done, total, static_cast<double>(done) / static_cast<double>(total), "");
       });
@@ -348,7 +388,8 @@ int previewCommand(Arguments& args) {
   }
 
   std::int64_t rendered = 0;
-  const RunExtent extent = scanRun(*source, colour, wanted, rendered);
+  KeptFrames kept(options.keepBytes);
+  const RunExtent extent = scanRun(*source, colour, wanted, rendered, kept);
   const Eigen::Vector3d centre = 0.5 * (extent.lo + extent.hi);
   const auto cameraFor = [&](int width, int height) {
     return options.eye ? options.cameraAt(options.target.value_or(centre), width, height)
@@ -393,7 +434,7 @@ int previewCommand(Arguments& args) {
   ProgressLine progress("frames");
   std::int64_t written = 0;
   std::future<void> encoding;
-  source->walk(last, wanted, [&](const io::FrameData& frame, const IdPairs& lines) {
+  const auto renderOne = [&](const io::FrameData& frame, const IdPairs& lines) {
     const std::int64_t f = frame.frame;
     io::SplatImage image = render(*camera, frame, lines);
     io::drawCaption(image, captionOf(*source, frame, settings), textScale);
@@ -415,7 +456,12 @@ int previewCommand(Arguments& args) {
     ++written;
     progress.update(written, rendered, static_cast<double>(written) / static_cast<double>(rendered),
                     io::cacheFilePath(outDir, f, "png").string());
-  });
+  };
+  if (kept.whole()) {
+    for (const auto& [frame, lines] : kept.frames()) renderOne(frame, lines);
+  } else {
+    source->walk(last, wanted, renderOne);
+  }
   if (encoding.valid()) encoding.get();
   progress.finish();
   if (sheet) sheet->image().writePng(outDir / "sheet.png");

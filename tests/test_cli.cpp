@@ -674,6 +674,9 @@ TEST_F(Cli, PreviewRendersTheFramesAskedForAsPngs) {
   EXPECT_EQ(readAll(path("b/frame_0035.png")), frame);
   // The camera frames the whole run, whatever frames are drawn: the same picture.
   EXPECT_EQ(readAll(path("c/frame_0035.png")), frame);
+  // The frames kept from the framing pass are those a second run gives.
+  ASSERT_EQ(run(args + path("k") + " --keep-mb 0").exit, 0);
+  EXPECT_EQ(readAll(path("k/frame_0035.png")), frame);
   // The same bytes from a simulation on one thread and on two.
   for (const char* threads : {"1", "2"}) {
     const std::string dir = path(std::string("t") + threads);
