@@ -13,23 +13,6 @@
 #include "io/preview/SceneGuides.h"
 
 namespace tickfx::app {
-namespace {
-
-Eigen::Vector3d positionOf(const io::FrameData& f, std::size_t row) {
-  const auto r = static_cast<Eigen::Index>(row);
-  return {f.position.x[r], f.position.y[r], f.position.z[r]};
-}
-
-void grow(Eigen::Vector3d& lo, Eigen::Vector3d& hi, const io::FrameData& f) {
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    const Eigen::Vector3d p = positionOf(f, i);
-    if (!p.allFinite()) continue;
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-}
-
-}  // namespace
 
 io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
                                 const std::string& labelA, const std::string& labelB,
@@ -43,7 +26,8 @@ io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
     const auto it = std::lower_bound(b.id.begin(), b.id.end(), a.id[i]);
     if (it != b.id.end() && *it == a.id[i]) {
       const double d =
-          (positionOf(a, i) - positionOf(b, static_cast<std::size_t>(it - b.id.begin()))).norm();
+          (io::positionOf(a, i) - io::positionOf(b, static_cast<std::size_t>(it - b.id.begin())))
+              .norm();
       distance[i] = std::isnan(d) ? kMissing : d;
       if (std::isfinite(distance[i])) found.largest = std::max(found.largest, d);
     }
@@ -61,8 +45,8 @@ io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
   }
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
-  grow(lo, hi, a);
-  grow(lo, hi, b);
+  io::growBounds(a, lo, hi);
+  io::growBounds(b, lo, hi);
   if (!(lo.x() <= hi.x())) lo = hi = Eigen::Vector3d::Zero();
   const io::PinholeCamera camera =
       io::PinholeCamera::framing(lo, hi, io::upVector(io::UpAxis::Y), 40.0, width, height, 0.1);

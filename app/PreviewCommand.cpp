@@ -115,16 +115,12 @@ struct RunExtent {
   double valueHi = -valueLo;
 
   void add(const io::FrameData& frame, const std::vector<double>& values) {
-    for (std::size_t i = 0; i < frame.size(); ++i) {
-      const auto r = static_cast<Eigen::Index>(i);
-      const Eigen::Vector3d p(frame.position.x[r], frame.position.y[r], frame.position.z[r]);
-      if (!p.allFinite()) continue;
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-      if (i < values.size() && std::isfinite(values[i])) {
-        valueLo = std::min(valueLo, values[i]);
-        valueHi = std::max(valueHi, values[i]);
-      }
+    io::growBounds(frame, lo, hi);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      // The range of the particles the camera frames.
+      if (!std::isfinite(values[i]) || !io::positionOf(frame, i).allFinite()) continue;
+      valueLo = std::min(valueLo, values[i]);
+      valueHi = std::max(valueHi, values[i]);
     }
   }
 };

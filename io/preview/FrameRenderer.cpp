@@ -7,11 +7,6 @@
 namespace tickfx::io {
 namespace {
 
-Eigen::Vector3d positionOf(const FrameData& frame, std::size_t row) {
-  const auto r = static_cast<Eigen::Index>(row);
-  return {frame.position.x[r], frame.position.y[r], frame.position.z[r]};
-}
-
 // The row of `id` in a frame whose rows are in id order, or nothing.
 std::optional<std::size_t> rowOf(const FrameData& frame, std::uint64_t id) {
   const auto it = std::lower_bound(frame.id.begin(), frame.id.end(), id);
@@ -20,6 +15,20 @@ std::optional<std::size_t> rowOf(const FrameData& frame, std::uint64_t id) {
 }
 
 }  // namespace
+
+Eigen::Vector3d positionOf(const FrameData& frame, std::size_t row) {
+  const auto r = static_cast<Eigen::Index>(row);
+  return {frame.position.x[r], frame.position.y[r], frame.position.z[r]};
+}
+
+void growBounds(const FrameData& frame, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    const Eigen::Vector3d p = positionOf(frame, i);
+    if (!p.allFinite()) continue;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+}
 
 SplatImage renderFrame(const PinholeCamera& camera, const FrameData& frame,
                        const std::vector<Rgb>& colours,

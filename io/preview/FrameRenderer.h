@@ -22,6 +22,13 @@ struct SplatSize {
   bool ignorePscale = false;
 };
 
+/// Row `row`'s position in `frame`, metres, widened to double for the camera.
+Eigen::Vector3d positionOf(const FrameData& frame, std::size_t row);
+
+/// Grows the box [lo, hi] to hold every finite position of `frame` (a particle gone to infinity
+/// or NaN would make the box useless for framing). Start from lo = +inf, hi = -inf.
+void growBounds(const FrameData& frame, Eigen::Vector3d& lo, Eigen::Vector3d& hi);
+
 /// What renderFrame draws besides the particles.
 struct RenderSettings {
   Rgb background{24, 24, 28};
