@@ -1,4 +1,5 @@
 // tickfx preview: an effect's frames, or a folder of caches, rendered to PNG without a DCC.
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -48,8 +49,9 @@ const char* const kPreviewHelp =
     "  --size WxH         pixels (default 1280x720; 1 to 16384 a side)\n"
     "  --frames A..B      only frames A to B (default all)\n"
     "  --every N          every Nth frame from A (default 1)\n"
-    "  --color C          speed (m/s, the default), age (s), nage (age / life), id, life, mass,\n"
-    "                     a custom attribute of the caches, or Cd (their own colours)\n"
+    "  --color C          speed (m/s), age (s), nage (age / life), id, life, mass, a custom\n"
+    "                     attribute of the caches, or Cd (their own colours); by default Cd when\n"
+    "                     the frames have it, else speed\n"
     "  --point-size P     splat diameter in pixels (default 3)\n"
     "  --radius R         splat radius in metres instead; a frame with pscale uses pscale\n"
     "  --camera X,Y,Z     the camera's position (metres), looking at the bounds' centre or at\n"
@@ -184,7 +186,7 @@ PreviewOptions readOptions(Arguments& args) {
   o.overrides = args.values("--set");
   o.out = args.value("--out").value_or("out/preview");
   o.size = parseSize(args.value("--size").value_or("1280x720"));
-  o.colour = args.value("--color").value_or("speed");
+  o.colour = args.value("--color").value_or("");  // empty: Cd when the frames have it, else speed
   o.frames = args.value("--frames");
   o.every = parseInteger(args.value("--every").value_or("1"), "preview: --every", 1, 1'000'000);
   const auto pointSize = args.value("--point-size");
@@ -353,7 +355,11 @@ int previewCommand(Arguments& args) {
   }
   const io::ColourBy colour = [&] {
     try {
-      return io::ColourBy::parse(options.colour, source->sample());
+      const io::FrameData sample = source->sample();
+      if (!options.colour.empty()) return io::ColourBy::parse(options.colour, sample);
+      const std::vector<std::string> choices = io::ColourBy::choices(sample);
+      const bool hasCd = std::find(choices.begin(), choices.end(), "Cd") != choices.end();
+      return io::ColourBy::parse(hasCd ? "Cd" : "speed", sample);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("preview: --color: ") + e.what());
     }

@@ -792,6 +792,39 @@ TEST_F(Cli, PreviewRendersACacheFolderAndItsAttributes) {
   EXPECT_NE(bytes.find("NETSCAPE2.0"), std::string::npos);
 }
 
+TEST_F(Cli, PreviewColoursCachesByTheirOwnCdUnlessToldOtherwise) {
+  // Two frames of a row of particles, red to blue along the row, as another tool might cache them.
+  fs::create_directories(path("cd"));
+  for (int f = 1; f <= 2; ++f) {
+    tickfx::io::FrameData frame;
+    frame.resize(5, {"Cd_r", "Cd_g", "Cd_b"});
+    for (Eigen::Index i = 0; i < 5; ++i) {
+      frame.id[static_cast<std::size_t>(i)] = static_cast<std::uint64_t>(i);
+      frame.position.x[i] = static_cast<float>(i);
+      frame.position.y[i] = 0.5f * static_cast<float>(f);
+      frame.position.z[i] = 0.0f;
+      frame.velocity.x[i] = frame.velocity.y[i] = frame.velocity.z[i] = static_cast<float>(i);
+      frame.age[i] = 0.0f;
+      frame.life[i] = 1.0f;
+      frame.mass[i] = 1.0f;
+      frame.attributes[0][i] = 1.0f - 0.25f * static_cast<float>(i);
+      frame.attributes[1][i] = 0.0f;
+      frame.attributes[2][i] = 0.25f * static_cast<float>(i);
+    }
+    tickfx::io::writeCsvCache(frame, path("cd/frame_000" + std::to_string(f) + ".csv"));
+  }
+  const std::string args = "preview " + path("cd") + " --size 160x90 --point-size 9 --out ";
+  for (const char* name : {"default", "Cd", "speed"}) {
+    const std::string colour =
+        std::string(name) == "default" ? "" : std::string(" --color ") + name;
+    const Result r = run(args + path(std::string("p_") + name) + colour);
+    ASSERT_EQ(r.exit, 0) << name << ": " << r.err;
+  }
+  const std::string byDefault = readAll(path("p_default/frame_0002.png"));
+  EXPECT_EQ(byDefault, readAll(path("p_Cd/frame_0002.png")));
+  EXPECT_NE(byDefault, readAll(path("p_speed/frame_0002.png")));
+}
+
 TEST_F(Cli, PreviewPipesItsFramesToFfmpegForAMovie) {
   // A stand-in for ffmpeg: keeps what it is sent as the movie, and its arguments.
   const std::string fake = path("ffmpeg");
