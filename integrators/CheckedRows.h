@@ -6,7 +6,9 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <tuple>
 
+#include "fields/ForceModule.h"
 #include "particles/NonfiniteState.h"
 
 namespace tickfx {
@@ -57,6 +59,21 @@ bool updateRows(const NonfiniteCheck* check, Eigen::Index n, const Kernel& kerne
                 Column*... columns) {
   return check != nullptr ? updateRowsChecked<true>(n, kernel, columns...)
                           : updateRowsChecked<false>(n, kernel, columns...);
+}
+
+/// An integrator's checked update of one tile: updateRows() over the three components of `rows`
+/// (`columnsOf(c)` gives component c's columns, in the kernel's order, as a tuple of pointers),
+/// then, when some value may be non-finite, the exact scan that flags the tile's rows.
+template <class Kernel, class ColumnsOf>
+void updateTile(NonfiniteCheck* check, ParticlePool& pool, RowRange rows, const Kernel& kernel,
+                const ColumnsOf& columnsOf) {
+  const Eigen::Index n = rows.count();
+  bool suspect = false;
+  for (int c = 0; c < 3; ++c) {
+    suspect |= std::apply(
+        [&](auto*... columns) { return updateRows(check, n, kernel, columns...); }, columnsOf(c));
+  }
+  if (suspect) check->scan(pool, rows.begin, rows.end);
 }
 
 }  // namespace tickfx

@@ -15,7 +15,6 @@ void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const 
             {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                         old = rowsOf(prev, tile.rows());
-               bool suspect = false;
                const auto update = [dt](Eigen::Index i, float* pos, float* vel, float* last,
                                         const float* acc) {
                  const float position = pos[i];
@@ -27,11 +26,10 @@ void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const 
                  vel[i] = nextV;
                  return nextP + nextV;  // the new velocity is not in the new position
                };
-               for (int c = 0; c < 3; ++c) {
-                 suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
-                                       old[c].data(), a[c].data());
-               }
-               if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+               updateTile(check, pool, tile.rows(), update, [&](int c) {
+                 return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
+                                   static_cast<const float*>(a[c].data()));
+               });
              }});
 }
 

@@ -17,7 +17,6 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
              [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), vMid = tile.stage(1), pr = rowsOf(p, tile.rows()),
                         vr = rowsOf(v, tile.rows()), old = rowsOf(prev, tile.rows());
-               bool suspect = false;
                // The position is final here: it is checked as it is written.
                const auto update = [dt, halfDt](Eigen::Index i, float* pos, float* last, float* mid,
                                                 const float* vel, const float* acc) {
@@ -29,32 +28,28 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
                  pos[i] = next;
                  return next;
                };
-               for (int c = 0; c < 3; ++c) {
-                 suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), old[c].data(),
-                                       vMid[c].data(), static_cast<const float*>(vr[c].data()),
-                                       static_cast<const float*>(a[c].data()));
-               }
                // The velocity is still the tick's start (finite), so the scan flags the rows
                // whose new position is not; the last pass adds those whose new velocity is not.
-               if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+               updateTile(check, pool, tile.rows(), update, [&](int c) {
+                 return std::tuple(pr[c].data(), old[c].data(), vMid[c].data(),
+                                   static_cast<const float*>(vr[c].data()),
+                                   static_cast<const float*>(a[c].data()));
+               });
              },
              // The second evaluation sees the new position (where a field would be sampled) with
              // the midpoint velocity, at t + dt/2.
              forcePass(pool, forces, kPoolColumn, 1, tHalf, 0),
              [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), vr = rowsOf(v, tile.rows());
-               bool suspect = false;
                // The new velocity alone: the position was checked by the first update.
                const auto update = [dt](Eigen::Index i, float* vel, const float* acc) {
                  const float velocity = vel[i] + acc[i] * dt;
                  vel[i] = velocity;
                  return velocity;
                };
-               for (int c = 0; c < 3; ++c) {
-                 suspect |= updateRows(check, vr.x.size(), update, vr[c].data(),
-                                       static_cast<const float*>(a[c].data()));
-               }
-               if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+               updateTile(check, pool, tile.rows(), update, [&](int c) {
+                 return std::tuple(vr[c].data(), static_cast<const float*>(a[c].data()));
+               });
              }});
 }
 

@@ -32,7 +32,6 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            }
          }
          Vec3Rows a = tile.stage(0), pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
-         bool suspect = false;
          const auto update = [dt2, invDt](Eigen::Index i, float* pos, float* vel, float* last,
                                           const float* acc) {
            const float position = pos[i];
@@ -45,11 +44,10 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            // passed last tick's check), and it can overflow where both positions are finite.
            return velocity;
          };
-         for (int c = 0; c < 3; ++c) {
-           suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
-                                 old[c].data(), static_cast<const float*>(a[c].data()));
-         }
-         if (suspect) check->scan(pool, r.begin, r.end);
+         updateTile(check, pool, r, update, [&](int c) {
+           return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
+                             static_cast<const float*>(a[c].data()));
+         });
        }});
 }
 

@@ -48,7 +48,6 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
          Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
          Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                   old = rowsOf(prev, tile.rows());
-         bool suspect = false;
          // s1..s4: the four slopes of the velocity (k1..k4); u2..u4: the stage velocities.
          const auto update = [sixthH](Eigen::Index i, float* pos, float* vel, float* last,
                                       const float* s1, const float* s2, const float* s3,
@@ -68,12 +67,10 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
          const auto in = [](Eigen::Map<FloatColumn>& column) {
            return static_cast<const float*>(column.data());
          };
-         for (int c = 0; c < 3; ++c) {
-           suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
-                                 old[c].data(), in(k1[c]), in(k2[c]), in(k3[c]), in(k4[c]),
-                                 in(v2[c]), in(v3[c]), in(v4[c]));
-         }
-         if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+         updateTile(check, pool, tile.rows(), update, [&](int c) {
+           return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), in(k1[c]), in(k2[c]),
+                             in(k3[c]), in(k4[c]), in(v2[c]), in(v3[c]), in(v4[c]));
+         });
        }});
 }
 

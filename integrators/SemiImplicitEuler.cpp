@@ -19,7 +19,6 @@ void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, co
             {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                         old = rowsOf(prev, tile.rows());
-               bool suspect = false;
                // The new position alone is tested, exactly: p_new = p + v_new·dt with dt > 0 is
                // non-finite whenever p or v_new is, or when it overflows.
                const auto update = [dt](Eigen::Index i, float* pos, float* vel, float* last,
@@ -32,12 +31,10 @@ void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, co
                  pos[i] = next;
                  return next;
                };
-               for (int c = 0; c < 3; ++c) {
-                 suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), vr[c].data(),
-                                       old[c].data(), a[c].data());
-               }
-               // The exact per-row test, which flags the rows, only for a tile that has some.
-               if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+               updateTile(check, pool, tile.rows(), update, [&](int c) {
+                 return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
+                                   static_cast<const float*>(a[c].data()));
+               });
              }});
 }
 

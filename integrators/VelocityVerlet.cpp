@@ -28,7 +28,6 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
        [&](const Tile& tile) {
          Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                   ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
-         bool suspect = false;
          // The position is final here: it is checked as it is written.
          const auto update = [dt, halfDt2](Eigen::Index i, float* pos, float* last, float* pred,
                                            const float* vel, const float* acc) {
@@ -39,19 +38,17 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            pred[i] = vel[i] + acc[i] * dt;
            return next;
          };
-         for (int c = 0; c < 3; ++c) {
-           suspect |= updateRows(check, pr.x.size(), update, pr[c].data(), old[c].data(),
-                                 vPred[c].data(), static_cast<const float*>(vr[c].data()),
-                                 static_cast<const float*>(ar[c].data()));
-         }
          // The velocity is still the tick's start (finite), so the scan flags the rows
          // whose new position is not; the last pass adds those whose new velocity is not.
-         if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+         updateTile(check, pool, tile.rows(), update, [&](int c) {
+           return std::tuple(pr[c].data(), old[c].data(), vPred[c].data(),
+                             static_cast<const float*>(vr[c].data()),
+                             static_cast<const float*>(ar[c].data()));
+         });
        },
        forcePass(pool, forces, kPoolColumn, 0, t1, 1),
        [&](const Tile& tile) {
          Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
-         bool suspect = false;
          // The new velocity alone: the position was checked by the first update.
          const auto update = [halfDt](Eigen::Index i, float* vel, float* acc,
                                       const float* accNext) {
@@ -60,11 +57,9 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            acc[i] = accNext[i];
            return velocity;
          };
-         for (int c = 0; c < 3; ++c) {
-           suspect |= updateRows(check, vr.x.size(), update, vr[c].data(), ar[c].data(),
-                                 static_cast<const float*>(aNew[c].data()));
-         }
-         if (suspect) check->scan(pool, tile.rows().begin, tile.rows().end);
+         updateTile(check, pool, tile.rows(), update, [&](int c) {
+           return std::tuple(vr[c].data(), ar[c].data(), static_cast<const float*>(aNew[c].data()));
+         });
        }});
 }
 
