@@ -256,13 +256,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
     return false;
   }
   pool_.markAllStepped();
-  tick_ = first + ticks;
-  pool_.updateAges(tick_, settings_.stepRateHz);
-  if (keepVelocities) {
-    pool_.applyRemovalTo(previousVelocity_);
-    velocitiesTick_ = tick_;
-  }
-  pool_.removeDead();
+  endTicks(first + ticks, keepVelocities);
   fusedTicks_ += ticks;
   return true;
 }
@@ -285,7 +279,11 @@ void ParticleSystem::runTick(bool keepVelocities) {
   if (nonfiniteCheck_.found()) takeNonfinite();
   pool_.markAllStepped();
   forces_.endTick(pool_, time.stage(2));
-  ++tick_;
+  endTicks(tick_ + 1, keepVelocities);
+}
+
+void ParticleSystem::endTicks(std::int64_t tick, bool keepVelocities) {
+  tick_ = tick;
   pool_.updateAges(tick_, settings_.stepRateHz);
   if (keepVelocities) {
     pool_.applyRemovalTo(previousVelocity_);

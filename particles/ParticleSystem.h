@@ -166,6 +166,9 @@ class ParticleSystem {
   void runTick(bool keepVelocities);
   bool fusesTicks(std::int64_t ticks) const;
   bool runFusedTicks(std::int64_t ticks, bool keepVelocities);
+  // After the ticks up to `tick` (the count it sets): ages, the kept velocities' rows matched to
+  // the deaths, the dead removed. Shared by a tick and a fused frame.
+  void endTicks(std::int64_t tick, bool keepVelocities);
   void takeNonfinite();
   void spawnStructure(const StructureBuild& build);
 
