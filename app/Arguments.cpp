@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 namespace tickfx::app {
 
@@ -78,20 +79,21 @@ std::pair<long long, long long> parseRange(const std::string& text, long long mi
   }
 }
 
-std::array<double, 3> parseTriple(const std::string& text, const UsageError& refusal) {
-  std::array<double, 3> v{};
-  std::size_t start = 0;
-  for (std::size_t k = 0; k < 3; ++k) {
-    const std::size_t comma = k < 2 ? text.find(',', start) : text.size();
-    if (comma == std::string::npos) throw refusal;
-    try {
-      v[k] = parseNumber(text.substr(start, comma - start), "", -1e9, 1e9);
-    } catch (const UsageError&) {
-      throw refusal;
-    }
-    start = comma + 1;
+std::vector<double> parseNumberList(const std::string& text, const std::string& option,
+                                    std::size_t count, const std::string& shape, double min,
+                                    double max) {
+  std::vector<std::string> parts;
+  std::stringstream list(text);
+  std::string part;
+  while (std::getline(list, part, ',')) parts.push_back(part);
+  if (!text.empty() && text.back() == ',') parts.push_back("");
+  if (parts.size() != count) {
+    throw UsageError(option + ": '" + text + "' is not " + std::to_string(count) + " numbers " +
+                     shape);
   }
-  return v;
+  std::vector<double> values;
+  for (const std::string& p : parts) values.push_back(parseNumber(p, option, min, max));
+  return values;
 }
 
 double parseNumber(const std::string& text, const std::string& option, double min, double max) {

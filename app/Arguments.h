@@ -1,7 +1,6 @@
 // A small, strict command-line reader: every argument must be consumed, or it is an error.
 #pragma once
 
-#include <array>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -48,8 +47,11 @@ double parseNumber(const std::string& text, const std::string& option, double mi
 /// Parses "A..B", whole numbers with min <= A <= B <= max; throws `refusal` otherwise.
 std::pair<long long, long long> parseRange(const std::string& text, long long min, long long max,
                                            const UsageError& refusal);
-/// Parses "x,y,z", three finite numbers; throws `refusal` otherwise.
-std::array<double, 3> parseTriple(const std::string& text, const UsageError& refusal);
+/// Parses `count` comma-separated numbers, each finite and in [min, max]. UsageError "OPTION:
+/// 'TEXT' is not COUNT numbers SHAPE" for another count, parseNumber's message for a bad number.
+std::vector<double> parseNumberList(const std::string& text, const std::string& option,
+                                    std::size_t count, const std::string& shape, double min,
+                                    double max);
 
 /// "a, b or c" with `last` = " or ": the words of a usage message's list of choices.
 std::string joinWords(const std::vector<std::string>& words, const std::string& last);

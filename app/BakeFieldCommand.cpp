@@ -77,25 +77,9 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& kindOptions
 }
 
 // "x,y,z" (or `count` numbers), each a number in [-1e9, 1e9].
-std::vector<double> parseList(const std::string& text, const std::string& option, std::size_t count,
-                              const std::string& shape) {
-  std::vector<std::string> parts;
-  std::stringstream list(text);
-  std::string part;
-  while (std::getline(list, part, ',')) parts.push_back(part);
-  if (!text.empty() && text.back() == ',') parts.push_back("");
-  if (parts.size() != count) {
-    throw UsageError(option + ": '" + text + "' is not " + std::to_string(count) + " numbers " +
-                     shape);
-  }
-  std::vector<double> values;
-  for (const std::string& p : parts) values.push_back(parseNumber(p, option, -kBig, kBig));
-  return values;
-}
-
 Eigen::Vector3d parseVector(const std::string& text, const std::string& option,
                             bool nonZero = false) {
-  const std::vector<double> v = parseList(text, option, 3, "x,y,z");
+  const std::vector<double> v = parseNumberList(text, option, 3, "x,y,z", -kBig, kBig);
   const Eigen::Vector3d out(v[0], v[1], v[2]);
   if (nonZero && out.isZero(0.0)) {
     throw UsageError(option + ": '" + text + "' is not a direction (expected x,y,z not all zero)");
@@ -223,7 +207,8 @@ int bakeFieldCommand(Arguments& args) {
 
   if (voxelSize) bake.voxelSize = parsePositive(*voxelSize, p + "--voxel-size", kBig);
   if (bounds) {
-    const std::vector<double> b = parseList(*bounds, p + "--bounds", 6, "x0,y0,z0,x1,y1,z1");
+    const std::vector<double> b =
+        parseNumberList(*bounds, p + "--bounds", 6, "x0,y0,z0,x1,y1,z1", -kBig, kBig);
     for (int c = 0; c < 3; ++c) {
       if (b[c + 3] < b[c]) {
         const std::string axis(1, "xyz"[c]);

@@ -103,10 +103,13 @@ io::UpAxis parseUp(const std::string& text) {
 }
 
 Eigen::Vector3d parsePoint(const std::string& option, const std::optional<std::string>& text) {
-  const auto v = parseTriple(
-      *text, UsageError("preview: " + option + ": '" + *text +
-                        "' is not a point X,Y,Z (metres, three numbers from -1e9 to 1e9)"));
-  return {v[0], v[1], v[2]};
+  try {
+    const std::vector<double> v = parseNumberList(*text, option, 3, "x,y,z", -1e9, 1e9);
+    return {v[0], v[1], v[2]};
+  } catch (const UsageError&) {
+    throw UsageError("preview: " + option + ": '" + *text +
+                     "' is not a point X,Y,Z (metres, three numbers from -1e9 to 1e9)");
+  }
 }
 
 // The particles' bounds and the colouring value's range over the whole run.
