@@ -71,17 +71,9 @@ void FfmpegMovie::add(const SplatImage& image) {
   if (image.width() != width_ || image.height() != height_) {
     throw std::invalid_argument("FfmpegMovie::add: a frame of another size");
   }
-  std::vector<std::uint8_t> row(static_cast<std::size_t>(width_) * 3);
-  for (int y = 0; y < height_; ++y) {
-    for (int x = 0; x < width_; ++x) {
-      const Rgb c = image.at(x, y);
-      for (int k = 0; k < 3; ++k)
-        row[static_cast<std::size_t>(x) * 3 + static_cast<std::size_t>(k)] =
-            c[static_cast<std::size_t>(k)];
-    }
-    // A short write means ffmpeg has gone; finish() reports its status.
-    if (std::fwrite(row.data(), 1, row.size(), pipe_) != row.size()) return;
-  }
+  const std::vector<std::uint8_t> bytes = image.rgb8();
+  // A short write means ffmpeg has gone; finish() reports its status.
+  (void)std::fwrite(bytes.data(), 1, bytes.size(), pipe_);
 }
 
 void FfmpegMovie::finish() {

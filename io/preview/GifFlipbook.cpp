@@ -185,10 +185,12 @@ struct GifFlipbook::Encoder {
     // No local palette: every frame uses the global one.
     check(EGifPutImageDesc(gif.get(), 0, 0, width, height, false, nullptr));
     const Quantiser& q = quantiser();
+    const std::vector<std::uint8_t> rgb = image.rgb8();
     std::vector<GifPixelType> row(static_cast<std::size_t>(width));
     for (int y = 0; y < height; ++y) {
       for (int x = 0; x < width; ++x) {
-        row[static_cast<std::size_t>(x)] = q.index(x, y, image.at(x, y));
+        const std::uint8_t* c = &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
+        row[static_cast<std::size_t>(x)] = q.index(x, y, {c[0], c[1], c[2]});
       }
       check(EGifPutLine(gif.get(), row.data(), width));
     }

@@ -136,14 +136,19 @@ Rgb SplatImage::at(int x, int y) const {
   return {toByte(p[0]), toByte(p[1]), toByte(p[2])};
 }
 
-std::vector<std::uint8_t> SplatImage::png() const {
+std::vector<std::uint8_t> SplatImage::rgb8() const {
   // Each value rounded as at() rounds it, rows in parallel (each row's bytes are its own).
-  std::vector<std::uint8_t> rows(rgb_.size());
+  std::vector<std::uint8_t> bytes(rgb_.size());
   tbb::parallel_for(0, height_, [&](int y) {
     const std::size_t begin = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 3;
     const std::size_t end = begin + static_cast<std::size_t>(width_) * 3;
-    for (std::size_t i = begin; i < end; ++i) rows[i] = toByte(rgb_[i]);
+    for (std::size_t i = begin; i < end; ++i) bytes[i] = toByte(rgb_[i]);
   });
+  return bytes;
+}
+
+std::vector<std::uint8_t> SplatImage::png() const {
+  const std::vector<std::uint8_t> rows = rgb8();
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {

@@ -45,6 +45,9 @@ class SplatImage {
   int width() const { return width_; }
   int height() const { return height_; }
 
+  /// The image as 8-bit RGB, 3 bytes a pixel, rows top to bottom: what at() gives for every
+  /// pixel, converted in parallel. What the PNG, GIF and movie writers encode.
+  std::vector<std::uint8_t> rgb8() const;
   /// The image as PNG bytes (8-bit RGB, no metadata: the same image gives the same bytes).
   std::vector<std::uint8_t> png() const;
   /// Writes png() to `path` atomically (io/AtomicFile.h); throws WriteError.
