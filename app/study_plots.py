@@ -54,6 +54,10 @@ def save(figure, directory, name):
     return path
 
 
+# The exact solution, drawn wide and faint under the simulated curves.
+EXACT = {"color": "black", "linewidth": 3, "alpha": 0.3, "label": "exact"}
+
+
 def titled(axes, title, xlabel, ylabel):
     """Titles an axes, names both axes with their units, and draws a light grid."""
     axes.set_title(title)
@@ -72,8 +76,7 @@ def constant_acceleration(directory):
         for (integrator,), run in runs(by_rate[(rate,)], "integrator").items():
             t = column(run, "t")
             if not exact_drawn:
-                left.plot(t, column(run, "exact"), color="black", linewidth=3, alpha=0.3,
-                          label="exact")
+                left.plot(t, column(run, "exact"), **EXACT)
                 exact_drawn = True
             left.plot(t, column(run, "position"), label=NAMES.get(integrator, integrator))
             right.plot(t, column(run, "error"), label=NAMES.get(integrator, integrator))
@@ -92,8 +95,7 @@ def oscillator(directory):
     for (rate,), (position, energy, phase) in zip(by_rate, axes):
         end = max(column(by_rate[(rate,)], "t"))
         fine = [end * i / 1000 for i in range(1001)]
-        position.plot(fine, [-math.cos(t) for t in fine], color="black", linewidth=3, alpha=0.3,
-                      label="exact")
+        position.plot(fine, [-math.cos(t) for t in fine], **EXACT)
         for (integrator,), run in runs(by_rate[(rate,)], "integrator").items():
             label = NAMES.get(integrator, integrator)
             t = column(run, "t")
@@ -102,11 +104,10 @@ def oscillator(directory):
             phase.plot(column(run, "position"), column(run, "velocity"), label=label)
         titled(position, f"dt = 1/{rate} s: position", "time (s)", "position (m)")
         titled(energy, f"dt = 1/{rate} s: energy", "time (s)", "energy (J)")
-        energy.axhline(0.5, color="black", linewidth=3, alpha=0.3, label="exact")
+        energy.axhline(0.5, **EXACT)
         energy.set_yscale("log")
         titled(phase, f"dt = 1/{rate} s: phase portrait", "position (m)", "velocity (m/s)")
-        circle = plt.Circle((0, 0), 1.0, fill=False, color="black", linewidth=3, alpha=0.3,
-                            label="exact")
+        circle = plt.Circle((0, 0), 1.0, fill=False, **EXACT)
         phase.add_patch(circle)
         phase.set_aspect("equal", adjustable="datalim")
         energy.legend(fontsize="small")
@@ -126,8 +127,7 @@ def wind(directory):
         if not exact_drawn:
             fine = max(by_rate, key=lambda k: int(k[0]))
             tf = column(by_rate[fine], "t")
-            position.plot(tf, column(by_rate[fine], "exact"), color="black", linewidth=3,
-                          alpha=0.3, label="exact")
+            position.plot(tf, column(by_rate[fine], "exact"), **EXACT)
             exact_drawn = True
         p = column(run, "position")
         position.plot(t, p, marker="." if int(rate) < 100 else None, label=f"{rate} Hz")
