@@ -180,6 +180,19 @@ void writeFile(const std::filesystem::path& path, const std::string& text) {
   if (!file) throw std::runtime_error("cannot write " + path.string());
 }
 
+// Writes each (name, text) into `dir`, made first; returns the paths in order.
+std::vector<std::filesystem::path> writeFiles(
+    const std::filesystem::path& dir,
+    const std::vector<std::pair<std::string, std::string>>& files) {
+  std::filesystem::create_directories(dir);
+  std::vector<std::filesystem::path> written;
+  for (const auto& [name, text] : files) {
+    writeFile(dir / name, text);
+    written.push_back(dir / name);
+  }
+  return written;
+}
+
 }  // namespace
 
 // ---- exact solutions ------------------------------------------------------------------------
@@ -431,34 +444,16 @@ std::vector<std::filesystem::path> writeStudySeriesCsv(const StudyPlan& plan,
     simulate(integrator, forces, rate, wholeTicks(plan.windDuration, rate), 0.0f, 0.0f,
              [&](std::int64_t tick, float p, float) { row(tick, p); });
   }
-  std::filesystem::create_directories(dir);
-  const std::vector<std::pair<std::filesystem::path, std::string>> files = {
-      {dir / "series_constant_acceleration.csv", gravity},
-      {dir / "series_oscillator.csv", oscillator},
-      {dir / "series_wind.csv", wind},
-  };
-  std::vector<std::filesystem::path> written;
-  for (const auto& [path, text] : files) {
-    writeFile(path, text);
-    written.push_back(path);
-  }
-  return written;
+  return writeFiles(dir, {{"series_constant_acceleration.csv", gravity},
+                          {"series_oscillator.csv", oscillator},
+                          {"series_wind.csv", wind}});
 }
 
 std::vector<std::filesystem::path> writeStudyCsv(const StudyResults& results,
                                                  const std::filesystem::path& dir) {
-  std::filesystem::create_directories(dir);
-  const std::vector<std::pair<std::filesystem::path, std::string>> files = {
-      {dir / "constant_acceleration.csv", constantAccelerationCsv(results)},
-      {dir / "oscillator.csv", oscillatorCsv(results)},
-      {dir / "wind.csv", windCsv(results)},
-  };
-  std::vector<std::filesystem::path> written;
-  for (const auto& [path, text] : files) {
-    writeFile(path, text);
-    written.push_back(path);
-  }
-  return written;
+  return writeFiles(dir, {{"constant_acceleration.csv", constantAccelerationCsv(results)},
+                          {"oscillator.csv", oscillatorCsv(results)},
+                          {"wind.csv", windCsv(results)}});
 }
 
 }  // namespace tickfx
