@@ -275,7 +275,7 @@ int bakeFieldCommand(Arguments& args) {
   for (int f = first; f <= last; ++f) {
     const std::string path = frames ? sequenceFramePath(*out, f, digits) : *out;
     const double time = frames ? (f - first) / rate : 0.0;
-    progress.update(f - first, count, static_cast<double>(f - first) / count, path);
+    progress.update(f - first, count, path);
     bakeField(field, settings, path, time);
     progress.finish();  // the line below replaces it
     std::printf("%s: %s field, grid '%s', %.0f voxels of %s m%s\n", path.c_str(), kind.c_str(),

@@ -302,8 +302,7 @@ int determinismCommand(Arguments& args) {
   ProgressLine progress("schedules");
   for (const DriveCase& drive : drives) {
     const auto done = static_cast<std::int64_t>(traces.size());
-    progress.update(done, static_cast<std::int64_t>(drives.size()),
-                    static_cast<double>(done) / static_cast<double>(drives.size()), drive.label);
+    progress.update(done, static_cast<std::int64_t>(drives.size()), drive.label);
     try {
       traces.push_back(traceDrive(effect, drive));
     } catch (const io::BuildError& e) {  // a vector field's file that does not load: bad input

@@ -320,7 +320,7 @@ RunExtent scanRun(PreviewSource& source, const io::ColourBy& colour,
           kept.keep(frame, lines);
         }
         ++done;
-        progress.update(done, total, static_cast<double>(done) / static_cast<double>(total), "");
+        progress.update(done, total, "");
       });
   if (!(extent.lo.x() <= extent.hi.x())) extent.lo = extent.hi = Eigen::Vector3d::Zero();
   if (!(extent.valueLo <= extent.valueHi)) extent.valueLo = extent.valueHi = 0.0;
@@ -459,8 +459,7 @@ int previewCommand(Arguments& args) {
       sheet->place(written, cell);
     }
     ++written;
-    progress.update(written, rendered, static_cast<double>(written) / static_cast<double>(rendered),
-                    io::cacheFilePath(outDir, f, "png").string());
+    progress.update(written, rendered, io::cacheFilePath(outDir, f, "png").string());
   };
   if (kept.whole()) {
     for (const auto& [frame, lines] : kept.frames()) renderOne(frame, lines);

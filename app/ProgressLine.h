@@ -23,6 +23,10 @@ class ProgressLine {
   /// of the work done in [0, 1] (the bar and the time left: units may differ in length), and a
   /// `detail` to end the line with.
   void update(std::int64_t done, std::int64_t total, double fraction, std::string_view detail);
+  /// update() with units of equal length: the fraction done is done / total (total > 0).
+  void update(std::int64_t done, std::int64_t total, std::string_view detail) {
+    update(done, total, static_cast<double>(done) / static_cast<double>(total), detail);
+  }
   /// Erases the line (before other output, and at the end); the next update() draws it again.
   void finish();
 
