@@ -442,40 +442,59 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 }
 
 // Per integrator, step() on 1 thread with the non-finite check (NonfinitePolicy::Stop) and
-// without (Keep), the two systems taking turns batch by batch. The check is folded into a pass
-// that reads the tile anyway, so what is left is near the spread of where code and columns happen
-// to sit in memory: a second unchecked system, timed alongside, shows that spread (A/A).
+// without (Keep), all systems taking turns batch by batch. The check is folded into a pass that
+// reads the tile anyway, so what is left is of the order of where columns happen to sit in memory
+// (two identical systems measured up to 2 % apart): each side is kCheckCopies systems allocated
+// one after another, and a side's figure is the median of all its batches, so that no one
+// placement decides. The A/A spread sets half the unchecked copies against the other half.
 void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& timing) {
+  constexpr int kCheckCopies = 4;
   struct Cost {
     std::size_t n;
     std::string integrator;
     double cost, spread;  // %
   };
   std::vector<Cost> costs;
-  std::printf("\nnon-finite check, step() on 1 thread: checked against unchecked\n");
+  std::printf(
+      "\nnon-finite check, step() on 1 thread: checked against unchecked (%d systems a side)\n",
+      kCheckCopies);
   std::printf("%10s  %-22s %14s %14s %10s %12s\n", "N", "integrator", "checked ms", "unchecked ms",
               "cost", "A/A spread");
+  const auto pooledMedian = [](const std::vector<bench::Case>& cases, int first, int count) {
+    std::vector<double> all;
+    for (int i = first; i < first + count; ++i) {
+      const std::vector<double>& s = cases[static_cast<std::size_t>(i)].secondsPerTick;
+      all.insert(all.end(), s.begin(), s.end());
+    }
+    return bench::median(all);
+  };
   for (const std::size_t n : sizes) {
     for (const std::string& name : tickfx::integratorNames()) {
-      auto checked = makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name);
-      auto unchecked = makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name);
-      // A second unchecked copy: how far two identical systems differ is the noise floor.
-      auto control = makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name);
+      // Interleaved allocations, so that neither side gets the earlier (or later) memory.
+      std::vector<std::unique_ptr<tickfx::ParticleSystem>> systems;
+      for (int i = 0; i < kCheckCopies; ++i) {
+        systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name));
+        systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name));
+      }
       std::vector<bench::Case> cases;
-      cases.emplace_back("checked", [&](std::int64_t ticks) {
-        for (std::int64_t i = 0; i < ticks; ++i) checked->step();
-      });
-      cases.emplace_back("unchecked", [&](std::int64_t ticks) {
-        for (std::int64_t i = 0; i < ticks; ++i) unchecked->step();
-      });
-      cases.emplace_back("unchecked copy", [&](std::int64_t ticks) {
-        for (std::int64_t i = 0; i < ticks; ++i) control->step();
-      });
+      for (const auto& system : systems) {
+        const bool checked = system->settings().nonfinite == tickfx::NonfinitePolicy::Stop;
+        cases.emplace_back(checked ? "checked" : "unchecked",
+                           [s = system.get()](std::int64_t ticks) {
+                             for (std::int64_t i = 0; i < ticks; ++i) s->step();
+                           });
+      }
       bench::timeCases(cases, timing);
-      const double with = bench::median(cases[0].secondsPerTick);
-      const double without = bench::median(cases[1].secondsPerTick);
-      const double copy = bench::median(cases[2].secondsPerTick);
-      costs.push_back({n, name, 100.0 * (with / without - 1.0), 100.0 * (copy / without - 1.0)});
+      // Cases alternate checked, unchecked: gather each side.
+      std::vector<bench::Case> checkedCases, uncheckedCases;
+      for (std::size_t i = 0; i < cases.size(); ++i) {
+        (i % 2 == 0 ? checkedCases : uncheckedCases).push_back(cases[i]);
+      }
+      const double with = pooledMedian(checkedCases, 0, kCheckCopies);
+      const double without = pooledMedian(uncheckedCases, 0, kCheckCopies);
+      const double halfA = pooledMedian(uncheckedCases, 0, kCheckCopies / 2);
+      const double halfB = pooledMedian(uncheckedCases, kCheckCopies / 2, kCheckCopies / 2);
+      costs.push_back({n, name, 100.0 * (with / without - 1.0), 100.0 * (halfB / halfA - 1.0)});
       std::printf("%10zu  %-22s %14.4f %14.4f %+9.1f %% %+10.1f %%\n", n, name.c_str(), 1e3 * with,
                   1e3 * without, costs.back().cost, costs.back().spread);
       std::fflush(stdout);
