@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <system_error>
@@ -14,6 +13,7 @@
 #include "fields/Gravity.h"
 #include "fields/PeriodicWind.h"
 #include "integrators/Integrator.h"
+#include "io/AtomicFile.h"
 #include "particles/DetMath.h"
 #include "particles/ParticlePool.h"
 
@@ -173,21 +173,18 @@ class Table {
   std::vector<std::vector<std::string>> rows_;
 };
 
-void writeFile(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  file << text;
-  file.close();
-  if (!file) throw std::runtime_error("cannot write " + path.string());
-}
-
-// Writes each (name, text) into `dir`, made first; returns the paths in order.
+// Writes each (name, text) into `dir`, made first; returns the paths in order. Each file is
+// written whole or not at all (io::writeFileAtomically): a failure names the file and the
+// system's reason, and the files before it stay as written.
 std::vector<std::filesystem::path> writeFiles(
     const std::filesystem::path& dir,
     const std::vector<std::pair<std::string, std::string>>& files) {
-  std::filesystem::create_directories(dir);
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw io::WriteError(dir, error.message());
   std::vector<std::filesystem::path> written;
   for (const auto& [name, text] : files) {
-    writeFile(dir / name, text);
+    io::writeFileAtomically(dir / name, [&text](std::ostream& out) { out << text; });
     written.push_back(dir / name);
   }
   return written;

@@ -2,7 +2,8 @@
 # study source is compiled in directly: app/ is built only with the command line.
 tickfx_add_test(test_study
   ${CMAKE_CURRENT_SOURCE_DIR}/test_study.cpp
-  ${PROJECT_SOURCE_DIR}/app/IntegratorStudy.cpp)
+  ${PROJECT_SOURCE_DIR}/app/IntegratorStudy.cpp
+  LIBS tickfx::io)
 # The progress bar of the long commands (app/ProgressLine.cpp, compiled in directly).
 tickfx_add_test(test_progress
   ${CMAKE_CURRENT_SOURCE_DIR}/test_progress.cpp

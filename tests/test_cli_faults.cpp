@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <string>
 #include <system_error>
@@ -281,6 +282,36 @@ TEST_F(CliFaults, SigtermWithoutCheckpointsStopsAfterTheFrameAndSaysItCannotResu
   EXPECT_EQ(std::stoi(m[1]), std::stoi(m[2]));
   expectOnlyFrames(out, "csv", std::stoi(m[1]));
   expectTheUndisturbedBytes(out, "csv", std::stoi(m[1]));
+}
+
+// The study's tables under a file-size limit between its files' sizes (constant_acceleration.csv
+// about 3.9 kB, oscillator.csv 1.1 kB, wind.csv 4.1 kB): the third is refused by name and with
+// the system's reason, and the two before it are whole, the bytes of an unlimited run.
+TEST_F(CliFaults, AFileSizeLimitStopsTheStudyAtTheTableItCannotWrite) {
+  const std::string whole = path("whole"), limited = path("limited");
+  ASSERT_EQ(runProgram(TICKFX_CLI, "study --out " + whole).exit, 0);
+  ASSERT_LT(std::filesystem::file_size(whole + "/constant_acceleration.csv"), 4000u);
+  ASSERT_GT(std::filesystem::file_size(whole + "/wind.csv"), 4000u);
+  const Result r = runProgram("prlimit", "--fsize=4000 -- '" TICKFX_CLI "' study --out " + limited);
+  EXPECT_EQ(r.exit, 1);
+  EXPECT_EQ(r.err, limited + "/wind.csv: error: cannot write (File too large)\n");
+  for (const char* name : {"constant_acceleration.csv", "oscillator.csv"}) {
+    EXPECT_EQ(readAll(limited + "/" + name), readAll(whole + "/" + name)) << name;
+  }
+  std::vector<std::string> left;
+  for (const auto& entry : std::filesystem::directory_iterator(limited)) {
+    left.push_back(entry.path().filename().string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"constant_acceleration.csv", "oscillator.csv"}));
+}
+
+// An output folder that cannot be made (a file stands where a parent folder should be).
+TEST_F(CliFaults, TheStudyNamesAnOutputFolderItCannotMake) {
+  { std::ofstream(path("file")) << "x"; }
+  const Result r = runProgram(TICKFX_CLI, "study --out " + path("file/study"));
+  EXPECT_EQ(r.exit, 1);
+  EXPECT_EQ(r.err, path("file/study") + ": error: cannot write (Not a directory)\n");
 }
 
 }  // namespace
