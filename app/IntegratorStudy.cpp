@@ -183,9 +183,10 @@ std::vector<std::filesystem::path> writeFiles(
   std::filesystem::create_directories(dir, error);
   if (error) throw io::WriteError(dir, error.message());
   std::vector<std::filesystem::path> written;
-  for (const auto& [name, text] : files) {
-    io::writeFileAtomically(dir / name, [&text](std::ostream& out) { out << text; });
-    written.push_back(dir / name);
+  for (const auto& file : files) {  // not a structured binding: clang 14 cannot capture one
+    const std::string& text = file.second;
+    io::writeFileAtomically(dir / file.first, [&text](std::ostream& out) { out << text; });
+    written.push_back(dir / file.first);
   }
   return written;
 }
