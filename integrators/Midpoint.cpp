@@ -1,6 +1,7 @@
 #include "integrators/Midpoint.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
 
@@ -12,6 +13,24 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1);
+  if (const auto forms = tickForms(pool, forces, time, {0, 1})) {
+    // Both evaluations in the row's registers: the midpoint velocity, then the acceleration at
+    // t + dt/2 from it (the position does not enter a uniform force or a drag).
+    runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, [dt, halfDt](const auto& a) {
+      return [dt, halfDt, a](Eigen::Index i, float* pos, float* vel, float* last) {
+        const float position = pos[i];
+        const float velocity = vel[i];
+        const float mid = velocity + a.at(0, velocity) * halfDt;
+        const float next = position + mid * dt;
+        const float nextV = velocity + a.at(1, mid) * dt;
+        last[i] = position;
+        pos[i] = next;
+        vel[i] = nextV;
+        return CheckedPair{next, nextV};  // the new velocity is not in the new position
+      };
+    });
+    return;
+  }
   runPasses(rows, forces.isLocal(), scratch_,
             {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0),
              [&](const Tile& tile) {

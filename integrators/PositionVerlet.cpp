@@ -1,8 +1,32 @@
 #include "integrators/PositionVerlet.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
+namespace {
+
+// A new particle has no history: the position it would have had a step ago, p − v·dt + a·dt²/2.
+inline float startingPrevious(float position, float velocity, float acceleration, float dt,
+                              float halfDt2) {
+  return position - velocity * dt + acceleration * halfDt2;
+}
+
+// One row: p_new = 2p − p_prev + a·dt², v = (p_new − p)/dt. Returns the velocity, which alone
+// tells: it is not finite when the new position is not (the old one passed last tick's check),
+// and it can overflow where both positions are finite.
+inline float positionVerletRow(float dt2, float invDt, float acceleration, Eigen::Index i,
+                               float* pos, float* vel, float* last) {
+  const float position = pos[i];
+  const float next = (position * 2.0f - last[i]) + acceleration * dt2;
+  const float velocity = (next - position) * invDt;
+  last[i] = position;
+  pos[i] = next;
+  vel[i] = velocity;
+  return velocity;
+}
+
+}  // namespace
 
 void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                                const StepRows& rows, NonfiniteCheck* check) {
@@ -15,34 +39,48 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = rows.fresh;
   const std::size_t n = rows.rows.end;
-  const TickInstant t0 = time.stage(0);
+  // The rows of a tile spawned this tick: their history, from `acceleration(c, row)` (the row's
+  // index within the tile).
+  const auto start = [&](const RowRange& r, const auto& acceleration) {
+    const RowRange started = intersect(r, fresh, n);
+    if (started.count() == 0) return;
+    const auto offset = static_cast<Eigen::Index>(started.begin - r.begin);
+    Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started), vr = rowsOf(v, started);
+    for (int c = 0; c < 3; ++c) {
+      for (Eigen::Index i = 0; i < started.count(); ++i) {
+        old[c][i] = startingPrevious(pr[c][i], vr[c][i], acceleration(c, offset + i, vr[c][i]), dt,
+                                     halfDt2);
+      }
+    }
+  };
+  if (const auto forms = tickForms(pool, forces, time, {0})) {
+    runPasses(rows, true, scratch_, {[&](const Tile& tile) {
+                const RowRange r = tile.rows();
+                start(r, [&](int c, Eigen::Index, float velocity) {
+                  return withFormAccelerations(*forms, c,
+                                               [&](const auto& a) { return a.at(0, velocity); });
+                });
+                Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
+                updateTileUnderForms(
+                    check, pool, r, *forms,
+                    [dt2, invDt](const auto& a) {
+                      return [dt2, invDt, a](Eigen::Index i, float* pos, float* vel, float* last) {
+                        return positionVerletRow(dt2, invDt, a.at(0, vel[i]), i, pos, vel, last);
+                      };
+                    },
+                    [&](int c) { return std::tuple(pr[c].data(), vr[c].data(), old[c].data()); });
+              }});
+    return;
+  }
   runPasses(
       rows, forces.isLocal(), scratch_,
-      {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0), [&](const Tile& tile) {
+      {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0), [&](const Tile& tile) {
          const RowRange r = tile.rows();
-         // A new particle has no history: give it the position it would have had a step ago.
-         const RowRange started = intersect(r, fresh, n);
-         if (started.count() > 0) {
-           const std::size_t i = started.begin - r.begin;
-           Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started), vr = rowsOf(v, started);
-           Vec3Rows a = tile.stage(0);
-           for (int c = 0; c < 3; ++c) {
-             old[c] = pr[c] - vr[c] * dt +
-                      a[c].segment(static_cast<Eigen::Index>(i), started.count()) * halfDt2;
-           }
-         }
          Vec3Rows a = tile.stage(0), pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
+         start(r, [&](int c, Eigen::Index i, float) { return a[c][i]; });
          const auto update = [dt2, invDt](Eigen::Index i, float* pos, float* vel, float* last,
                                           const float* acc) {
-           const float position = pos[i];
-           const float next = (position * 2.0f - last[i]) + acc[i] * dt2;
-           const float velocity = (next - position) * invDt;
-           last[i] = position;
-           pos[i] = next;
-           vel[i] = velocity;
-           // The velocity alone tells: it is not finite when the new position is not (the old one
-           // passed last tick's check), and it can overflow where both positions are finite.
-           return velocity;
+           return positionVerletRow(dt2, invDt, acc[i], i, pos, vel, last);
          };
          updateTile(check, pool, r, update, [&](int c) {
            return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),

@@ -1,6 +1,7 @@
 #include "integrators/RungeKutta4.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
 namespace {
@@ -20,6 +21,31 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
 
+  if (const auto forms = tickForms(pool, forces, time, {0, 1, 2})) {
+    // The four stages of a row in its registers, by the passes' own operations: the stage
+    // positions are not needed (a uniform force or a drag does not read the position), and the
+    // slopes and stage velocities never leave the row.
+    runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, [=](const auto& a) {
+      return [=](Eigen::Index i, float* pos, float* vel, float* last) {
+        const float position = pos[i];
+        const float velocity = vel[i];
+        const float k1 = a.at(0, velocity);
+        const float v2 = velocity + k1 * halfH;
+        const float k2 = a.at(1, v2);
+        const float v3 = velocity + k2 * halfH;
+        const float k3 = a.at(1, v3);
+        const float v4 = velocity + k3 * h;
+        const float k4 = a.at(2, v4);
+        const float nextP = position + ((velocity + v2 * 2.0f) + (v3 * 2.0f + v4)) * sixthH;
+        const float nextV = velocity + ((k1 + k2 * 2.0f) + (k3 * 2.0f + k4)) * sixthH;
+        last[i] = position;
+        pos[i] = nextP;
+        vel[i] = nextV;
+        return CheckedPair{nextP, nextV};
+      };
+    });
+    return;
+  }
   auto velocityRows = [&](const Tile& tile, int slot) {
     return slot == kState ? rowsOf(v, tile.rows()) : tile.stage(slot);
   };

@@ -20,10 +20,6 @@ class SemiImplicitEuler final : public Integrator {
                  const StepRows& rows, NonfiniteCheck* check) override;
 
  private:
-  // Under uniform forces and at most one linear drag (ForceSet::uniformAndDrag): one pass.
-  void integrateUniformAndDrag(ParticlePool& pool, const ForceSet::UniformAndDrag& form, float dt,
-                               const StepRows& rows, NonfiniteCheck* check);
-
   StageScratch scratch_{1};  // acceleration
 };
 

@@ -1,6 +1,7 @@
 #include "integrators/VelocityVerlet.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
 
@@ -16,15 +17,45 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   const std::size_t fresh = rows.fresh;
   const std::size_t n = rows.rows.end;
   const TickInstant t0 = time.stage(0), t1 = time.stage(2);
+  // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
+  const auto startRows = [&](const Tile& tile) {
+    const RowRange started = intersect(tile.rows(), fresh, n);
+    if (started.count() == 0) return;
+    Vec3Rows out = rowsOf(a, started);
+    forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0}, started, out);
+  };
+  if (const auto forms = tickForms(pool, forces, time, {2})) {
+    // The position, the predicted velocity, a(t + dt) from it and the new velocity in the row's
+    // registers (the position does not enter a uniform force or a drag).
+    runPasses(rows, true, scratch_, {[&](const Tile& tile) {
+                startRows(tile);
+                Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                         ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
+                updateTileUnderForms(
+                    check, pool, tile.rows(), *forms,
+                    [=](const auto& accelerations) {
+                      return [=](Eigen::Index i, float* pos, float* vel, float* last, float* acc) {
+                        const float position = pos[i];
+                        const float velocity = vel[i];
+                        const float next = position + (velocity * dt + acc[i] * halfDt2);
+                        const float accNext = accelerations.at(2, velocity + acc[i] * dt);
+                        const float nextV = velocity + (acc[i] + accNext) * halfDt;
+                        last[i] = position;
+                        pos[i] = next;
+                        vel[i] = nextV;
+                        acc[i] = accNext;
+                        return CheckedPair{next, nextV};  // the new velocity is not in next
+                      };
+                    },
+                    [&](int c) {
+                      return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), ar[c].data());
+                    });
+              }});
+    return;
+  }
   runPasses(
       rows, forces.isLocal(), scratch_,
-      {[&](const Tile& tile) {
-         // Stepped rows carry a(t) from their last tick; new rows need it evaluated.
-         const RowRange started = intersect(tile.rows(), fresh, n);
-         if (started.count() == 0) return;
-         Vec3Rows out = rowsOf(a, started);
-         forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0}, started, out);
-       },
+      {startRows,
        [&](const Tile& tile) {
          Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                   ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
