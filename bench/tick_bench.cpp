@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "BenchHarness.h"
+#include "fields/AnchorSpring.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
@@ -241,17 +242,21 @@ class HandSoaLoop {
 
 // ---- tickfx side -----------------------------------------------------------------------------
 
+// With `tether`, an anchor spring after the drag: forces no scheme can form in its update loop
+// (ForceSet::uniformAndDrag), so every scheme takes its force passes.
 std::unique_ptr<tickfx::ParticleSystem> makeSystem(
     std::size_t n, int threads, tickfx::NonfinitePolicy nonfinite = tickfx::NonfinitePolicy::Stop,
-    const std::string& integrator = "semi_implicit_euler") {
+    const std::string& integrator = "semi_implicit_euler", bool tether = false) {
   tickfx::SystemSettings settings;
   settings.nonfinite = nonfinite;
   settings.stepRateHz = kStepRateHz;
   settings.integrator = integrator;
   settings.maxParticles = n;
   settings.threads = threads;
+  tickfx::ForceSet forces = makeForces();
+  if (tether) forces.add(std::make_unique<tickfx::AnchorSpring>(Eigen::Vector3f::Zero(), 0.5f));
   auto system = std::make_unique<tickfx::ParticleSystem>(
-      settings, std::vector<tickfx::EmitterSettings>{}, makeForces());
+      settings, std::vector<tickfx::EmitterSettings>{}, std::move(forces));
   tickfx::ParticlePool& pool = system->pool();
   pool.reserve(n);  // one allocation instead of the doubling growth
   for (std::size_t i = 0; i < n; ++i) {
@@ -442,11 +447,12 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 }
 
 // Per integrator, step() on 1 thread with the non-finite check (NonfinitePolicy::Stop) and
-// without (Keep), all systems taking turns batch by batch. The check is folded into a pass that
-// reads the tile anyway, so what is left is of the order of where columns happen to sit in memory
-// (two identical systems measured up to 2 % apart): each side is kCheckCopies systems allocated
-// one after another, and a side's figure is the median of all its batches, so that no one
-// placement decides. The A/A spread sets half the unchecked copies against the other half.
+// without (Keep), all systems taking turns batch by batch: under the tick's own forces, which
+// every scheme forms in its one update loop, and with an anchor spring added ("+spring"), which
+// sends every scheme through its force passes. Two identical systems measured up to 2 % apart
+// with where their columns sat: each side is kCheckCopies systems allocated one after another,
+// and a side's figure is the median of all its batches, so that no one placement decides. The
+// A/A spread sets half the unchecked copies against the other half.
 void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& timing) {
   constexpr int kCheckCopies = 4;
   struct Cost {
@@ -458,7 +464,7 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
   std::printf(
       "\nnon-finite check, step() on 1 thread: checked against unchecked (%d systems a side)\n",
       kCheckCopies);
-  std::printf("%10s  %-22s %14s %14s %10s %12s\n", "N", "integrator", "checked ms", "unchecked ms",
+  std::printf("%10s  %-30s %14s %14s %10s %12s\n", "N", "integrator", "checked ms", "unchecked ms",
               "cost", "A/A spread");
   const auto pooledMedian = [](const std::vector<bench::Case>& cases, int first, int count) {
     std::vector<double> all;
@@ -469,35 +475,38 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
     return bench::median(all);
   };
   for (const std::size_t n : sizes) {
-    for (const std::string& name : tickfx::integratorNames()) {
-      // Interleaved allocations, so that neither side gets the earlier (or later) memory.
-      std::vector<std::unique_ptr<tickfx::ParticleSystem>> systems;
-      for (int i = 0; i < kCheckCopies; ++i) {
-        systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name));
-        systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name));
+    for (const bool tether : {false, true}) {
+      for (const std::string& name : tickfx::integratorNames()) {
+        const std::string label = name + (tether ? " +spring" : "");
+        // Interleaved allocations, so that neither side gets the earlier (or later) memory.
+        std::vector<std::unique_ptr<tickfx::ParticleSystem>> systems;
+        for (int i = 0; i < kCheckCopies; ++i) {
+          systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name, tether));
+          systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name, tether));
+        }
+        std::vector<bench::Case> cases;
+        for (const auto& system : systems) {
+          const bool checked = system->settings().nonfinite == tickfx::NonfinitePolicy::Stop;
+          cases.emplace_back(checked ? "checked" : "unchecked",
+                             [s = system.get()](std::int64_t ticks) {
+                               for (std::int64_t i = 0; i < ticks; ++i) s->step();
+                             });
+        }
+        bench::timeCases(cases, timing);
+        // Cases alternate checked, unchecked: gather each side.
+        std::vector<bench::Case> checkedCases, uncheckedCases;
+        for (std::size_t i = 0; i < cases.size(); ++i) {
+          (i % 2 == 0 ? checkedCases : uncheckedCases).push_back(cases[i]);
+        }
+        const double with = pooledMedian(checkedCases, 0, kCheckCopies);
+        const double without = pooledMedian(uncheckedCases, 0, kCheckCopies);
+        const double halfA = pooledMedian(uncheckedCases, 0, kCheckCopies / 2);
+        const double halfB = pooledMedian(uncheckedCases, kCheckCopies / 2, kCheckCopies / 2);
+        costs.push_back({n, label, 100.0 * (with / without - 1.0), 100.0 * (halfB / halfA - 1.0)});
+        std::printf("%10zu  %-30s %14.4f %14.4f %+9.1f %% %+10.1f %%\n", n, label.c_str(),
+                    1e3 * with, 1e3 * without, costs.back().cost, costs.back().spread);
+        std::fflush(stdout);
       }
-      std::vector<bench::Case> cases;
-      for (const auto& system : systems) {
-        const bool checked = system->settings().nonfinite == tickfx::NonfinitePolicy::Stop;
-        cases.emplace_back(checked ? "checked" : "unchecked",
-                           [s = system.get()](std::int64_t ticks) {
-                             for (std::int64_t i = 0; i < ticks; ++i) s->step();
-                           });
-      }
-      bench::timeCases(cases, timing);
-      // Cases alternate checked, unchecked: gather each side.
-      std::vector<bench::Case> checkedCases, uncheckedCases;
-      for (std::size_t i = 0; i < cases.size(); ++i) {
-        (i % 2 == 0 ? checkedCases : uncheckedCases).push_back(cases[i]);
-      }
-      const double with = pooledMedian(checkedCases, 0, kCheckCopies);
-      const double without = pooledMedian(uncheckedCases, 0, kCheckCopies);
-      const double halfA = pooledMedian(uncheckedCases, 0, kCheckCopies / 2);
-      const double halfB = pooledMedian(uncheckedCases, kCheckCopies / 2, kCheckCopies / 2);
-      costs.push_back({n, name, 100.0 * (with / without - 1.0), 100.0 * (halfB / halfA - 1.0)});
-      std::printf("%10zu  %-22s %14.4f %14.4f %+9.1f %% %+10.1f %%\n", n, name.c_str(), 1e3 * with,
-                  1e3 * without, costs.back().cost, costs.back().spread);
-      std::fflush(stdout);
     }
   }
   std::printf("\n");
