@@ -95,8 +95,10 @@ struct Exploding {
     s.nonfinite = policy;
     ForceSet forces;
     forces.add(std::make_unique<LinearDrag>(600.0f));
-    // A spring network (even empty) is not local: the integrator runs each pass over all rows
-    // in turn instead of tile by tile, and the check runs as a pass of its own.
+    // The drag alone is a form every scheme computes in its one update loop
+    // (UniformAndDragRows.h). A spring network (even empty) is not local and not such a form:
+    // the integrator then runs its force passes, each over all rows in turn instead of tile by
+    // tile, and checks in its last update loop.
     if (split) forces.add(std::make_unique<SpringNetwork>());
     system = std::make_unique<ParticleSystem>(s, std::vector<EmitterSettings>{}, std::move(forces));
     const Eigen::Vector3f velocities[] = {
@@ -174,8 +176,8 @@ TEST_P(NonfiniteRun, KillRemovesEachParticleAtItsOwnTickAndCountsIt) {
   EXPECT_EQ(kill.system->tickCount(), Exploding::kLastTick + 100);
 }
 
-// Each integrator checks inside its own last update loop (integrators/CheckedRows.h), so each is
-// tested: in lockstep with an unchecked run of the same effect, the checked one must stop at the
+// Each integrator checks inside its own update loops (integrators/CheckedRows.h): the one pass
+// ("fused": the drag alone) and the force passes ("split"), so each is tested both ways: in lockstep with an unchecked run of the same effect, the checked one must stop at the
 // first tick whose state has a non-finite position or velocity, naming exactly those rows. Drag
 // of 600/s at 60 Hz is unstable under every scheme here. Under explicit Euler the velocity goes
 // non-finite a tick before the position does (the position takes the old velocity): a check of
