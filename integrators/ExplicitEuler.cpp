@@ -1,7 +1,6 @@
 #include "integrators/ExplicitEuler.h"
 
-#include "integrators/CheckedRows.h"
-#include "integrators/UniformAndDragRows.h"
+#include "integrators/SingleEvaluationStep.h"
 
 namespace tickfx {
 namespace {
@@ -25,31 +24,11 @@ inline float explicitEulerRow(float dt, float acceleration, Eigen::Index i, floa
 void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                               const StepRows& rows, NonfiniteCheck* check) {
   const float dt = time.dt();
-  Vec3Column& p = pool.position();
-  Vec3Column& v = pool.velocity();
-  Vec3Column& prev = pool.previousPosition();
-  if (const auto forms = tickForms(pool, forces, time, {0})) {
-    runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, [dt](const auto& a) {
-      return [dt, a](Eigen::Index i, float* pos, float* vel, float* last) {
-        return explicitEulerRow(dt, a.at(0, vel[i]), i, pos, vel, last);
-      };
-    });
-    return;
-  }
-  runPasses(
-      rows, forces.isLocal(), scratch_,
-      {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0), [&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                  old = rowsOf(prev, tile.rows());
-         const auto update = [dt](Eigen::Index i, float* pos, float* vel, float* last,
-                                  const float* acc) {
-           return explicitEulerRow(dt, acc[i], i, pos, vel, last);
-         };
-         updateTile(check, pool, tile.rows(), update, [&](int c) {
-           return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
-                             static_cast<const float*>(a[c].data()));
-         });
-       }});
+  stepSingleEvaluation(
+      pool, forces, time, rows, check, scratch_,
+      [dt](float acceleration, Eigen::Index i, float* pos, float* vel, float* last) {
+        return explicitEulerRow(dt, acceleration, i, pos, vel, last);
+      });
 }
 
 }  // namespace tickfx

@@ -1,0 +1,48 @@
+// The tick of a scheme that evaluates the forces once, at t, from the state at t, and then
+// updates each row from its own position, velocity and that acceleration (explicit and
+// semi-implicit Euler): the one pass under uniform forces and a drag, else a force pass and an
+// update pass.
+#pragma once
+
+#include <tuple>
+
+#include "integrators/CheckedRows.h"
+#include "integrators/Integrator.h"
+#include "integrators/StagePasses.h"
+#include "integrators/UniformAndDragRows.h"
+
+namespace tickfx {
+
+/// Advances `rows` one tick: `row(acceleration, i, pos, vel, last)` updates row i of one
+/// component (acceleration in m/s², the columns as updateRowsChecked passes them) and returns
+/// what the check sums. `scratch` holds the acceleration of the force pass (one stage value).
+template <class Row>
+void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                          const StepRows& rows, NonfiniteCheck* check, StageScratch& scratch,
+                          const Row& row) {
+  if (const auto forms = tickForms(pool, forces, time, {0})) {
+    runStateUpdateUnderForms(pool, scratch, rows, check, *forms, [&row](const auto& a) {
+      return [row, a](Eigen::Index i, float* pos, float* vel, float* last) {
+        return row(a.at(0, vel[i]), i, pos, vel, last);
+      };
+    });
+    return;
+  }
+  Vec3Column& p = pool.position();
+  Vec3Column& v = pool.velocity();
+  Vec3Column& prev = pool.previousPosition();
+  runPasses(
+      rows, forces.isLocal(), scratch,
+      {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0), [&](const Tile& tile) {
+         Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                  old = rowsOf(prev, tile.rows());
+         const auto update = [row](Eigen::Index i, float* pos, float* vel, float* last,
+                                   const float* acc) { return row(acc[i], i, pos, vel, last); };
+         updateTile(check, pool, tile.rows(), update, [&](int c) {
+           return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
+                             static_cast<const float*>(a[c].data()));
+         });
+       }});
+}
+
+}  // namespace tickfx
