@@ -429,7 +429,10 @@ int previewCommand(Arguments& args) {
                            lines, settings);
   };
   std::optional<io::GifFlipbook> gif;
-  if (options.gif) gif.emplace(size.width, size.height, io::GifFlipbook::delayFor(source->fps()));
+  if (options.gif) {
+    gif.emplace(size.width, size.height, io::GifFlipbook::delayFor(source->fps()),
+                settings.background);
+  }
   std::optional<io::FfmpegMovie> movie;
   if (options.ffmpeg) {
     movie.emplace(*options.ffmpeg, outDir / "flipbook.mp4", size.width, size.height, source->fps());

@@ -29,8 +29,10 @@
 namespace tickfx::io {
 namespace {
 
-const Rgb kBlack{0, 0, 0}, kWhite{255, 255, 255}, kRed{255, 0, 0}, kGrey102{102, 102, 102},
-    kGrey153{153, 153, 153}, kOrange{204, 85, 51}, kTeal{0, 170, 153};
+const Rgb kBlack{0, 0, 0}, kWhite{255, 255, 255}, kRed{255, 0, 0}, kGrey64{64, 64, 64},
+    kGrey128{128, 128, 128}, kGrey191{191, 191, 191}, kOrange{204, 85, 51}, kTeal{0, 170, 153};
+// The frames' background, which the palette holds exactly (the preview's own).
+const Rgb kBackground{24, 24, 28};
 
 struct CloseDecoder {
   void operator()(GifFileType* gif) const { DGifCloseFile(gif, nullptr); }
@@ -92,8 +94,8 @@ SplatImage firstFrame() {
   SplatImage image(8, 6, kBlack);
   image.set(1, 1, kWhite);
   image.set(2, 1, kRed);
-  image.set(3, 1, kGrey102);
-  image.set(4, 1, kGrey153);
+  image.set(3, 1, kGrey64);
+  image.set(4, 1, kGrey191);
   image.set(5, 1, kOrange);
   image.set(7, 5, kTeal);
   return image;
@@ -103,14 +105,14 @@ SplatImage secondFrame() {
   SplatImage image(8, 6, kWhite);
   image.set(0, 0, kBlack);
   image.set(6, 2, kRed);
-  image.set(2, 4, kGrey153);
-  image.set(3, 4, kGrey102);
+  image.set(2, 4, kGrey191);
+  image.set(3, 4, kGrey64);
   return image;
 }
 
 TEST(GifFlipbook, DecodesToTheFramesWithTheirDelayAndLoopsForever) {
   const SplatImage frames[] = {firstFrame(), secondFrame()};
-  GifFlipbook book(8, 6, 7);
+  GifFlipbook book(8, 6, 7, kBackground);
   EXPECT_EQ(book.frameCount(), 0u);
   book.add(frames[0]);
   book.add(frames[1]);
@@ -169,8 +171,8 @@ TEST(GifFlipbook, DecodesToTheFramesWithTheirDelayAndLoopsForever) {
   EXPECT_EQ(second.ExtensionBlocks[0].Function, GRAPHICS_EXT_FUNC_CODE);
 }
 
-TEST(GifFlipbook, HasTheFixedPaletteOfACubeAndFourGreys) {
-  GifFlipbook book(1, 1, 10);
+TEST(GifFlipbook, HasTheFixedPaletteOfACubeThreeGreysAndTheBackground) {
+  GifFlipbook book(1, 1, 10, kBackground);
   book.add(SplatImage(1, 1, kBlack));
   const Decoded gif = decode(book.bytes());
   ASSERT_NE(gif->SColorMap, nullptr);
@@ -187,11 +189,44 @@ TEST(GifFlipbook, HasTheFixedPaletteOfACubeAndFourGreys) {
       for (const std::uint8_t b : sixes) expected.insert({r, g, b});
     }
   }
-  for (const std::uint8_t v : std::array<std::uint8_t, 4>{51, 102, 153, 204}) {
-    expected.insert({v, v, v});
-  }
+  for (const std::uint8_t v : std::array<std::uint8_t, 3>{64, 128, 191}) expected.insert({v, v, v});
+  expected.insert(kBackground);
   EXPECT_EQ(expected.size(), 256u);
   EXPECT_EQ(palette, expected);
+}
+
+// The background is one palette colour: a frame of it is flat (and compresses to a few bytes a
+// row), where a colour one step off it is dithered.
+TEST(GifFlipbook, KeepsTheBackgroundExactAndFlat) {
+  constexpr int kWidth = 64, kHeight = 48;
+  SplatImage frame(kWidth, kHeight, kBackground);
+  frame.set(10, 10, kWhite);
+  GifFlipbook book(kWidth, kHeight, 10, kBackground);
+  book.add(frame);
+  const std::vector<std::uint8_t> bytes = book.bytes();
+  const Decoded gif = decode(bytes);
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      EXPECT_EQ(pixel(*gif, 0, x, y), x == 10 && y == 10 ? kWhite : kBackground) << x << "," << y;
+    }
+  }
+
+  const Rgb offBackground{25, 24, 28};
+  GifFlipbook other(kWidth, kHeight, 10, kBackground);
+  other.add(SplatImage(kWidth, kHeight, offBackground));
+  const std::vector<std::uint8_t> otherBytes = other.bytes();
+  const Decoded dithered = decode(otherBytes);
+  std::set<Rgb> colours;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) colours.insert(pixel(*dithered, 0, x, y));
+  }
+  // Both files are alike up to the image data (header, palette, loop, image descriptor): past
+  // that, the flat image takes less than half the dithered one's bytes (96 bytes against 239).
+  const auto differ = std::mismatch(bytes.begin(), bytes.end(), otherBytes.begin()).first;
+  const auto shared = static_cast<std::size_t>(differ - bytes.begin());
+  EXPECT_GT(shared, 800u);
+  EXPECT_LT(bytes.size() - shared, (otherBytes.size() - shared) / 2);
+  EXPECT_EQ(colours, (std::set<Rgb>{kBlack, kGrey64}));  // a near-grey, dithered between greys
 }
 
 // The decoded mean of each 4 × 4 window of a flat image, per channel.
@@ -223,9 +258,9 @@ std::set<Rgb> coloursIn(const GifFileType& gif, int side) {
 
 TEST(GifFlipbook, DithersAColourOffThePaletteToItsMeanOverEveryFourByFour) {
   constexpr int kSide = 12;
-  const Rgb colours[] = {{128, 128, 128}, {200, 100, 60}, {30, 240, 120}, {1, 254, 77}};
+  const Rgb colours[] = {{96, 96, 96}, {200, 100, 60}, {30, 240, 120}, {1, 254, 77}};
   for (const Rgb& colour : colours) {
-    GifFlipbook book(kSide, kSide, 10);
+    GifFlipbook book(kSide, kSide, 10, kBackground);
     book.add(SplatImage(kSide, kSide, colour));
     const Decoded gif = decode(book.bytes());
     EXPECT_GT(coloursIn(*gif, kSide).size(), 1u);  // a pattern, not the nearest colour
@@ -237,12 +272,12 @@ TEST(GifFlipbook, DithersAColourOffThePaletteToItsMeanOverEveryFourByFour) {
 
 TEST(GifFlipbook, DithersANearGreyBetweenGreysOnly) {
   constexpr int kSide = 8;
-  GifFlipbook book(kSide, kSide, 10);
-  book.add(SplatImage(kSide, kSide, {131, 124, 129}));  // spread 7, mean 128
+  GifFlipbook book(kSide, kSide, 10, kBackground);
+  book.add(SplatImage(kSide, kSide, {99, 92, 97}));  // spread 7, mean 96
   const Decoded gif = decode(book.bytes());
-  EXPECT_EQ(coloursIn(*gif, kSide), (std::set<Rgb>{kGrey102, kGrey153}));
+  EXPECT_EQ(coloursIn(*gif, kSide), (std::set<Rgb>{kGrey64, kGrey128}));
   for (const auto& mean : windowMeans(*gif, kSide)) {
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], 128.0, 2.0);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], 96.0, 2.0);
   }
 }
 
@@ -253,7 +288,7 @@ TEST(GifFlipbook, GivesAPixelItsIndexFromItsColourAndPlaceAlone) {
   for (int y = 0; y < 16; ++y) {
     for (int x = 16; x < 32; ++x) b.set(x, y, a.at(x, y));
   }
-  GifFlipbook book(32, 16, 10);
+  GifFlipbook book(32, 16, 10, kBackground);
   book.add(a);
   book.add(b);
   const Decoded gif = decode(book.bytes());
@@ -273,7 +308,7 @@ TEST(GifFlipbook, GivesAPixelItsIndexFromItsColourAndPlaceAlone) {
 
 TEST(GifFlipbook, GivesTheSameBytesForTheSameFrames) {
   const auto build = [] {
-    GifFlipbook book(48, 32, 4);
+    GifFlipbook book(48, 32, 4, kBackground);
     for (unsigned seed = 1; seed <= 3; ++seed) book.add(noise(48, 32, seed));
     return book.bytes();
   };
@@ -283,28 +318,28 @@ TEST(GifFlipbook, GivesTheSameBytesForTheSameFrames) {
 }
 
 TEST(GifFlipbook, RefusesBadSizesDelaysAndFrames) {
-  EXPECT_THROW(GifFlipbook(0, 6, 10), std::invalid_argument);
-  EXPECT_THROW(GifFlipbook(8, 0, 10), std::invalid_argument);
-  EXPECT_THROW(GifFlipbook(-1, 6, 10), std::invalid_argument);
-  EXPECT_THROW(GifFlipbook(65536, 6, 10), std::invalid_argument);
-  EXPECT_THROW(GifFlipbook(8, 65536, 10), std::invalid_argument);
-  EXPECT_THROW(GifFlipbook(8, 6, 0), std::invalid_argument);
-  EXPECT_THROW(GifFlipbook(8, 6, 65536), std::invalid_argument);
-  EXPECT_NO_THROW(GifFlipbook(65535, 65535, 65535));
+  EXPECT_THROW(GifFlipbook(0, 6, 10, kBackground), std::invalid_argument);
+  EXPECT_THROW(GifFlipbook(8, 0, 10, kBackground), std::invalid_argument);
+  EXPECT_THROW(GifFlipbook(-1, 6, 10, kBackground), std::invalid_argument);
+  EXPECT_THROW(GifFlipbook(65536, 6, 10, kBackground), std::invalid_argument);
+  EXPECT_THROW(GifFlipbook(8, 65536, 10, kBackground), std::invalid_argument);
+  EXPECT_THROW(GifFlipbook(8, 6, 0, kBackground), std::invalid_argument);
+  EXPECT_THROW(GifFlipbook(8, 6, 65536, kBackground), std::invalid_argument);
+  EXPECT_NO_THROW(GifFlipbook(65535, 65535, 65535, kBackground));
   try {
-    [[maybe_unused]] const GifFlipbook book(0, 720, 4);
+    [[maybe_unused]] const GifFlipbook book(0, 720, 4, kBackground);
     ADD_FAILURE() << "no exception";
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(), "a flipbook of 0x720 pixels (expected 1 to 65535 a side)");
   }
   try {
-    [[maybe_unused]] const GifFlipbook book(1280, 720, 0);
+    [[maybe_unused]] const GifFlipbook book(1280, 720, 0, kBackground);
     ADD_FAILURE() << "no exception";
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(), "a frame delay of 0 centiseconds (expected 1 to 65535)");
   }
 
-  GifFlipbook book(8, 6, 10);
+  GifFlipbook book(8, 6, 10, kBackground);
   book.add(firstFrame());
   const std::vector<std::uint8_t> before = book.bytes();
   EXPECT_THROW(book.add(SplatImage(9, 6, kBlack)), std::invalid_argument);
@@ -345,7 +380,7 @@ class GifFlipbookFile : public ::testing::Test {
 };
 
 TEST_F(GifFlipbookFile, WritesItsBytes) {
-  GifFlipbook book(8, 6, 4);
+  GifFlipbook book(8, 6, 4, kBackground);
   book.add(firstFrame());
   book.add(secondFrame());
   const std::filesystem::path path = dir_ / "flipbook.gif";
@@ -360,7 +395,7 @@ TEST_F(GifFlipbookFile, WritesItsBytes) {
 }
 
 TEST_F(GifFlipbookFile, RefusesAFolderThatDoesNotExistAndWritesNothing) {
-  GifFlipbook book(8, 6, 4);
+  GifFlipbook book(8, 6, 4, kBackground);
   book.add(firstFrame());
   const std::filesystem::path path = dir_ / "missing" / "flipbook.gif";
   try {

@@ -56,14 +56,30 @@ DitherTable makeDitherTable(int levels) {
   return table;
 }
 
+// Grey levels (of 5: 0, 64, 128, 191, 255) for near-greys, beside the cube's black and white.
+constexpr int kGreyLevels = 5;
+// The palette's last slot: the frames' background colour, exactly.
+constexpr std::size_t kBackgroundIndex = 255;
+
+std::string giflibError(int code) {
+  const char* s = GifErrorString(code);
+  return std::string("giflib: ") + (s != nullptr ? s : "error " + std::to_string(code));
+}
+
+}  // namespace
+
+// Named, not anonymous: an Encoder (a class with linkage) holds one.
+namespace gifpalette {
+
 struct Quantiser {
-  DitherTable six = makeDitherTable(6), seven = makeDitherTable(7);
-  // The palette index of grey level j of 6 (0 and 5 are the cube's black and white).
-  std::array<std::uint8_t, 6> grey{
-      0, kCubeColours, kCubeColours + 1, kCubeColours + 2, kCubeColours + 3, kCubeColours - 1};
+  DitherTable six = makeDitherTable(6), seven = makeDitherTable(7), five = makeDitherTable(5);
+  // The palette index of grey level j of 5 (0 and 4 are the cube's black and white).
+  std::array<std::uint8_t, kGreyLevels> grey{0, kCubeColours, kCubeColours + 1, kCubeColours + 2,
+                                             kCubeColours - 1};
+  Rgb background;
   std::array<GifColorType, 256> palette{};
 
-  Quantiser() {
+  explicit Quantiser(Rgb bg) : background(bg) {
     for (int r = 0; r < kRedLevels; ++r) {
       for (int g = 0; g < kGreenLevels; ++g) {
         for (int b = 0; b < kBlueLevels; ++b) {
@@ -74,40 +90,34 @@ struct Quantiser {
         }
       }
     }
-    for (int j = 1; j <= 4; ++j) {
-      const auto v = static_cast<GifByteType>(levelValue(j, 6));
+    for (int j = 1; j < kGreyLevels - 1; ++j) {
+      const auto v = static_cast<GifByteType>(levelValue(j, kGreyLevels));
       palette[grey[static_cast<std::size_t>(j)]] = {v, v, v};
     }
+    palette[kBackgroundIndex] = {background[0], background[1], background[2]};
   }
 
   static int cubeIndex(int r, int g, int b) { return (r * kGreenLevels + g) * kBlueLevels + b; }
 
   GifPixelType index(int x, int y, Rgb c) const {
+    // Most of a frame: one index, no dither, so the background is flat and compresses to little.
+    if (c == background) return static_cast<GifPixelType>(kBackgroundIndex);
     const auto k = static_cast<std::size_t>(
         kBayer[static_cast<std::size_t>(y & 3)][static_cast<std::size_t>(x & 3)]);
     const auto [lo, hi] = std::minmax({c[0], c[1], c[2]});
     if (hi - lo < kNearGreySpread) {
       const int mean = (c[0] + c[1] + c[2] + 1) / 3;
-      return grey[six[k][static_cast<std::size_t>(mean)]];
+      return grey[five[k][static_cast<std::size_t>(mean)]];
     }
     return static_cast<GifPixelType>(cubeIndex(six[k][c[0]], seven[k][c[1]], six[k][c[2]]));
   }
 };
 
-const Quantiser& quantiser() {
-  static const Quantiser q;
-  return q;
-}
-
-std::string giflibError(int code) {
-  const char* s = GifErrorString(code);
-  return std::string("giflib: ") + (s != nullptr ? s : "error " + std::to_string(code));
-}
-
-}  // namespace
+}  // namespace gifpalette
 
 struct GifFlipbook::Encoder {
   int width, height, delay;
+  gifpalette::Quantiser quantiser;
   std::vector<std::uint8_t> header;               // signature, screen, palette, loop extension
   std::vector<std::vector<std::uint8_t>> frames;  // each frame's extension and image, exact size
   // Where giflib's writes go: the header, then each frame's scratch. The scratch keeps its
@@ -143,7 +153,8 @@ struct GifFlipbook::Encoder {
     if (result != GIF_OK) throw std::runtime_error(giflibError(gif->Error));
   }
 
-  Encoder(int w, int h, int d) : width(w), height(h), delay(d) {
+  Encoder(int w, int h, int d, Rgb background)
+      : width(w), height(h), delay(d), quantiser(background) {
     int error = 0;
     gif.reset(EGifOpen(this, &Encoder::append, &error));
     if (!gif) throw std::runtime_error(giflibError(error));
@@ -151,7 +162,7 @@ struct GifFlipbook::Encoder {
     // The graphics control and application extensions are GIF89a's; giflib would otherwise
     // write GIF87a, the signature being written before any of them.
     EGifSetGifVersion(gif.get(), true);
-    ColorMapObject* map = GifMakeMapObject(256, quantiser().palette.data());
+    ColorMapObject* map = GifMakeMapObject(256, quantiser.palette.data());
     if (map == nullptr) throw std::bad_alloc();
     const int screen = EGifPutScreenDesc(gif.get(), width, height, 8, 0, map);
     GifFreeMapObject(map);
@@ -184,7 +195,7 @@ struct GifFlipbook::Encoder {
     check(EGifPutExtension(gif.get(), GRAPHICS_EXT_FUNC_CODE, length, extension));
     // No local palette: every frame uses the global one.
     check(EGifPutImageDesc(gif.get(), 0, 0, width, height, false, nullptr));
-    const Quantiser& q = quantiser();
+    const gifpalette::Quantiser& q = quantiser;
     const std::vector<std::uint8_t> rgb = image.rgb8();
     std::vector<GifPixelType> row(static_cast<std::size_t>(width));
     for (int y = 0; y < height; ++y) {
@@ -199,7 +210,7 @@ struct GifFlipbook::Encoder {
   }
 };
 
-GifFlipbook::GifFlipbook(int width, int height, int delayCentiseconds) {
+GifFlipbook::GifFlipbook(int width, int height, int delayCentiseconds, Rgb background) {
   if (width < 1 || height < 1 || width > kMaxWord || height > kMaxWord) {
     throw std::invalid_argument("a flipbook of " + std::to_string(width) + "x" +
                                 std::to_string(height) + " pixels (expected 1 to " +
@@ -209,7 +220,7 @@ GifFlipbook::GifFlipbook(int width, int height, int delayCentiseconds) {
     throw std::invalid_argument("a frame delay of " + std::to_string(delayCentiseconds) +
                                 " centiseconds (expected 1 to " + std::to_string(kMaxWord) + ")");
   }
-  encoder_ = std::make_unique<Encoder>(width, height, delayCentiseconds);
+  encoder_ = std::make_unique<Encoder>(width, height, delayCentiseconds, background);
 }
 
 GifFlipbook::~GifFlipbook() = default;

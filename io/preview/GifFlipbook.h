@@ -14,10 +14,11 @@ namespace tickfx::io {
 /// A looping animated GIF built frame by frame in memory and written whole at the end.
 ///
 /// Every frame is quantised to one fixed palette of 256 colours (a 6 × 7 × 6 RGB cube, 6 levels
-/// of red and blue and 7 of green evenly spread over 0..255, and the greys 51, 102, 153 and 204)
-/// with a 4 × 4 ordered dither, so a pixel's index depends only on its colour and its position:
-/// the same frames give the same bytes whatever else is in them. A palette colour is kept
-/// exactly; another colour becomes a pattern of its neighbours in the palette whose mean over
+/// of red and blue and 7 of green evenly spread over 0..255, the greys 64, 128 and 191, and the
+/// frames' background colour) with a 4 × 4 ordered dither, so a pixel's index depends only on its
+/// colour and its position: the same frames give the same bytes whatever else is in them. A
+/// palette colour is kept exactly, the background among them, so that most of a frame is one
+/// flat colour; another colour becomes a pattern of its neighbours in the palette whose mean over
 /// any 4 × 4 pixels is within 2 of it in each channel. Near-greys (channels within 7 of each
 /// other) are dithered between greys only, so that they pick up no tint: their mean is within 2
 /// of the channels' mean.
@@ -27,9 +28,9 @@ namespace tickfx::io {
 class GifFlipbook {
  public:
   /// Frames of width × height pixels shown `delayCentiseconds` each (GIF counts delays in
-  /// 1/100 s). Throws std::invalid_argument for a size outside 1..65535 or a delay outside
-  /// 1..65535.
-  GifFlipbook(int width, int height, int delayCentiseconds);
+  /// 1/100 s), on `background` (RenderSettings::background: the palette holds it exactly).
+  /// Throws std::invalid_argument for a size outside 1..65535 or a delay outside 1..65535.
+  GifFlipbook(int width, int height, int delayCentiseconds, Rgb background);
   ~GifFlipbook();
   GifFlipbook(GifFlipbook&&) noexcept;
   GifFlipbook& operator=(GifFlipbook&&) noexcept;
