@@ -5,7 +5,9 @@
 
 #include <cstdint>
 #include <random>
+#include <set>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "io/preview/ColourMap.h"
@@ -211,6 +213,16 @@ TEST(PixelFont, DrawsEachGlyphsPixelsAtItsScale) {
   drawText(question, 0, 0, "?", white, 1);
   EXPECT_EQ(inked(unknown, white), inked(question, white));
   EXPECT_FALSE(inked(question, white).empty());
+  // Every character the font has is a pattern of its own (names in captions may quote or
+  // bracket), and none is the '?' of an unknown one but '?' itself.
+  const std::string known = " !\"#'()*+,-./0123456789:;<=>?[]_%abcdefghijklmnopqrstuvwxyz";
+  std::set<std::vector<std::pair<int, int>>> patterns;
+  for (const char c : known) {
+    SplatImage glyph(6, 8, kBlack);
+    drawText(glyph, 0, 0, std::string(1, c), white, 1);
+    patterns.insert(inked(glyph, white));
+  }
+  EXPECT_EQ(patterns.size(), known.size());
   SplatImage edge(3, 3, kBlack);
   drawText(edge, -2, -2, "88", white, 1);  // partly outside: no crash, some ink
   EXPECT_FALSE(inked(edge, white).empty());

@@ -16,7 +16,8 @@ inline constexpr int kGlyphHeight = 7;
 int textWidth(std::string_view text, int scale);
 
 /// Draws `text` with its top-left corner at (x, y): lower-case letters, digits, space and
-/// . , : = - + _ / ( ) % ?; upper-case letters are drawn as lower-case, anything else as '?'.
+/// . , : ; = - + * _ / ( ) [ ] < > % # ! ? ' "; upper-case letters are drawn as lower-case,
+/// anything else as '?'.
 /// Pixels outside the image are skipped.
 void drawText(SplatImage& image, int x, int y, std::string_view text, Rgb colour, int scale);
 
