@@ -39,37 +39,34 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = rows.fresh;
   const std::size_t n = rows.rows.end;
-  // The rows of a tile spawned this tick: their history, from `acceleration(c, row)` (the row's
-  // index within the tile).
-  const auto start = [&](const RowRange& r, const auto& acceleration) {
+  // Component c of the rows of tile rows `r` spawned this tick: their history, with
+  // `acceleration(i, v)` the acceleration of the tile's row i at velocity v.
+  const auto start = [&](const RowRange& r, int c, const auto& acceleration) {
     const RowRange started = intersect(r, fresh, n);
     if (started.count() == 0) return;
     const auto offset = static_cast<Eigen::Index>(started.begin - r.begin);
     Vec3Rows old = rowsOf(prev, started), pr = rowsOf(p, started), vr = rowsOf(v, started);
-    for (int c = 0; c < 3; ++c) {
-      for (Eigen::Index i = 0; i < started.count(); ++i) {
-        old[c][i] = startingPrevious(pr[c][i], vr[c][i], acceleration(c, offset + i, vr[c][i]), dt,
-                                     halfDt2);
-      }
+    for (Eigen::Index i = 0; i < started.count(); ++i) {
+      old[c][i] =
+          startingPrevious(pr[c][i], vr[c][i], acceleration(offset + i, vr[c][i]), dt, halfDt2);
     }
   };
   if (const auto forms = tickForms(pool, forces, time, {0})) {
-    runPasses(rows, true, scratch_, {[&](const Tile& tile) {
-                const RowRange r = tile.rows();
-                start(r, [&](int c, Eigen::Index, float velocity) {
-                  return withFormAccelerations(*forms, c,
-                                               [&](const auto& a) { return a.at(0, velocity); });
-                });
-                Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
-                updateTileUnderForms(
-                    check, pool, r, *forms,
-                    [dt2, invDt](const auto& a) {
-                      return [dt2, invDt, a](Eigen::Index i, float* pos, float* vel, float* last) {
-                        return positionVerletRow(dt2, invDt, a.at(0, vel[i]), i, pos, vel, last);
-                      };
-                    },
-                    [&](int c) { return std::tuple(pr[c].data(), vr[c].data(), old[c].data()); });
-              }});
+    const auto startTile = [&](const Tile& tile) {
+      for (int c = 0; c < 3; ++c) {
+        withFormAccelerations(*forms, c, [&](const auto& a) {
+          start(tile.rows(), c, [&a](Eigen::Index, float velocity) { return a.at(0, velocity); });
+        });
+      }
+    };
+    runOnePass(
+        pool, scratch_, rows, check, *forms,
+        [dt2, invDt](const auto& a) {
+          return [dt2, invDt, a](Eigen::Index i, float* pos, float* vel, float* last) {
+            return positionVerletRow(dt2, invDt, a.at(0, vel[i]), i, pos, vel, last);
+          };
+        },
+        startTile);
     return;
   }
   runPasses(
@@ -77,7 +74,7 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
       {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0), [&](const Tile& tile) {
          const RowRange r = tile.rows();
          Vec3Rows a = tile.stage(0), pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
-         start(r, [&](int c, Eigen::Index i, float) { return a[c][i]; });
+         for (int c = 0; c < 3; ++c) start(r, c, [&](Eigen::Index i, float) { return a[c][i]; });
          const auto update = [dt2, invDt](Eigen::Index i, float* pos, float* vel, float* last,
                                           const float* acc) {
            return positionVerletRow(dt2, invDt, acc[i], i, pos, vel, last);

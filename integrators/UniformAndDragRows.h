@@ -100,23 +100,39 @@ void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange ro
   if (suspect) check->scan(pool, rows.begin, rows.end);
 }
 
-/// The one pass of a scheme whose row update reads and writes the position, the velocity and the
-/// previous position alone: `kernelFor(accelerations)` gives the kernel (i, pos, vel, last) of one
-/// component, for every tile of `rows`.
-template <class KernelFor>
-void runStateUpdateUnderForms(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
-                              NonfiniteCheck* check, const TickForms& forms,
-                              const KernelFor& kernelFor) {
+/// The one pass of a scheme over every tile of `rows`: `beforeTile(tile)` first (the rows spawned
+/// this tick start their history, say), then for each component the kernel
+/// `kernelFor(accelerations)` gives, (i, pos, vel, last, extra...), over the position, the
+/// velocity, the previous position and the `extra` columns of the tile.
+template <class KernelFor, class BeforeTile, class... Extra>
+void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
+                NonfiniteCheck* check, const TickForms& forms, const KernelFor& kernelFor,
+                const BeforeTile& beforeTile, Extra&... extra) {
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   runPasses(rows, true, scratch, {[&](const Tile& tile) {
-              Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                       old = rowsOf(prev, tile.rows());
-              updateTileUnderForms(check, pool, tile.rows(), forms, kernelFor, [&](int c) {
-                return std::tuple(pr[c].data(), vr[c].data(), old[c].data());
+              beforeTile(tile);
+              const RowRange r = tile.rows();
+              Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
+              std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
+              updateTileUnderForms(check, pool, r, forms, kernelFor, [&](int c) {
+                return std::apply(
+                    [&](auto&... e) {
+                      return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), e[c].data()...);
+                    },
+                    more);
               });
             }});
+}
+
+/// runOnePass() of a scheme whose row update reads and writes the position, the velocity and
+/// the previous position alone, with nothing to do before a tile.
+template <class KernelFor>
+void runStateUpdateUnderForms(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
+                              NonfiniteCheck* check, const TickForms& forms,
+                              const KernelFor& kernelFor) {
+  runOnePass(pool, scratch, rows, check, forms, kernelFor, [](const Tile&) {});
 }
 
 }  // namespace tickfx

@@ -27,30 +27,23 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   if (const auto forms = tickForms(pool, forces, time, {2})) {
     // The position, the predicted velocity, a(t + dt) from it and the new velocity in the row's
     // registers (the position does not enter a uniform force or a drag).
-    runPasses(rows, true, scratch_, {[&](const Tile& tile) {
-                startRows(tile);
-                Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                         ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
-                updateTileUnderForms(
-                    check, pool, tile.rows(), *forms,
-                    [=](const auto& accelerations) {
-                      return [=](Eigen::Index i, float* pos, float* vel, float* last, float* acc) {
-                        const float position = pos[i];
-                        const float velocity = vel[i];
-                        const float next = position + (velocity * dt + acc[i] * halfDt2);
-                        const float accNext = accelerations.at(2, velocity + acc[i] * dt);
-                        const float nextV = velocity + (acc[i] + accNext) * halfDt;
-                        last[i] = position;
-                        pos[i] = next;
-                        vel[i] = nextV;
-                        acc[i] = accNext;
-                        return CheckedPair{next, nextV};  // the new velocity is not in next
-                      };
-                    },
-                    [&](int c) {
-                      return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), ar[c].data());
-                    });
-              }});
+    runOnePass(
+        pool, scratch_, rows, check, *forms,
+        [=](const auto& accelerations) {
+          return [=](Eigen::Index i, float* pos, float* vel, float* last, float* acc) {
+            const float position = pos[i];
+            const float velocity = vel[i];
+            const float next = position + (velocity * dt + acc[i] * halfDt2);
+            const float accNext = accelerations.at(2, velocity + acc[i] * dt);
+            const float nextV = velocity + (acc[i] + accNext) * halfDt;
+            last[i] = position;
+            pos[i] = next;
+            vel[i] = nextV;
+            acc[i] = accNext;
+            return CheckedPair{next, nextV};  // the new velocity is not in next
+          };
+        },
+        startRows, a);
     return;
   }
   runPasses(
