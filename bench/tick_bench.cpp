@@ -449,7 +449,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 // Per integrator, step() on 1 thread with the non-finite check (NonfinitePolicy::Stop) and
 // without (Keep), all systems taking turns batch by batch: under the tick's own forces, which
 // every scheme forms in its one update loop, and with an anchor spring added ("+spring"), which
-// sends every scheme through its force passes. Two identical systems measured up to 2 % apart
+// sends every scheme through its force passes. Two identical systems measured up to 3 % apart
 // with where their columns sat: each side is kCheckCopies systems allocated one after another,
 // and a side's figure is the median of all its batches, so that no one placement decides. The
 // A/A spread sets half the unchecked copies against the other half.
@@ -466,10 +466,13 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
       kCheckCopies);
   std::printf("%10s  %-30s %14s %14s %10s %12s\n", "N", "integrator", "checked ms", "unchecked ms",
               "cost", "A/A spread");
-  const auto pooledMedian = [](const std::vector<bench::Case>& cases, int first, int count) {
+  // The median of the batches of copies [first, first + count) of one side: the cases alternate
+  // checked (side 0) and unchecked (side 1).
+  const auto pooledMedian = [](const std::vector<bench::Case>& cases, int side, int first,
+                               int count) {
     std::vector<double> all;
     for (int i = first; i < first + count; ++i) {
-      const std::vector<double>& s = cases[static_cast<std::size_t>(i)].secondsPerTick;
+      const std::vector<double>& s = cases[static_cast<std::size_t>(2 * i + side)].secondsPerTick;
       all.insert(all.end(), s.begin(), s.end());
     }
     return bench::median(all);
@@ -485,23 +488,17 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
           systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name, tether));
         }
         std::vector<bench::Case> cases;
-        for (const auto& system : systems) {
-          const bool checked = system->settings().nonfinite == tickfx::NonfinitePolicy::Stop;
-          cases.emplace_back(checked ? "checked" : "unchecked",
-                             [s = system.get()](std::int64_t ticks) {
-                               for (std::int64_t i = 0; i < ticks; ++i) s->step();
+        for (std::size_t i = 0; i < systems.size(); ++i) {
+          cases.emplace_back(i % 2 == 0 ? "checked" : "unchecked",
+                             [s = systems[i].get()](std::int64_t ticks) {
+                               for (std::int64_t t = 0; t < ticks; ++t) s->step();
                              });
         }
         bench::timeCases(cases, timing);
-        // Cases alternate checked, unchecked: gather each side.
-        std::vector<bench::Case> checkedCases, uncheckedCases;
-        for (std::size_t i = 0; i < cases.size(); ++i) {
-          (i % 2 == 0 ? checkedCases : uncheckedCases).push_back(cases[i]);
-        }
-        const double with = pooledMedian(checkedCases, 0, kCheckCopies);
-        const double without = pooledMedian(uncheckedCases, 0, kCheckCopies);
-        const double halfA = pooledMedian(uncheckedCases, 0, kCheckCopies / 2);
-        const double halfB = pooledMedian(uncheckedCases, kCheckCopies / 2, kCheckCopies / 2);
+        const double with = pooledMedian(cases, 0, 0, kCheckCopies);
+        const double without = pooledMedian(cases, 1, 0, kCheckCopies);
+        const double halfA = pooledMedian(cases, 1, 0, kCheckCopies / 2);
+        const double halfB = pooledMedian(cases, 1, kCheckCopies / 2, kCheckCopies / 2);
         costs.push_back({n, label, 100.0 * (with / without - 1.0), 100.0 * (halfB / halfA - 1.0)});
         std::printf("%10zu  %-30s %14.4f %14.4f %+9.1f %% %+10.1f %%\n", n, label.c_str(),
                     1e3 * with, 1e3 * without, costs.back().cost, costs.back().spread);
