@@ -5,8 +5,8 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
 #include <cmath>
+#include <cstring>
 #include <tuple>
 #include <type_traits>
 
@@ -15,22 +15,80 @@
 
 namespace tickfx {
 
-/// What a row's update hands to the check when its new position does not contain its new
-/// velocity: both values (a kernel whose new position does returns that one float).
-using CheckedPair = std::array<float, 2>;
+/// Four rows of a column as one value: the register of SSE and NEON. Its arithmetic is lane by
+/// lane and IEEE (no contraction: -ffp-contract=off), so rows computed four at a time have the
+/// bits of the rows computed one by one.
+using Lanes4 = float __attribute__((vector_size(16)));
 
-/// Runs `kernel(i, columns...)` for i in [0, n): one row's update, reading and writing the rows
-/// through `columns` (each a distinct column: they are __restrict here, which is what lets the
-/// loop vectorise; the same kernel reaching its columns through captured pointers measured 3.5×
-/// slower). With kCheck, adds what each call returns (a float, or both values of a CheckedPair,
-/// one after the other) into kLanes partial sums, so the compiler vectorises the sum without
-/// reassociating anything (which -ffast-math is banned for). A sum with a NaN or an infinity among
-/// its terms is not finite, whatever its order, so a finite sum clears every row; a sum of finite
-/// terms can also overflow, and then the caller's exact scan finds nothing and only time is lost.
-/// A pair's values are added to the sum one by one rather than to each other first: the value
-/// computed last (the velocity, at the end of a long dependency chain in a one-pass scheme) is
-/// then one add from the end, not two, and a loop bound by that chain's latency measured the
-/// difference. Returns whether some returned value may be non-finite (always false without kCheck).
+/// Where a row kernel reads and writes: row `i` of each column it is given (Lane = float), or
+/// rows i..i+3 (Lane = Lanes4). A kernel is written once over `auto row` and `auto` values, and
+/// runs four rows at a time in the loop's body and one at a time in its tail.
+template <class Lane>
+struct RowsAt {
+  Eigen::Index i;
+
+  Lane load(const float* column) const {
+    if constexpr (std::is_same_v<Lane, float>) {
+      return column[i];
+    } else {
+      Lane value;
+      std::memcpy(&value, column + i, sizeof value);
+      return value;
+    }
+  }
+  void store(float* column, Lane value) const {
+    if constexpr (std::is_same_v<Lane, float>) {
+      column[i] = value;
+    } else {
+      std::memcpy(column + i, &value, sizeof value);
+    }
+  }
+};
+
+/// `value` in every lane: a value a kernel computes that is the same for every row.
+template <class Lane>
+Lane broadcast(float value) {
+  if constexpr (std::is_same_v<Lane, float>) {
+    return value;
+  } else {
+    return Lane{value, value, value, value};
+  }
+}
+
+/// What a row kernel hands to the check: the one value its new state is not finite without
+/// (a Lane), or, when its new position does not contain its new velocity, both (a CheckedPair).
+template <class Lane>
+struct CheckedPair {
+  Lane position;
+  Lane velocity;
+};
+template <class Lane>
+CheckedPair(Lane, Lane) -> CheckedPair<Lane>;
+
+/// The value the check sums for what a kernel returned: a pair is added to itself first, so that
+/// the sums' loop-carried chain has one add a row group, not two.
+template <class Lane>
+Lane checkedValue(Lane value) {
+  return value;
+}
+template <class Lane>
+Lane checkedValue(const CheckedPair<Lane>& pair) {
+  return pair.position + pair.velocity;
+}
+
+/// Runs `kernel(row, columns...)` over rows [0, n): four rows at a time (RowsAt<Lanes4>), then
+/// the tail one by one (RowsAt<float>), reading and writing through `columns` (each a distinct
+/// column: they are __restrict here, which lets the compiler keep values in registers across a
+/// row's stores). With kCheck, sums what each call returns (see checkedValue) lane by lane: a sum
+/// with a NaN or an infinity among its terms is not finite, whatever its order, so a finite sum
+/// clears every row; a sum of finite terms can also overflow, and then the caller's exact scan
+/// finds nothing and only time is lost. Returns whether some returned value may be non-finite
+/// (always false without kCheck).
+///
+/// The sums are two Lanes4 in registers, one for each half of an 8-row group, so each is one add
+/// an iteration from its last value. Written as a float array (the scalar kernel run 8 times for
+/// the compiler to vectorise), they lived on the stack: two more loads and stores an iteration,
+/// which made the check cost velocity Verlet's one pass 16 to 20 % of its tick.
 ///
 /// Not inlined: inlined into an integrator's tile lambda, the checked and unchecked loops were
 /// placed so differently that the checked tick measured 4 to 9 % slower for reasons that had
@@ -39,37 +97,26 @@ using CheckedPair = std::array<float, 2>;
 template <bool kCheck, class Kernel, class... Column>
 [[gnu::noinline]] bool updateRowsChecked(Eigen::Index n, const Kernel& kernel,
                                          Column* __restrict... columns) {
-  using Value = decltype(kernel(Eigen::Index{0}, columns...));
-  constexpr bool kPair = std::is_same_v<Value, CheckedPair>;
-  constexpr int kLanes = 8;
-  float sums[kLanes] = {};
+  Lanes4 low = {}, high = {};
   Eigen::Index i = 0;
-  for (; i + kLanes <= n; i += kLanes) {
-    for (int lane = 0; lane < kLanes; ++lane) {
-      const Value value = kernel(i + lane, columns...);
-      if constexpr (kCheck && kPair) {
-        sums[lane] += value[0];
-        sums[lane] += value[1];
-      } else if constexpr (kCheck) {
-        sums[lane] += value;
-      }
+  for (; i + 8 <= n; i += 8) {
+    const Lanes4 first = checkedValue(kernel(RowsAt<Lanes4>{i}, columns...));
+    const Lanes4 second = checkedValue(kernel(RowsAt<Lanes4>{i + 4}, columns...));
+    if constexpr (kCheck) {
+      low += first;
+      high += second;
     }
   }
+  float tail = 0.0f;
   for (; i < n; ++i) {
-    const Value value = kernel(i, columns...);
-    if constexpr (kCheck && kPair) {
-      sums[0] += value[0];
-      sums[0] += value[1];
-    } else if constexpr (kCheck) {
-      sums[0] += value;
-    }
+    const float value = checkedValue(kernel(RowsAt<float>{i}, columns...));
+    if constexpr (kCheck) tail += value;
   }
   if constexpr (!kCheck) {
     return false;
   } else {
-    float total = 0.0f;
-    for (const float sum : sums) total += sum;
-    return !std::isfinite(total);
+    const Lanes4 sum = low + high;
+    return !std::isfinite(((sum[0] + sum[1]) + (sum[2] + sum[3])) + tail);
   }
 }
 

@@ -5,18 +5,19 @@
 namespace tickfx {
 namespace {
 
-// One row: p ← p + v·dt and v ← v + a·dt, both from the state at t. Returns what the check sums:
-// the new position plus the new velocity, as the new velocity is not in the new position.
-inline float explicitEulerRow(float dt, float acceleration, Eigen::Index i, float* pos, float* vel,
-                              float* last) {
-  const float position = pos[i];
-  const float velocity = vel[i];
-  const float nextP = position + velocity * dt;
-  const float nextV = velocity + acceleration * dt;
-  last[i] = position;
-  pos[i] = nextP;
-  vel[i] = nextV;
-  return nextP + nextV;
+// The rows `at`: p ← p + v·dt and v ← v + a·dt, both from the state at t. Returns both new
+// values for the check, as the new velocity is not in the new position.
+template <class At, class Lane>
+CheckedPair<Lane> explicitEulerRow(float dt, Lane acceleration, At at, float* pos, float* vel,
+                                   float* last) {
+  const Lane position = at.load(pos);
+  const Lane velocity = at.load(vel);
+  const Lane nextP = position + velocity * dt;
+  const Lane nextV = velocity + acceleration * dt;
+  at.store(last, position);
+  at.store(pos, nextP);
+  at.store(vel, nextV);
+  return {nextP, nextV};
 }
 
 }  // namespace
@@ -24,11 +25,10 @@ inline float explicitEulerRow(float dt, float acceleration, Eigen::Index i, floa
 void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                               const StepRows& rows, NonfiniteCheck* check) {
   const float dt = time.dt();
-  stepSingleEvaluation(
-      pool, forces, time, rows, check, scratch_,
-      [dt](float acceleration, Eigen::Index i, float* pos, float* vel, float* last) {
-        return explicitEulerRow(dt, acceleration, i, pos, vel, last);
-      });
+  stepSingleEvaluation(pool, forces, time, rows, check, scratch_,
+                       [dt](auto acceleration, auto at, float* pos, float* vel, float* last) {
+                         return explicitEulerRow(dt, acceleration, at, pos, vel, last);
+                       });
 }
 
 }  // namespace tickfx

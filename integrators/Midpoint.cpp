@@ -17,15 +17,15 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
     // Both evaluations in the row's registers: the midpoint velocity, then the acceleration at
     // t + dt/2 from it (the position does not enter a uniform force or a drag).
     runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, [dt, halfDt](const auto& a) {
-      return [dt, halfDt, a](Eigen::Index i, float* pos, float* vel, float* last) {
-        const float position = pos[i];
-        const float velocity = vel[i];
-        const float mid = velocity + a.at(0, velocity) * halfDt;
-        const float next = position + mid * dt;
-        const float nextV = velocity + a.at(1, mid) * dt;
-        last[i] = position;
-        pos[i] = next;
-        vel[i] = nextV;
+      return [dt, halfDt, a](auto at, float* pos, float* vel, float* last) {
+        const auto position = at.load(pos);
+        const auto velocity = at.load(vel);
+        const auto mid = velocity + a.at(0, velocity) * halfDt;
+        const auto next = position + mid * dt;
+        const auto nextV = velocity + a.at(1, mid) * dt;
+        at.store(last, position);
+        at.store(pos, next);
+        at.store(vel, nextV);
         return CheckedPair{next, nextV};  // the new velocity is not in the new position
       };
     });
@@ -37,14 +37,14 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
                Vec3Rows a = tile.stage(0), vMid = tile.stage(1), pr = rowsOf(p, tile.rows()),
                         vr = rowsOf(v, tile.rows()), old = rowsOf(prev, tile.rows());
                // The position is final here: it is checked as it is written.
-               const auto update = [dt, halfDt](Eigen::Index i, float* pos, float* last, float* mid,
+               const auto update = [dt, halfDt](auto at, float* pos, float* last, float* mid,
                                                 const float* vel, const float* acc) {
-                 const float position = pos[i];
-                 const float velocity = vel[i] + acc[i] * halfDt;
-                 const float next = position + velocity * dt;
-                 last[i] = position;
-                 mid[i] = velocity;
-                 pos[i] = next;
+                 const auto position = at.load(pos);
+                 const auto velocity = at.load(vel) + at.load(acc) * halfDt;
+                 const auto next = position + velocity * dt;
+                 at.store(last, position);
+                 at.store(mid, velocity);
+                 at.store(pos, next);
                  return next;
                };
                // The velocity is still the tick's start (finite), so the scan flags the rows
@@ -61,9 +61,9 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
              [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), vr = rowsOf(v, tile.rows());
                // The new velocity alone: the position was checked by the first update.
-               const auto update = [dt](Eigen::Index i, float* vel, const float* acc) {
-                 const float velocity = vel[i] + acc[i] * dt;
-                 vel[i] = velocity;
+               const auto update = [dt](auto at, float* vel, const float* acc) {
+                 const auto velocity = at.load(vel) + at.load(acc) * dt;
+                 at.store(vel, velocity);
                  return velocity;
                };
                updateTile(check, pool, tile.rows(), update, [&](int c) {

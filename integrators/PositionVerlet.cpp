@@ -15,14 +15,15 @@ inline float startingPrevious(float position, float velocity, float acceleration
 // One row: p_new = 2p − p_prev + a·dt², v = (p_new − p)/dt. Returns the velocity, which alone
 // tells: it is not finite when the new position is not (the old one passed last tick's check),
 // and it can overflow where both positions are finite.
-inline float positionVerletRow(float dt2, float invDt, float acceleration, Eigen::Index i,
-                               float* pos, float* vel, float* last) {
-  const float position = pos[i];
-  const float next = (position * 2.0f - last[i]) + acceleration * dt2;
-  const float velocity = (next - position) * invDt;
-  last[i] = position;
-  pos[i] = next;
-  vel[i] = velocity;
+template <class At, class Lane>
+Lane positionVerletRow(float dt2, float invDt, Lane acceleration, At at, float* pos, float* vel,
+                       float* last) {
+  const Lane position = at.load(pos);
+  const Lane next = (position * 2.0f - at.load(last)) + acceleration * dt2;
+  const Lane velocity = (next - position) * invDt;
+  at.store(last, position);
+  at.store(pos, next);
+  at.store(vel, velocity);
   return velocity;
 }
 
@@ -62,8 +63,8 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
     runOnePass(
         pool, scratch_, rows, check, *forms,
         [dt2, invDt](const auto& a) {
-          return [dt2, invDt, a](Eigen::Index i, float* pos, float* vel, float* last) {
-            return positionVerletRow(dt2, invDt, a.at(0, vel[i]), i, pos, vel, last);
+          return [dt2, invDt, a](auto at, float* pos, float* vel, float* last) {
+            return positionVerletRow(dt2, invDt, a.at(0, at.load(vel)), at, pos, vel, last);
           };
         },
         startTile);
@@ -75,9 +76,9 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
          const RowRange r = tile.rows();
          Vec3Rows a = tile.stage(0), pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
          for (int c = 0; c < 3; ++c) start(r, c, [&](Eigen::Index i, float) { return a[c][i]; });
-         const auto update = [dt2, invDt](Eigen::Index i, float* pos, float* vel, float* last,
+         const auto update = [dt2, invDt](auto at, float* pos, float* vel, float* last,
                                           const float* acc) {
-           return positionVerletRow(dt2, invDt, acc[i], i, pos, vel, last);
+           return positionVerletRow(dt2, invDt, at.load(acc), at, pos, vel, last);
          };
          updateTile(check, pool, r, update, [&](int c) {
            return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),

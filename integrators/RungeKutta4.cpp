@@ -26,21 +26,21 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
     // positions are not needed (a uniform force or a drag does not read the position), and the
     // slopes and stage velocities never leave the row.
     runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, [=](const auto& a) {
-      return [=](Eigen::Index i, float* pos, float* vel, float* last) {
-        const float position = pos[i];
-        const float velocity = vel[i];
-        const float k1 = a.at(0, velocity);
-        const float v2 = velocity + k1 * halfH;
-        const float k2 = a.at(1, v2);
-        const float v3 = velocity + k2 * halfH;
-        const float k3 = a.at(1, v3);
-        const float v4 = velocity + k3 * h;
-        const float k4 = a.at(2, v4);
-        const float nextP = position + ((velocity + v2 * 2.0f) + (v3 * 2.0f + v4)) * sixthH;
-        const float nextV = velocity + ((k1 + k2 * 2.0f) + (k3 * 2.0f + k4)) * sixthH;
-        last[i] = position;
-        pos[i] = nextP;
-        vel[i] = nextV;
+      return [=](auto at, float* pos, float* vel, float* last) {
+        const auto position = at.load(pos);
+        const auto velocity = at.load(vel);
+        const auto k1 = a.at(0, velocity);
+        const auto v2 = velocity + k1 * halfH;
+        const auto k2 = a.at(1, v2);
+        const auto v3 = velocity + k2 * halfH;
+        const auto k3 = a.at(1, v3);
+        const auto v4 = velocity + k3 * h;
+        const auto k4 = a.at(2, v4);
+        const auto nextP = position + ((velocity + v2 * 2.0f) + (v3 * 2.0f + v4)) * sixthH;
+        const auto nextV = velocity + ((k1 + k2 * 2.0f) + (k3 * 2.0f + k4)) * sixthH;
+        at.store(last, position);
+        at.store(pos, nextP);
+        at.store(vel, nextV);
         return CheckedPair{nextP, nextV};
       };
     });
@@ -75,20 +75,21 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
          Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                   old = rowsOf(prev, tile.rows());
          // s1..s4: the four slopes of the velocity (k1..k4); u2..u4: the stage velocities.
-         const auto update = [sixthH](Eigen::Index i, float* pos, float* vel, float* last,
-                                      const float* s1, const float* s2, const float* s3,
-                                      const float* s4, const float* u2, const float* u3,
-                                      const float* u4) {
-           const float position = pos[i];
-           const float velocity = vel[i];
-           const float nextP =
-               position + ((velocity + u2[i] * 2.0f) + (u3[i] * 2.0f + u4[i])) * sixthH;
-           const float nextV =
-               velocity + ((s1[i] + s2[i] * 2.0f) + (s3[i] * 2.0f + s4[i])) * sixthH;
-           last[i] = position;
-           pos[i] = nextP;
-           vel[i] = nextV;
-           return nextP + nextV;
+         const auto update = [sixthH](auto at, float* pos, float* vel, float* last, const float* s1,
+                                      const float* s2, const float* s3, const float* s4,
+                                      const float* u2, const float* u3, const float* u4) {
+           const auto position = at.load(pos);
+           const auto velocity = at.load(vel);
+           const auto nextP =
+               position +
+               ((velocity + at.load(u2) * 2.0f) + (at.load(u3) * 2.0f + at.load(u4))) * sixthH;
+           const auto nextV =
+               velocity +
+               ((at.load(s1) + at.load(s2) * 2.0f) + (at.load(s3) * 2.0f + at.load(s4))) * sixthH;
+           at.store(last, position);
+           at.store(pos, nextP);
+           at.store(vel, nextV);
+           return CheckedPair{nextP, nextV};
          };
          const auto in = [](Eigen::Map<FloatColumn>& column) {
            return static_cast<const float*>(column.data());

@@ -5,17 +5,17 @@
 namespace tickfx {
 namespace {
 
-// One row: v ← v + a·dt, then p ← p + v_new·dt. Returns the new position, the one value the check
-// needs: p_new = p + v_new·dt with dt > 0 is non-finite whenever p or v_new is, or when it
-// overflows.
-inline float semiImplicitEulerRow(float dt, float acceleration, Eigen::Index i, float* pos,
-                                  float* vel, float* last) {
-  const float position = pos[i];
-  const float velocity = vel[i] + acceleration * dt;
-  const float next = position + velocity * dt;
-  last[i] = position;
-  vel[i] = velocity;
-  pos[i] = next;
+// The rows `at`: v ← v + a·dt, then p ← p + v_new·dt. Returns the new position, the one value
+// the check needs: p_new = p + v_new·dt with dt > 0 is non-finite whenever p or v_new is, or when
+// it overflows.
+template <class At, class Lane>
+Lane semiImplicitEulerRow(float dt, Lane acceleration, At at, float* pos, float* vel, float* last) {
+  const Lane position = at.load(pos);
+  const Lane velocity = at.load(vel) + acceleration * dt;
+  const Lane next = position + velocity * dt;
+  at.store(last, position);
+  at.store(vel, velocity);
+  at.store(pos, next);
   return next;
 }
 
@@ -24,11 +24,10 @@ inline float semiImplicitEulerRow(float dt, float acceleration, Eigen::Index i, 
 void SemiImplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                                   const StepRows& rows, NonfiniteCheck* check) {
   const float dt = time.dt();
-  stepSingleEvaluation(
-      pool, forces, time, rows, check, scratch_,
-      [dt](float acceleration, Eigen::Index i, float* pos, float* vel, float* last) {
-        return semiImplicitEulerRow(dt, acceleration, i, pos, vel, last);
-      });
+  stepSingleEvaluation(pool, forces, time, rows, check, scratch_,
+                       [dt](auto acceleration, auto at, float* pos, float* vel, float* last) {
+                         return semiImplicitEulerRow(dt, acceleration, at, pos, vel, last);
+                       });
 }
 
 }  // namespace tickfx

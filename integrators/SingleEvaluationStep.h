@@ -13,17 +13,18 @@
 
 namespace tickfx {
 
-/// Advances `rows` one tick: `row(acceleration, i, pos, vel, last)` updates row i of one
-/// component (acceleration in m/s², the columns as updateRowsChecked passes them) and returns
-/// what the check sums. `scratch` holds the acceleration of the force pass (one stage value).
+/// Advances `rows` one tick: `row(acceleration, at, pos, vel, last)` updates the rows `at` (a
+/// RowsAt) of one component (acceleration in m/s², a value of at's lane type; the columns as
+/// updateRowsChecked passes them) and returns what the check sums. `scratch` holds the acceleration
+/// of the force pass (one stage value).
 template <class Row>
 void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                           const StepRows& rows, NonfiniteCheck* check, StageScratch& scratch,
                           const Row& row) {
   if (const auto forms = tickForms(pool, forces, time, {0})) {
     runStateUpdateUnderForms(pool, scratch, rows, check, *forms, [&row](const auto& a) {
-      return [row, a](Eigen::Index i, float* pos, float* vel, float* last) {
-        return row(a.at(0, vel[i]), i, pos, vel, last);
+      return [row, a](auto at, float* pos, float* vel, float* last) {
+        return row(a.at(0, at.load(vel)), at, pos, vel, last);
       };
     });
     return;
@@ -36,8 +37,9 @@ void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const Step
       {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0), [&](const Tile& tile) {
          Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                   old = rowsOf(prev, tile.rows());
-         const auto update = [row](Eigen::Index i, float* pos, float* vel, float* last,
-                                   const float* acc) { return row(acc[i], i, pos, vel, last); };
+         const auto update = [row](auto at, float* pos, float* vel, float* last, const float* acc) {
+           return row(at.load(acc), at, pos, vel, last);
+         };
          updateTile(check, pool, tile.rows(), update, [&](int c) {
            return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
                              static_cast<const float*>(a[c].data()));

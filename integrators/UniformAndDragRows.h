@@ -31,12 +31,14 @@ struct FormAccelerations {
   float k = 0.0f;                     // 1/s
   float air = 0.0f;                   // m/s
 
-  float at(int stage, float velocity) const {
+  /// The acceleration at `velocity` (m/s), of one row (float) or four (Lanes4).
+  template <class Lane>
+  Lane at(int stage, Lane velocity) const {
     const float u = uniform[static_cast<std::size_t>(stage)];
     if constexpr (kDrag) {
       return u + k * (air - velocity);
     } else {
-      return u;
+      return broadcast<Lane>(u);
     }
   }
 };

@@ -30,16 +30,17 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
     runOnePass(
         pool, scratch_, rows, check, *forms,
         [=](const auto& accelerations) {
-          return [=](Eigen::Index i, float* pos, float* vel, float* last, float* acc) {
-            const float position = pos[i];
-            const float velocity = vel[i];
-            const float next = position + (velocity * dt + acc[i] * halfDt2);
-            const float accNext = accelerations.at(2, velocity + acc[i] * dt);
-            const float nextV = velocity + (acc[i] + accNext) * halfDt;
-            last[i] = position;
-            pos[i] = next;
-            vel[i] = nextV;
-            acc[i] = accNext;
+          return [=](auto row, float* pos, float* vel, float* last, float* acc) {
+            const auto position = row.load(pos);
+            const auto velocity = row.load(vel);
+            const auto acceleration = row.load(acc);
+            const auto next = position + (velocity * dt + acceleration * halfDt2);
+            const auto accNext = accelerations.at(2, velocity + acceleration * dt);
+            const auto nextV = velocity + (acceleration + accNext) * halfDt;
+            row.store(last, position);
+            row.store(pos, next);
+            row.store(vel, nextV);
+            row.store(acc, accNext);
             return CheckedPair{next, nextV};  // the new velocity is not in next
           };
         },
@@ -53,13 +54,15 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
          Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
                   ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
          // The position is final here: it is checked as it is written.
-         const auto update = [dt, halfDt2](Eigen::Index i, float* pos, float* last, float* pred,
+         const auto update = [dt, halfDt2](auto at, float* pos, float* last, float* pred,
                                            const float* vel, const float* acc) {
-           const float position = pos[i];
-           const float next = position + (vel[i] * dt + acc[i] * halfDt2);
-           last[i] = position;
-           pos[i] = next;
-           pred[i] = vel[i] + acc[i] * dt;
+           const auto position = at.load(pos);
+           const auto velocity = at.load(vel);
+           const auto acceleration = at.load(acc);
+           const auto next = position + (velocity * dt + acceleration * halfDt2);
+           at.store(last, position);
+           at.store(pos, next);
+           at.store(pred, velocity + acceleration * dt);
            return next;
          };
          // The velocity is still the tick's start (finite), so the scan flags the rows
@@ -74,11 +77,11 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
        [&](const Tile& tile) {
          Vec3Rows aNew = tile.stage(1), vr = rowsOf(v, tile.rows()), ar = rowsOf(a, tile.rows());
          // The new velocity alone: the position was checked by the first update.
-         const auto update = [halfDt](Eigen::Index i, float* vel, float* acc,
-                                      const float* accNext) {
-           const float velocity = vel[i] + (acc[i] + accNext[i]) * halfDt;
-           vel[i] = velocity;
-           acc[i] = accNext[i];
+         const auto update = [halfDt](auto at, float* vel, float* acc, const float* accNext) {
+           const auto next = at.load(accNext);
+           const auto velocity = at.load(vel) + (at.load(acc) + next) * halfDt;
+           at.store(vel, velocity);
+           at.store(acc, next);
            return velocity;
          };
          updateTile(check, pool, tile.rows(), update, [&](int c) {
