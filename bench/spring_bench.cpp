@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
               tickfx::hashToHex(tickfx::stateHash(step1->pool())).c_str());
 
   // The evaluate cases: the force pass an integrator runs, over the same blocks of rows.
-  tickfx::ParticlePool& evalPool = eval->pool();
+  tickfx::ParticlePool& evalPool = eval->editPool();
   const tickfx::ForceSet& evalForces = eval->forces();
   tickfx::Vec3Column acceleration;
   acceleration.resize(static_cast<Eigen::Index>(particles));

@@ -257,7 +257,7 @@ std::unique_ptr<tickfx::ParticleSystem> makeSystem(
   if (tether) forces.add(std::make_unique<tickfx::AnchorSpring>(Eigen::Vector3f::Zero(), 0.5f));
   auto system = std::make_unique<tickfx::ParticleSystem>(
       settings, std::vector<tickfx::EmitterSettings>{}, std::move(forces));
-  tickfx::ParticlePool& pool = system->pool();
+  tickfx::ParticlePool& pool = system->editPool();
   pool.reserve(n);  // one allocation instead of the doubling growth
   for (std::size_t i = 0; i < n; ++i) {
     const Particle p = initialParticle(i);
@@ -375,7 +375,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
                             std::int64_t ticks) {
     arena.execute([&] {
       for (std::int64_t i = 0; i < ticks; ++i) {
-        integrator.step(system.pool(), system.forces(), tickfx::StepTime{tick++, kStepRateHz});
+        integrator.step(system.editPool(), system.forces(), tickfx::StepTime{tick++, kStepRateHz});
       }
     });
   };

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <initializer_list>
 #include <optional>
 #include <tuple>
@@ -15,6 +16,7 @@
 #include "fields/ForceSet.h"
 #include "integrators/CheckedRows.h"
 #include "integrators/Integrator.h"
+#include "integrators/NonfiniteExceptions.h"
 #include "integrators/StagePasses.h"
 
 namespace tickfx {
@@ -48,6 +50,17 @@ struct FormAccelerations {
 /// wind); the drag is the same at every stage.
 struct TickForms {
   std::array<ForceSet::UniformAndDrag, 3> at;
+
+  /// Whether every value of the forms is finite (a module's own form could be NaN; the
+  /// exceptions check of the one pass needs finite constants as much as finite rows).
+  bool finite() const {
+    for (const ForceSet::UniformAndDrag& form : at) {
+      if (!form.uniform.allFinite() || !form.air.allFinite() || !std::isfinite(form.k)) {
+        return false;
+      }
+    }
+    return true;
+  }
 };
 
 /// The forms at the `stages` a scheme evaluates when the forces have that shape (which does not
@@ -102,10 +115,24 @@ void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange ro
   if (suspect) check->scan(pool, rows.begin, rows.end);
 }
 
+/// The check of a tile's one pass by exceptions (see NonfiniteCheck::steppedRowsFinite()): the
+/// whole tile is scanned when the pass raised a kNonfiniteExceptions flag, else its rows spawned
+/// this tick (from `fresh` on), whose values the tick did not make from checked ones.
+inline void checkByExceptions(NonfiniteCheck& check, ParticlePool& pool, RowRange r,
+                              std::size_t fresh) {
+  const RowRange scanned = takeNonfiniteExceptions() ? r : intersect(r, fresh, r.end);
+  if (scanned.count() == 0) return;
+  check.scan(pool, scanned.begin, scanned.end);
+  takeNonfiniteExceptions();  // the scan's own sums of what it found: not the next tile's
+}
+
 /// The one pass of a scheme over every tile of `rows`: `beforeTile(tile)` first (the rows spawned
 /// this tick start their history, say), then for each component the kernel
-/// `kernelFor(accelerations)` gives, (i, pos, vel, last, extra...), over the position, the
-/// velocity, the previous position and the `extra` columns of the tile.
+/// `kernelFor(accelerations)` gives, (at, pos, vel, last, extra...), over the position, the
+/// velocity, the previous position and the `extra` columns of the tile. Checked (`check` set),
+/// it sums what the kernels return, or, when the stepped rows start finite and the forms are
+/// finite, runs the kernels unchecked and tests the exception flags after each tile: the sums are
+/// one add per value, up to 12 % of a one-pass tick (midpoint at 10⁴), the flags one test a tile.
 template <class KernelFor, class BeforeTile, class... Extra>
 void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
                 NonfiniteCheck* check, const TickForms& forms, const KernelFor& kernelFor,
@@ -113,18 +140,21 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
+  const bool byExceptions = check != nullptr && check->steppedRowsFinite() && forms.finite();
   runPasses(rows, true, scratch, {[&](const Tile& tile) {
               beforeTile(tile);
               const RowRange r = tile.rows();
               Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
               std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
-              updateTileUnderForms(check, pool, r, forms, kernelFor, [&](int c) {
+              NonfiniteCheck* const sums = byExceptions ? nullptr : check;
+              updateTileUnderForms(sums, pool, r, forms, kernelFor, [&](int c) {
                 return std::apply(
                     [&](auto&... e) {
                       return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), e[c].data()...);
                     },
                     more);
               });
+              if (byExceptions) checkByExceptions(*check, pool, r, rows.fresh);
             }});
 }
 

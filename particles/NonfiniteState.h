@@ -50,8 +50,10 @@ struct NonfiniteEvent {
 
 /// Finds non-finite positions and velocities. An integrator's last update loop over a tile sums
 /// the values it writes as it writes them (integrators/CheckedRows.h) and calls scan() only for a
-/// tile whose sum is not finite; the advection schemes call it for every tile once their passes
-/// are done with it, while the tile is in cache. scan() sums the tile's six columns (one add per
+/// tile whose sum is not finite; a scheme's one pass over rows that start finite tests the
+/// floating-point exception flags after each tile instead (steppedRowsFinite()); the advection
+/// schemes call scan() for every tile once their passes are done with it, while the tile is in
+/// cache. scan() sums the tile's six columns (one add per
 /// value), finite unless a value is not (or the sum overflows), and tests each row only then.
 /// Rows found get kFlag in the pool's dead flags. scan() may run on disjoint rows from several
 /// threads; what it flags does not depend on how rows are split.
@@ -66,8 +68,17 @@ class NonfiniteCheck {
   bool found() const { return found_.load(std::memory_order_relaxed); }
   void clear() { found_.store(false, std::memory_order_relaxed); }
 
+  /// Whether the rows a tick steps (all but those spawned for it) are known to be finite when it
+  /// starts: the tick before them was checked and nothing has written the state since
+  /// (ParticleSystem keeps this; false by default). A scheme's one pass then checks them by the
+  /// floating-point exceptions its arithmetic raises (integrators/NonfiniteExceptions.h), at no
+  /// cost per value, and scans the spawned rows.
+  bool steppedRowsFinite() const { return steppedRowsFinite_; }
+  void setSteppedRowsFinite(bool finite) { steppedRowsFinite_ = finite; }
+
  private:
   std::atomic<bool> found_{false};
+  bool steppedRowsFinite_ = false;
 };
 
 }  // namespace tickfx

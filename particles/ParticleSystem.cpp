@@ -228,6 +228,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
     begin = end;
   }
   NonfiniteCheck* const check = stop ? &nonfiniteCheck_ : nullptr;
+  nonfiniteCheck_.setSteppedRowsFinite(steppedRowsChecked_);
   parallelForTasks(blocks.size(), [&](std::size_t i) {
     const Block& block = blocks[i];
     if (stop && block.begin < startRows) {
@@ -275,6 +276,7 @@ void ParticleSystem::runTick(bool keepVelocities) {
   forces_.beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};
   const bool check = settings_.nonfinite != NonfinitePolicy::Keep;
+  nonfiniteCheck_.setSteppedRowsFinite(steppedRowsChecked_);
   integrator_->step(pool_, forces_, time, check ? &nonfiniteCheck_ : nullptr);
   if (nonfiniteCheck_.found()) takeNonfinite();
   pool_.markAllStepped();
@@ -284,6 +286,8 @@ void ParticleSystem::runTick(bool keepVelocities) {
 
 void ParticleSystem::endTicks(std::int64_t tick, bool keepVelocities) {
   tick_ = tick;
+  // Checked and not stopped, the rows left are finite: a kill removes the rows found below.
+  steppedRowsChecked_ = settings_.nonfinite != NonfinitePolicy::Keep && !nonfiniteStop_;
   pool_.updateAges(tick_, settings_.stepRateHz);
   if (keepVelocities) {
     pool_.applyRemovalTo(previousVelocity_);

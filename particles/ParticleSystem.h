@@ -55,6 +55,10 @@ struct SystemSettings {
 /// the acceleration): on finding a non-finite value it goes back and runs its ticks one by one,
 /// which stop at the exact tick.
 ///
+/// Checked ticks (NonfinitePolicy::Stop, Kill) read, and clear when raised, the invalid, overflow
+/// and divide-by-zero floating-point exception flags of the threads they run on: a scheme's one
+/// pass checks the rows it steps by them (NonfiniteCheck::steppedRowsFinite()).
+///
 /// Not thread-safe: one thread drives a system. Inside a tick the system runs its loops in its
 /// own TBB arena, or on the host's executor (setTaskExecutor()); it never changes TBB's
 /// process-wide limits.
@@ -136,7 +140,13 @@ class ParticleSystem {
   TaskExecutor* taskExecutor() const { return executor_; }
 
   const ParticlePool& pool() const { return pool_; }
-  ParticlePool& pool() { return pool_; }
+  /// The state to write between ticks (a restored checkpoint, a host's own edits). The next
+  /// checked tick then checks every value it writes, as nothing says the state is still finite;
+  /// after it, the one passes check by floating-point exceptions again (NonfiniteCheck).
+  ParticlePool& editPool() {
+    steppedRowsChecked_ = false;
+    return pool_;
+  }
   const ForceSet& forces() const { return forces_; }
   const Integrator& integrator() const { return *integrator_; }
   const FixedStepDriver& driver() const { return driver_; }
@@ -204,6 +214,9 @@ class ParticleSystem {
   struct FrameStart;
   std::unique_ptr<FrameStart> frameStart_;
   NonfiniteCheck nonfiniteCheck_;
+  // Whether every row the next tick steps is finite: the ticks so far were checked and
+  // editPool() has not been called since.
+  bool steppedRowsChecked_ = true;
   std::optional<NonfiniteEvent> nonfiniteStop_;
   std::uint64_t nonfiniteKilled_ = 0;
 };

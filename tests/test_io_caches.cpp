@@ -48,10 +48,11 @@ class Caches : public ::testing::Test {
     ForceSet forces;
     forces.add(std::make_unique<Gravity>());
     ParticleSystem system(settings, {e}, std::move(forces));
-    const std::size_t heat = system.pool().addAttribute("heat", 1.5f);
+    const std::size_t heat = system.editPool().addAttribute("heat", 1.5f);
     system.advance(frameDuration({24, 1}) * 3);
     for (std::size_t i = 0; i < system.pool().size(); ++i) {
-      system.pool().attribute(heat)[static_cast<Eigen::Index>(i)] = 0.1f * static_cast<float>(i);
+      system.editPool().attribute(heat)[static_cast<Eigen::Index>(i)] =
+          0.1f * static_cast<float>(i);
     }
     EXPECT_GT(system.alpha(), 0.0f);
     return captureFrame(system, 3, 0.125);

@@ -54,14 +54,14 @@ std::unique_ptr<ParticleSystem> makeSystem(const SystemSettings& settings,
                                            const std::vector<std::string>& attributes = {"heat",
                                                                                          "spin"}) {
   auto system = test::referenceSystem(settings);
-  for (const std::string& a : attributes) system->pool().addAttribute(a, 0.25f);
+  for (const std::string& a : attributes) system->editPool().addAttribute(a, 0.25f);
   return system;
 }
 
 // Gives the attributes a history of their own (each value depends on every earlier frame), so
 // a checkpoint that lost them could not be rebuilt from the other columns.
 void evolveAttributes(ParticleSystem& system) {
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   const std::size_t heat = pool.findAttribute("heat"), spin = pool.findAttribute("spin");
   for (std::size_t i = 0; i < pool.size(); ++i) {
     const auto r = static_cast<Eigen::Index>(i);
@@ -277,7 +277,7 @@ TEST_F(ioCheckpoint, StaleRowsPastTheTargetsSizeDoNotLeakIn) {
 
   auto b = makeSystem(settings);
   b->stepTicks(3);
-  ParticlePool& pool = b->pool();
+  ParticlePool& pool = b->editPool();
   ASSERT_LT(pool.size(), 100u);
   pool.reserve(2048);
   std::fill(pool.dead().begin() + static_cast<std::ptrdiff_t>(pool.size()), pool.dead().end(),

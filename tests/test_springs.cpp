@@ -789,7 +789,7 @@ std::vector<double> pairExtension(const PairCase& c, double seconds, float k, fl
   ParticleSystem system(settingsFor(c.integrator, c.rate), {}, std::move(forces));
   const Eigen::Vector3d u = Eigen::Vector3d(1.0, 2.0, 2.0) / 3.0;
   const Eigen::Vector3d centre(0.3, 1.0, -0.2);
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   std::uint64_t ids[2];
   for (int i = 0; i < 2; ++i) {
     ParticleInit init;
@@ -1144,7 +1144,7 @@ TEST(SpringLifecycle, SpringsWhoseEndDiesAreRemoved) {
   ForceSet forces;
   SpringNetwork& network = addNetwork(forces);
   ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   spawnInARow(pool, 3, Eigen::Vector3f(1.1f, 0.1f, 0.0f), 0);
   network.add(Spring{0, 1, 1.0f, 10.0f, 0.1f, 0.0f});
   network.add(Spring{1, 2, 1.0f, 10.0f, 0.1f, 0.0f});
@@ -1200,7 +1200,7 @@ TEST(SpringLifecycle, SpringsPastADeadRowKeepTheirEnds) {
   ForceSet forces;
   SpringNetwork& network = addNetwork(forces);
   ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   spawnInARow(pool, 4, Eigen::Vector3f(1.5f, 0.0f, 0.0f), 1);
   network.add(Spring{0, 1, 1.0f, 10.0f, 0.0f, 0.0f});
   network.add(Spring{2, 3, 1.0f, 10.0f, 0.0f, 0.0f});
@@ -1220,7 +1220,7 @@ TEST(SpringLifecycle, ASpringWaitsForItsEndsToBeBorn) {
   ForceSet forces;
   SpringNetwork& network = addNetwork(forces);
   ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   pool.spawn(ParticleInit{}, 0);
   network.add(Spring{0, 1, 1.0f, 10.0f, 0.0f, 0.0f});
   system.stepTicks(10);
@@ -1242,7 +1242,7 @@ TEST(SpringLifecycle, ASpringBreaksAtTheFirstTickThatStartsStretchedPastItsRatio
   ForceSet forces;
   SpringNetwork& network = addNetwork(forces);
   ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   for (int i = 0; i < 2; ++i) {
     ParticleInit p;
     p.position = Eigen::Vector3f(i == 0 ? -0.5f : 0.5f, 0.0f, 0.0f);
@@ -1277,7 +1277,7 @@ TEST(SpringLifecycle, OnlySpringsStretchedPastTheirRatioBreak) {
   ForceSet forces;
   SpringNetwork& network = addNetwork(forces);
   ParticleSystem system(settingsFor("semi_implicit_euler", 60), {}, std::move(forces));
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   for (float x : {0.0f, 2.0f, 4.0f, 6.0f}) {
     ParticleInit p;
     p.position = Eigen::Vector3f(x, 0.0f, 0.0f);
@@ -1306,7 +1306,7 @@ TEST(SpringLifecycle, VelocityVerletsKeptAccelerationIncludesASpringThatBrokeAtT
     ForceSet forces;
     SpringNetwork& network = addNetwork(forces);
     ParticleSystem system(settingsFor(integrator, kRate), {}, std::move(forces));
-    ParticlePool& pool = system.pool();
+    ParticlePool& pool = system.editPool();
     // 2 m apart and flying apart at 20 m/s: whole at the first tick's start (2 < 2.1), broken at
     // the second's (2.33 > 2.1).
     for (float side : {-1.0f, 1.0f}) {

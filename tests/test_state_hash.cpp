@@ -49,7 +49,7 @@ TEST(StateHash, ThreadCountDoesNotChangeTheState) {
 TEST(StateHash, OneFlippedBitOfOneParticleChangesIt) {
   const auto system = test::referenceSystem(test::referenceSettings("velocity_verlet"));
   system->stepTicks(90);
-  ParticlePool& pool = system->pool();
+  ParticlePool& pool = system->editPool();
   const std::uint64_t original = stateHash(pool);
   const auto last = static_cast<Eigen::Index>(pool.size() - 1);
   std::vector<FloatColumn*> columns{&pool.age(), &pool.lifetime(), &pool.mass(),
@@ -85,7 +85,7 @@ TEST(StateHash, OneFlippedBitOfOneParticleChangesIt) {
 TEST(StateHash, ColumnHashesNameTheColumnThatChanged) {
   const auto system = test::referenceSystem(test::referenceSettings("velocity_verlet"));
   system->stepTicks(90);
-  ParticlePool& pool = system->pool();
+  ParticlePool& pool = system->editPool();
   const std::vector<std::string> names = stateColumnNames(pool);
   ASSERT_EQ(names.size(), 3u + 12u + 4u + pool.attributeCount());
   EXPECT_EQ(names[0], "counters");

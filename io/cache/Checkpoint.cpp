@@ -311,7 +311,7 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
 
 // Nothing in here may throw once the pool has room: the state is replaced whole or not at all.
 void apply(const Parsed& p, ParticleSystem& system) {
-  ParticlePool& pool = system.pool();
+  ParticlePool& pool = system.editPool();
   const auto n = static_cast<std::size_t>(p.size);
   // Velocity Verlet's a(t) makes the pool keep an acceleration column (all zeros need none);
   // like reserve(), an allocation that changes no value of the state.

@@ -55,7 +55,7 @@ class PySystem {
   // change the simulation (row blocks depend on the row count alone).
   void pinStorage() {
     if (pinned_) return;
-    ParticlePool& pool = system_->pool();
+    ParticlePool& pool = system_->editPool();
     // Some of the columns are zero-filled as they grow: a reservation past the machine's memory
     // would not fail as an exception but get the interpreter killed.
     const double bytes = static_cast<double>(pool.maxParticles()) *
