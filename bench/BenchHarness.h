@@ -65,6 +65,8 @@ struct Case {
 
   std::string name;
   std::function<void(std::int64_t ticks)> run;
+  /// Run before each batch, untimed, when set (a setting the batch is timed under).
+  std::function<void()> before;
   /// Batches are whole multiples of this many ticks (a frame of several ticks).
   std::int64_t ticksPerFrame = 1;
   std::int64_t batch = 1;
@@ -75,6 +77,7 @@ struct Case {
 
 // The CPU clock is read outside the wall-clock interval, so it costs the figure nothing.
 inline double timeBatch(Case& c, double* cpu = nullptr) {
+  if (c.before) c.before();
   const double cpu0 = cpu != nullptr ? processCpuSeconds() : 0.0;
   const Clock::time_point start = Clock::now();
   c.run(c.batch);

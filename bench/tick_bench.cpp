@@ -447,12 +447,15 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 }
 
 // Per integrator, step() on 1 thread with the non-finite check (NonfinitePolicy::Stop) and
-// without (Keep), all systems taking turns batch by batch: under the tick's own forces, which
-// every scheme forms in its one update loop, and with an anchor spring added ("+spring"), which
-// sends every scheme through its force passes. Two identical systems measured up to 3 % apart
-// with where their columns sat: each side is kCheckCopies systems allocated one after another,
-// and a side's figure is the median of all its batches, so that no one placement decides. The
-// A/A spread sets half the unchecked copies against the other half.
+// without (Keep): under the tick's own forces, which every scheme forms in its one update loop,
+// and with an anchor spring added ("+spring"), which sends every scheme through its force passes.
+// Two identical systems measured up to 3 % apart at 10⁴ and 13 % at 10⁶ with where their columns
+// sat, so each of kCheckCopies systems is timed both ways, switching its policy before each batch
+// (and running one untimed tick, so that a checked batch starts as a run's checked ticks do:
+// after unchecked ones, the first checked tick checks every value), all taking turns batch by
+// batch in the order below; a side's figure is the median of all its batches. The A/A spread
+// sets half the systems' unchecked batches against the other half's: what placement alone does,
+// and what comparing sides on different systems would mistake for the check.
 void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& timing) {
   constexpr int kCheckCopies = 4;
   struct Cost {
@@ -462,17 +465,24 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
   };
   std::vector<Cost> costs;
   std::printf(
-      "\nnon-finite check, step() on 1 thread: checked against unchecked (%d systems a side)\n",
+      "\nnon-finite check, step() on 1 thread: checked against unchecked (%d systems, both ways)\n",
       kCheckCopies);
   std::printf("%10s  %-30s %14s %14s %10s %12s\n", "N", "integrator", "checked ms", "unchecked ms",
               "cost", "A/A spread");
-  // The median of the batches of copies [first, first + count) of one side: the cases alternate
-  // checked (side 0) and unchecked (side 1).
-  const auto pooledMedian = [](const std::vector<bench::Case>& cases, int side, int first,
-                               int count) {
+  // Case k times system k % kCheckCopies, checked in the first round of systems and unchecked in
+  // the second, then the other way round: each batch follows a batch of another system (a batch
+  // after its own system's measured faster at 10⁶, whose state fits in this machine's L3), and
+  // each side follows each system equally often.
+  constexpr int kCases = 4 * kCheckCopies;
+  const auto checkedCase = [](int k) { return (k / kCheckCopies) % 3 == 0; };
+  // The median of the batches of one side (checked or not) of systems [first, first + count).
+  const auto pooledMedian = [&](const std::vector<bench::Case>& cases, bool checked, int first,
+                                int count) {
     std::vector<double> all;
-    for (int i = first; i < first + count; ++i) {
-      const std::vector<double>& s = cases[static_cast<std::size_t>(2 * i + side)].secondsPerTick;
+    for (int k = 0; k < kCases; ++k) {
+      const int system = k % kCheckCopies;
+      if (checkedCase(k) != checked || system < first || system >= first + count) continue;
+      const std::vector<double>& s = cases[static_cast<std::size_t>(k)].secondsPerTick;
       all.insert(all.end(), s.begin(), s.end());
     }
     return bench::median(all);
@@ -481,24 +491,29 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
     for (const bool tether : {false, true}) {
       for (const std::string& name : tickfx::integratorNames()) {
         const std::string label = name + (tether ? " +spring" : "");
-        // Interleaved allocations, so that neither side gets the earlier (or later) memory.
         std::vector<std::unique_ptr<tickfx::ParticleSystem>> systems;
         for (int i = 0; i < kCheckCopies; ++i) {
           systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name, tether));
-          systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Keep, name, tether));
         }
         std::vector<bench::Case> cases;
-        for (std::size_t i = 0; i < systems.size(); ++i) {
-          cases.emplace_back(i % 2 == 0 ? "checked" : "unchecked",
-                             [s = systems[i].get()](std::int64_t ticks) {
-                               for (std::int64_t t = 0; t < ticks; ++t) s->step();
-                             });
+        for (int k = 0; k < kCases; ++k) {
+          tickfx::ParticleSystem* const s =
+              systems[static_cast<std::size_t>(k % kCheckCopies)].get();
+          const auto policy =
+              checkedCase(k) ? tickfx::NonfinitePolicy::Stop : tickfx::NonfinitePolicy::Keep;
+          cases.emplace_back(checkedCase(k) ? "checked" : "unchecked", [s](std::int64_t ticks) {
+            for (std::int64_t t = 0; t < ticks; ++t) s->step();
+          });
+          cases.back().before = [s, policy] {
+            s->setNonfinitePolicy(policy);
+            s->step();
+          };
         }
         bench::timeCases(cases, timing);
-        const double with = pooledMedian(cases, 0, 0, kCheckCopies);
-        const double without = pooledMedian(cases, 1, 0, kCheckCopies);
-        const double halfA = pooledMedian(cases, 1, 0, kCheckCopies / 2);
-        const double halfB = pooledMedian(cases, 1, kCheckCopies / 2, kCheckCopies / 2);
+        const double with = pooledMedian(cases, true, 0, kCheckCopies);
+        const double without = pooledMedian(cases, false, 0, kCheckCopies);
+        const double halfA = pooledMedian(cases, false, 0, kCheckCopies / 2);
+        const double halfB = pooledMedian(cases, false, kCheckCopies / 2, kCheckCopies / 2);
         costs.push_back({n, label, 100.0 * (with / without - 1.0), 100.0 * (halfB / halfA - 1.0)});
         std::printf("%10zu  %-30s %14.4f %14.4f %+9.1f %% %+10.1f %%\n", n, label.c_str(),
                     1e3 * with, 1e3 * without, costs.back().cost, costs.back().spread);

@@ -91,6 +91,10 @@ class ParticleSystem {
   /// Under NonfinitePolicy::Kill, the particles removed for a non-finite position or velocity
   /// since the system was made (a restored system counts from its restore).
   std::uint64_t nonfiniteKilled() const { return nonfiniteKilled_; }
+  /// What the ticks from now on do with non-finite state (SystemSettings::nonfinite): a host's
+  /// debug switch, say. After ticks under Keep the first checked tick checks every value it
+  /// writes, since nothing checked what they made. A stopped system stays stopped.
+  void setNonfinitePolicy(NonfinitePolicy policy) { settings_.nonfinite = policy; }
 
   /// Ticks run in fused frames so far (see the class comment): for tests and benches.
   std::int64_t fusedTicks() const { return fusedTicks_; }

@@ -123,6 +123,21 @@ bool finiteState(const ParticlePool& pool) {
   return true;
 }
 
+// The ids of the rows with a non-finite position or velocity component, in row order.
+std::vector<std::uint64_t> nonfiniteIds(const ParticlePool& pool) {
+  std::vector<std::uint64_t> ids;
+  for (std::size_t r = 0; r < pool.size(); ++r) {
+    bool finite = true;
+    for (int c = 0; c < 3; ++c) {
+      const auto i = static_cast<Eigen::Index>(r);
+      finite =
+          finite && std::isfinite(pool.position()[c][i]) && std::isfinite(pool.velocity()[c][i]);
+    }
+    if (!finite) ids.push_back(pool.id()[r]);
+  }
+  return ids;
+}
+
 class NonfiniteRun : public ::testing::TestWithParam<std::tuple<int, bool>> {
  protected:
   Exploding make(NonfinitePolicy policy) const {
@@ -201,16 +216,7 @@ TEST_P(NonfiniteEveryScheme, StopsAtTheFirstNonFiniteTickNamingTheRowsOfTheUnche
     ASSERT_TRUE(stop.system->nonfiniteStop()) << "tick " << tick;
     const NonfiniteEvent& e = *stop.system->nonfiniteStop();
     EXPECT_EQ(e.tick, tick);
-    std::vector<std::uint64_t> ids;
-    for (std::size_t r = 0; r < kept.size(); ++r) {
-      bool finite = true;
-      for (int c = 0; c < 3; ++c) {
-        const auto i = static_cast<Eigen::Index>(r);
-        finite =
-            finite && std::isfinite(kept.position()[c][i]) && std::isfinite(kept.velocity()[c][i]);
-      }
-      if (!finite) ids.push_back(kept.id()[r]);
-    }
+    std::vector<std::uint64_t> ids = nonfiniteIds(kept);
     EXPECT_EQ(e.particles, ids.size());
     ids.resize(std::min(ids.size(), NonfiniteEvent::kIdsKept));
     EXPECT_EQ(e.firstIds, ids);
@@ -265,6 +271,29 @@ TEST(NonfiniteExceptions, RaisedExactlyWhenArithmeticOnFiniteValuesMakesANonFini
   out = nan * 2.0f + inf;
   EXPECT_FALSE(takeNonfiniteExceptions()) << "a NaN or an infinity that is there spreads quietly";
   static_cast<void>(out);
+}
+
+// A host's switch: unchecked, the run goes on past its first non-finite tick (the NaNs and
+// infinities there spread quietly, raising no exception); switched to stop, the next tick stops
+// on the rows that are non-finite by then. Switched back to keep, a stopped system stays stopped.
+TEST(NonfinitePolicySwitch, ACheckSwitchedOnAfterUncheckedTicksFindsWhatTheyMade) {
+  Exploding run(NonfinitePolicy::Keep, 1, false, "midpoint");
+  Exploding stop(NonfinitePolicy::Stop, 1, false, "midpoint");
+  while (!stop.system->nonfiniteStop()) stop.system->step();
+  const std::int64_t first = stop.system->nonfiniteStop()->tick;
+  run.system->stepTicks(first + 2);
+  ASSERT_FALSE(finiteState(run.system->pool()));
+  run.system->setNonfinitePolicy(NonfinitePolicy::Stop);
+  run.system->step();
+  ASSERT_TRUE(run.system->nonfiniteStop());
+  EXPECT_EQ(run.system->nonfiniteStop()->tick, first + 3);
+  const std::vector<std::uint64_t> ids = nonfiniteIds(run.system->pool());
+  EXPECT_EQ(run.system->nonfiniteStop()->particles, ids.size());
+  EXPECT_EQ(run.system->nonfiniteStop()->firstIds, ids);
+  EXPECT_GT(ids.size(), stop.system->nonfiniteStop()->particles) << "more rows by then";
+  run.system->setNonfinitePolicy(NonfinitePolicy::Keep);
+  run.system->step();
+  EXPECT_EQ(run.system->tickCount(), first + 3);
 }
 
 // A quiet effect (a drag of 1/s alone: every scheme's one pass) of 3000 rows, `threads` threads.
