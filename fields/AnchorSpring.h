@@ -1,6 +1,8 @@
 // Every particle tied to one fixed point by a damped spring.
 #pragma once
 
+#include <cmath>
+
 #include "fields/ForceModule.h"
 
 namespace tickfx {
@@ -14,6 +16,9 @@ class AnchorSpring final : public ForceModule {
       : rest_(rest), k_(stiffness), c_(damping) {}
   std::string_view typeName() const override { return "anchor_spring"; }
   bool interleavesTicks() const override { return true; }
+  bool arithmeticOnly() const override {
+    return rest_.allFinite() && std::isfinite(k_) && std::isfinite(c_);
+  }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   float stiffness() const { return k_; }
   float damping() const { return c_; }

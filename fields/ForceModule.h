@@ -119,6 +119,12 @@ class ForceModule {
   /// state and the instant alone. A system whose modules all say so advances a frame's ticks
   /// block by block (ParticleSystem, fused frames). False unless a module says otherwise.
   virtual bool interleavesTicks() const { return false; }
+  /// True when, at finite positions and velocities, the module's acceleration is made by
+  /// arithmetic from those values and finite constants alone (no grid or table values, which may
+  /// already be NaN): it is then non-finite only through an operation that raises a
+  /// floating-point exception (invalid, overflow, divide-by-zero), and the integrators may check
+  /// ticks under it by the exception flags (NonfiniteCheck). False unless a module says so.
+  virtual bool arithmeticOnly() const { return false; }
   /// When the acceleration at `in` is the same for every particle, stores it in `a` and returns
   /// true. ForceSet then adds a leading run of such modules once per evaluation instead of once
   /// per particle; the per-particle sum keeps the same order, so the bits do not change.

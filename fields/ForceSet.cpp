@@ -57,6 +57,11 @@ bool ForceSet::isLocal() const {
   return std::all_of(modules_.begin(), modules_.end(), [](const auto& m) { return m->isLocal(); });
 }
 
+bool ForceSet::arithmeticOnly() const {
+  return std::all_of(modules_.begin(), modules_.end(),
+                     [](const auto& m) { return m->arithmeticOnly(); });
+}
+
 bool ForceSet::interleavesTicks() const {
   return std::all_of(modules_.begin(), modules_.end(),
                      [](const auto& m) { return m->interleavesTicks(); });

@@ -30,6 +30,8 @@ class ForceSet {
 
   /// True when every module interleaves ticks (see ForceModule::interleavesTicks).
   bool interleavesTicks() const;
+  /// True when every module is arithmetic only (see ForceModule::arithmeticOnly).
+  bool arithmeticOnly() const;
 
   /// Once per tick before any evaluation: the modules' beginTick, and whether any particle is
   /// pinned (inverse mass 0), which evaluate() then holds still.

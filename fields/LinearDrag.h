@@ -1,6 +1,8 @@
 // Linear drag toward the velocity of the surrounding air.
 #pragma once
 
+#include <cmath>
+
 #include "fields/ForceModule.h"
 
 namespace tickfx {
@@ -13,6 +15,7 @@ class LinearDrag final : public ForceModule {
       : k_(k), air_(airVelocity) {}
   std::string_view typeName() const override { return "drag"; }
   bool interleavesTicks() const override { return true; }
+  bool arithmeticOnly() const override { return std::isfinite(k_) && air_.allFinite(); }
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   bool linearDrag(float& k, Eigen::Vector3f& air) const override {
     k = k_;

@@ -1,6 +1,8 @@
 // A gusting wind that is the same everywhere and periodic in time.
 #pragma once
 
+#include <cmath>
+
 #include "fields/ForceModule.h"
 #include "particles/SettingProblem.h"
 
@@ -30,6 +32,10 @@ class PeriodicWind final : public ForceModule {
   explicit PeriodicWind(const Settings& settings);
   std::string_view typeName() const override { return "wind"; }
   bool interleavesTicks() const override { return true; }
+  bool arithmeticOnly() const override {
+    return s_.direction.allFinite() && std::isfinite(s_.base) && std::isfinite(s_.amplitude) &&
+           std::isfinite(s_.frequency) && std::isfinite(s_.phase);
+  }
   bool uniformAcceleration(const ForceInput& in, Eigen::Vector3f& a) const override;
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   /// The scalar strength (m/s²) at time `t` seconds.

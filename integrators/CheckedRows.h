@@ -11,6 +11,9 @@
 #include <type_traits>
 
 #include "fields/ForceModule.h"
+#include "fields/ForceSet.h"
+#include "integrators/NonfiniteExceptions.h"
+#include "integrators/StagePasses.h"
 #include "particles/NonfiniteState.h"
 
 namespace tickfx {
@@ -64,6 +67,11 @@ struct CheckedPair {
 };
 template <class Lane>
 CheckedPair(Lane, Lane) -> CheckedPair<Lane>;
+
+template <class T>
+inline constexpr bool kIsCheckedPair = false;
+template <class Lane>
+inline constexpr bool kIsCheckedPair<CheckedPair<Lane>> = true;
 
 /// The value the check sums for what a kernel returned: a pair is added to itself first, so that
 /// the sums' loop-carried chain has one add a row group, not two.
@@ -141,6 +149,44 @@ void updateTile(NonfiniteCheck* check, ParticlePool& pool, RowRange rows, const 
         [&](auto*... columns) { return updateRows(check, n, kernel, columns...); }, columnsOf(c));
   }
   if (suspect) check->scan(pool, rows.begin, rows.end);
+}
+
+/// The check of a tile by exceptions (see NonfiniteCheck::steppedRowsFinite()), once its passes
+/// are done: the whole tile is scanned when they raised a kNonfiniteExceptions flag, else its rows
+/// spawned this tick (from `fresh` on), whose values the tick did not make from checked ones.
+inline void checkByExceptions(NonfiniteCheck& check, ParticlePool& pool, RowRange r,
+                              std::size_t fresh) {
+  const RowRange scanned = takeNonfiniteExceptions() ? r : intersect(r, fresh, r.end);
+  if (scanned.count() == 0) return;
+  check.scan(pool, scanned.begin, scanned.end);
+  takeNonfiniteExceptions();  // the scan's own sums of what it found: not the next tile's
+}
+
+/// How a tick's passes check their tiles: `sums` for their update loops' updateTile() (nullptr:
+/// unchecked) and `afterEachTile` for runPasses().
+struct TileCheck {
+  NonfiniteCheck* sums = nullptr;
+  RowPass afterEachTile;
+};
+
+/// A TileCheck by exceptions: the update loops unchecked, checkByExceptions() after each tile.
+inline TileCheck checkTilesByExceptions(NonfiniteCheck& check, ParticlePool& pool,
+                                        const StepRows& rows) {
+  return {nullptr, [&check, &pool, fresh = rows.fresh](const Tile& tile) {
+            checkByExceptions(check, pool, tile.rows(), fresh);
+          }};
+}
+
+/// The TileCheck of a tick's force passes: by exceptions when the stepped rows start finite,
+/// every force is local (the passes of a tile then run on one thread, so the flags of its thread
+/// are the tile's) and arithmetic only (ForceSet::arithmeticOnly), else by sums (or none).
+inline TileCheck forcePassCheck(NonfiniteCheck* check, ParticlePool& pool, const ForceSet& forces,
+                                const StepRows& rows) {
+  if (check != nullptr && check->steppedRowsFinite() && forces.isLocal() &&
+      forces.arithmeticOnly()) {
+    return checkTilesByExceptions(*check, pool, rows);
+  }
+  return {check, {}};
 }
 
 }  // namespace tickfx

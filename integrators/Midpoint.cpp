@@ -31,6 +31,7 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
     });
     return;
   }
+  const TileCheck tiles = forcePassCheck(check, pool, forces, rows);
   runPasses(rows, forces.isLocal(), scratch_,
             {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0),
              [&](const Tile& tile) {
@@ -49,7 +50,7 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
                };
                // The velocity is still the tick's start (finite), so the scan flags the rows
                // whose new position is not; the last pass adds those whose new velocity is not.
-               updateTile(check, pool, tile.rows(), update, [&](int c) {
+               updateTile(tiles.sums, pool, tile.rows(), update, [&](int c) {
                  return std::tuple(pr[c].data(), old[c].data(), vMid[c].data(),
                                    static_cast<const float*>(vr[c].data()),
                                    static_cast<const float*>(a[c].data()));
@@ -66,10 +67,11 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
                  at.store(vel, velocity);
                  return velocity;
                };
-               updateTile(check, pool, tile.rows(), update, [&](int c) {
+               updateTile(tiles.sums, pool, tile.rows(), update, [&](int c) {
                  return std::tuple(vr[c].data(), static_cast<const float*>(a[c].data()));
                });
-             }});
+             }},
+            tiles.afterEachTile);
 }
 
 }  // namespace tickfx

@@ -70,21 +70,25 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
         startTile);
     return;
   }
-  runPasses(
-      rows, forces.isLocal(), scratch_,
-      {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0), [&](const Tile& tile) {
-         const RowRange r = tile.rows();
-         Vec3Rows a = tile.stage(0), pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
-         for (int c = 0; c < 3; ++c) start(r, c, [&](Eigen::Index i, float) { return a[c][i]; });
-         const auto update = [dt2, invDt](auto at, float* pos, float* vel, float* last,
-                                          const float* acc) {
-           return positionVerletRow(dt2, invDt, at.load(acc), at, pos, vel, last);
-         };
-         updateTile(check, pool, r, update, [&](int c) {
-           return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
-                             static_cast<const float*>(a[c].data()));
-         });
-       }});
+  const TileCheck tiles = forcePassCheck(check, pool, forces, rows);
+  runPasses(rows, forces.isLocal(), scratch_,
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0),
+             [&](const Tile& tile) {
+               const RowRange r = tile.rows();
+               Vec3Rows a = tile.stage(0), pr = rowsOf(p, r), vr = rowsOf(v, r),
+                        old = rowsOf(prev, r);
+               for (int c = 0; c < 3; ++c)
+                 start(r, c, [&](Eigen::Index i, float) { return a[c][i]; });
+               const auto update = [dt2, invDt](auto at, float* pos, float* vel, float* last,
+                                                const float* acc) {
+                 return positionVerletRow(dt2, invDt, at.load(acc), at, pos, vel, last);
+               };
+               updateTile(tiles.sums, pool, r, update, [&](int c) {
+                 return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
+                                   static_cast<const float*>(a[c].data()));
+               });
+             }},
+            tiles.afterEachTile);
 }
 
 }  // namespace tickfx

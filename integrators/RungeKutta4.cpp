@@ -64,11 +64,13 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
       }
     };
   };
+  const TileCheck tiles = forcePassCheck(check, pool, forces, rows);
   runPasses(
       rows, forces.isLocal(), scratch_,
       {evaluate(kState, kState, t0, K1), advance(kState, K1, P2, V2, halfH),
        evaluate(P2, V2, tHalf, K2), advance(V2, K2, P3, V3, halfH), evaluate(P3, V3, tHalf, K3),
-       advance(V3, K3, P4, V4, h), evaluate(P4, V4, t1, K4), [&](const Tile& tile) {
+       advance(V3, K3, P4, V4, h), evaluate(P4, V4, t1, K4),
+       [&](const Tile& tile) {
          Vec3Rows k1 = tile.stage(K1), k2 = tile.stage(K2), k3 = tile.stage(K3),
                   k4 = tile.stage(K4);
          Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
@@ -94,11 +96,12 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
          const auto in = [](Eigen::Map<FloatColumn>& column) {
            return static_cast<const float*>(column.data());
          };
-         updateTile(check, pool, tile.rows(), update, [&](int c) {
+         updateTile(tiles.sums, pool, tile.rows(), update, [&](int c) {
            return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), in(k1[c]), in(k2[c]),
                              in(k3[c]), in(k4[c]), in(v2[c]), in(v3[c]), in(v4[c]));
          });
-       }});
+       }},
+      tiles.afterEachTile);
 }
 
 }  // namespace tickfx

@@ -16,7 +16,6 @@
 #include "fields/ForceSet.h"
 #include "integrators/CheckedRows.h"
 #include "integrators/Integrator.h"
-#include "integrators/NonfiniteExceptions.h"
 #include "integrators/StagePasses.h"
 
 namespace tickfx {
@@ -115,17 +114,6 @@ void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange ro
   if (suspect) check->scan(pool, rows.begin, rows.end);
 }
 
-/// The check of a tile's one pass by exceptions (see NonfiniteCheck::steppedRowsFinite()): the
-/// whole tile is scanned when the pass raised a kNonfiniteExceptions flag, else its rows spawned
-/// this tick (from `fresh` on), whose values the tick did not make from checked ones.
-inline void checkByExceptions(NonfiniteCheck& check, ParticlePool& pool, RowRange r,
-                              std::size_t fresh) {
-  const RowRange scanned = takeNonfiniteExceptions() ? r : intersect(r, fresh, r.end);
-  if (scanned.count() == 0) return;
-  check.scan(pool, scanned.begin, scanned.end);
-  takeNonfiniteExceptions();  // the scan's own sums of what it found: not the next tile's
-}
-
 /// The one pass of a scheme over every tile of `rows`: `beforeTile(tile)` first (the rows spawned
 /// this tick start their history, say), then for each component the kernel
 /// `kernelFor(accelerations)` gives, (at, pos, vel, last, extra...), over the position, the
@@ -141,21 +129,22 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const bool byExceptions = check != nullptr && check->steppedRowsFinite() && forms.finite();
+  const TileCheck tileCheck =
+      byExceptions ? checkTilesByExceptions(*check, pool, rows) : TileCheck{check, {}};
   runPasses(rows, true, scratch, {[&](const Tile& tile) {
               beforeTile(tile);
               const RowRange r = tile.rows();
               Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
               std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
-              NonfiniteCheck* const sums = byExceptions ? nullptr : check;
-              updateTileUnderForms(sums, pool, r, forms, kernelFor, [&](int c) {
+              updateTileUnderForms(tileCheck.sums, pool, r, forms, kernelFor, [&](int c) {
                 return std::apply(
                     [&](auto&... e) {
                       return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), e[c].data()...);
                     },
                     more);
               });
-              if (byExceptions) checkByExceptions(*check, pool, r, rows.fresh);
-            }});
+            }},
+            tileCheck.afterEachTile);
 }
 
 /// runOnePass() of a scheme whose row update reads and writes the position, the velocity and

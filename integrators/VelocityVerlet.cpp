@@ -47,6 +47,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
         startRows, a);
     return;
   }
+  const TileCheck tiles = forcePassCheck(check, pool, forces, rows);
   runPasses(
       rows, forces.isLocal(), scratch_,
       {startRows,
@@ -67,7 +68,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
          };
          // The velocity is still the tick's start (finite), so the scan flags the rows
          // whose new position is not; the last pass adds those whose new velocity is not.
-         updateTile(check, pool, tile.rows(), update, [&](int c) {
+         updateTile(tiles.sums, pool, tile.rows(), update, [&](int c) {
            return std::tuple(pr[c].data(), old[c].data(), vPred[c].data(),
                              static_cast<const float*>(vr[c].data()),
                              static_cast<const float*>(ar[c].data()));
@@ -84,10 +85,11 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            at.store(acc, next);
            return velocity;
          };
-         updateTile(check, pool, tile.rows(), update, [&](int c) {
+         updateTile(tiles.sums, pool, tile.rows(), update, [&](int c) {
            return std::tuple(vr[c].data(), ar[c].data(), static_cast<const float*>(aNew[c].data()));
          });
-       }});
+       }},
+      tiles.afterEachTile);
 }
 
 }  // namespace tickfx

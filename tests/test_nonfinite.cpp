@@ -82,12 +82,26 @@ TEST(NonfiniteEvent, DescribesTheTickTimeCountAndIds) {
 // n is 38 (9³⁷ = 2.0e35, 2·9³⁷ = 4.1e35 are below; 9³⁸ = 1.8e36 is above), so tick 39; for 1e-3
 // it is 41 (1e-3·9⁴⁰ = 1.5e35, 1e-3·9⁴¹ = 1.3e36), so tick 42. The factor is rounded in float,
 // within 1e-6 of −9 over 42 ticks: far from these margins (the narrowest is 1.4×).
+// Which passes a scheme takes under the forces of a test scene: with nothing but uniform forces
+// and a drag, the one pass (UniformAndDragRows.h, checked by exceptions); with a weak anchor
+// spring too (local and arithmetic only), its force passes tile by tile, checked by exceptions;
+// with a spring network (even empty: not local), its force passes each over all rows in turn,
+// checked by sums in its last update loop.
+enum class Passes { OnePass, Tiles, Split };
+
+void addLayoutForces(ForceSet& forces, Passes passes) {
+  if (passes == Passes::Tiles) {
+    forces.add(std::make_unique<AnchorSpring>(Eigen::Vector3f::Zero(), 1e-3f));
+  }
+  if (passes == Passes::Split) forces.add(std::make_unique<SpringNetwork>());
+}
+
 struct Exploding {
   static constexpr std::int64_t kFirstTick = 39, kLastTick = 42;
 
   std::unique_ptr<ParticleSystem> system;
 
-  Exploding(NonfinitePolicy policy, int threads, bool split,
+  Exploding(NonfinitePolicy policy, int threads, Passes passes,
             const std::string& integrator = "semi_implicit_euler") {
     SystemSettings s;
     s.stepRateHz = 60;
@@ -96,11 +110,7 @@ struct Exploding {
     s.nonfinite = policy;
     ForceSet forces;
     forces.add(std::make_unique<LinearDrag>(600.0f));
-    // The drag alone is a form every scheme computes in its one update loop
-    // (UniformAndDragRows.h). A spring network (even empty) is not local and not such a form:
-    // the integrator then runs its force passes, each over all rows in turn instead of tile by
-    // tile, and checks in its last update loop.
-    if (split) forces.add(std::make_unique<SpringNetwork>());
+    addLayoutForces(forces, passes);
     system = std::make_unique<ParticleSystem>(s, std::vector<EmitterSettings>{}, std::move(forces));
     const Eigen::Vector3f velocities[] = {
         {0.0f, 0.0f, 2.0f}, {0.0f, 1e-3f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
@@ -141,7 +151,8 @@ std::vector<std::uint64_t> nonfiniteIds(const ParticlePool& pool) {
 class NonfiniteRun : public ::testing::TestWithParam<std::tuple<int, bool>> {
  protected:
   Exploding make(NonfinitePolicy policy) const {
-    return Exploding(policy, std::get<0>(GetParam()), std::get<1>(GetParam()));
+    return Exploding(policy, std::get<0>(GetParam()),
+                     std::get<1>(GetParam()) ? Passes::Split : Passes::OnePass);
   }
 };
 
@@ -193,51 +204,98 @@ TEST_P(NonfiniteRun, KillRemovesEachParticleAtItsOwnTickAndCountsIt) {
 }
 
 // Each integrator checks inside its own update loops (integrators/CheckedRows.h): the one pass
-// ("fused": the drag alone) and the force passes ("split"), so each is tested both ways: in
+// ("fused": the drag alone), the force passes tile by tile ("tiles", by exceptions) and over all
+// rows ("split", by sums), so each is tested three ways (see Passes): in
 // lockstep with an unchecked run of the same effect, the checked one must stop at the first tick
 // whose state has a non-finite position or velocity, naming exactly those rows. Drag of 600/s at 60
 // Hz is unstable under every scheme here. Under explicit Euler the velocity goes non-finite a tick
 // before the position does (the position takes the old velocity): a check of positions alone would
 // report a tick late.
-class NonfiniteEveryScheme : public ::testing::TestWithParam<std::tuple<std::string, bool>> {};
+class NonfiniteEveryScheme : public ::testing::TestWithParam<std::tuple<std::string, Passes>> {};
 
-TEST_P(NonfiniteEveryScheme, StopsAtTheFirstNonFiniteTickNamingTheRowsOfTheUncheckedRun) {
-  const auto& [integrator, split] = GetParam();
-  Exploding stop(NonfinitePolicy::Stop, 1, split, integrator);
-  Exploding keep(NonfinitePolicy::Keep, 1, split, integrator);
-  const ParticlePool& kept = keep.system->pool();
-  for (std::int64_t tick = 1; tick <= 400; ++tick) {
-    stop.system->step();
-    keep.system->step();
+// Steps `stop` (checked) and `keep` (unchecked, the same effect) in lockstep: `stop` must stop at
+// the first tick whose state has a non-finite position or velocity, naming exactly those rows,
+// with the state `keep` made. Returns that tick (0 if none in `ticks`).
+std::int64_t expectStopsWithTheUncheckedRun(ParticleSystem& stop, ParticleSystem& keep,
+                                            std::int64_t ticks) {
+  const ParticlePool& kept = keep.pool();
+  for (std::int64_t tick = 1; tick <= ticks; ++tick) {
+    stop.step();
+    keep.step();
     if (finiteState(kept)) {
-      ASSERT_FALSE(stop.system->nonfiniteStop()) << "tick " << tick;
+      EXPECT_FALSE(stop.nonfiniteStop()) << "tick " << tick;
+      if (stop.nonfiniteStop()) return 0;
       continue;
     }
-    ASSERT_TRUE(stop.system->nonfiniteStop()) << "tick " << tick;
-    const NonfiniteEvent& e = *stop.system->nonfiniteStop();
+    EXPECT_TRUE(stop.nonfiniteStop()) << "tick " << tick;
+    if (!stop.nonfiniteStop()) return 0;
+    const NonfiniteEvent& e = *stop.nonfiniteStop();
     EXPECT_EQ(e.tick, tick);
     std::vector<std::uint64_t> ids = nonfiniteIds(kept);
     EXPECT_EQ(e.particles, ids.size());
     ids.resize(std::min(ids.size(), NonfiniteEvent::kIdsKept));
     EXPECT_EQ(e.firstIds, ids);
-    EXPECT_EQ(stateHash(stop.system->pool()), stateHash(kept)) << "the check changed the state";
-    return;
+    EXPECT_EQ(stateHash(stop.pool()), stateHash(kept)) << "the check changed the state";
+    return tick;
   }
-  FAIL() << integrator << " stayed finite for 400 ticks: the scene no longer explodes";
+  return 0;
 }
 
-std::string schemeLayoutName(const ::testing::TestParamInfo<std::tuple<std::string, bool>>& info) {
-  return std::get<0>(info.param) + (std::get<1>(info.param) ? "_split" : "_fused");
+TEST_P(NonfiniteEveryScheme, StopsAtTheFirstNonFiniteTickNamingTheRowsOfTheUncheckedRun) {
+  const auto& [integrator, passes] = GetParam();
+  Exploding stop(NonfinitePolicy::Stop, 1, passes, integrator);
+  Exploding keep(NonfinitePolicy::Keep, 1, passes, integrator);
+  EXPECT_NE(expectStopsWithTheUncheckedRun(*stop.system, *keep.system, 400), 0)
+      << integrator << " stayed finite for 400 ticks: the scene no longer explodes";
+}
+
+// A position that overflows while every velocity stays finite: 3.3e38 m at 4e37 m/s, no force
+// (the one pass) or an empty spring network (the force passes), 6.7e35 m a tick at 60 Hz, past
+// the largest float (3.40e38) in the 16th tick (RK4's v + 2·v2 + 2·v3 + v4 = 2.4e38 stays
+// finite); position Verlet's 2·p overflows in the first.
+// From the second tick on the rows start finite, so the check of the one pass, and of explicit
+// Euler's new position in the force passes, is the overflow flag alone.
+TEST_P(NonfiniteEveryScheme, APositionThatOverflowsWithAFiniteVelocityStopsItsTick) {
+  const auto& [integrator, passes] = GetParam();
+  const auto make = [&, passes = passes, integrator = integrator](NonfinitePolicy policy) {
+    SystemSettings s;
+    s.stepRateHz = 60;
+    s.integrator = integrator;
+    s.nonfinite = policy;
+    ForceSet forces;
+    addLayoutForces(forces, passes);
+    auto system =
+        std::make_unique<ParticleSystem>(s, std::vector<EmitterSettings>{}, std::move(forces));
+    for (int r = 0; r < 3000; ++r) {
+      ParticleInit p;
+      if (r == 1500) {
+        p.position.x() = 3.3e38f;
+        p.velocity.x() = 4e37f;
+      }
+      system->editPool().spawn(p, 0);
+    }
+    return system;
+  };
+  auto stop = make(NonfinitePolicy::Stop), keep = make(NonfinitePolicy::Keep);
+  const std::int64_t tick = expectStopsWithTheUncheckedRun(*stop, *keep, 30);
+  EXPECT_EQ(tick, integrator == "position_verlet" ? 1 : 16);
+}
+
+std::string schemeLayoutName(
+    const ::testing::TestParamInfo<std::tuple<std::string, Passes>>& info) {
+  const char* names[] = {"_fused", "_tiles", "_split"};
+  return std::get<0>(info.param) + names[static_cast<int>(std::get<1>(info.param))];
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, NonfiniteEveryScheme,
                          ::testing::Combine(::testing::ValuesIn(integratorNames()),
-                                            ::testing::Bool()),
+                                            ::testing::Values(Passes::OnePass, Passes::Tiles,
+                                                              Passes::Split)),
                          schemeLayoutName);
 
 // Explicit Euler's velocity is non-finite a tick before its position: the check must see it.
 TEST(NonfiniteExplicitEuler, AVelocityThatIsNotFiniteStopsTheRunBeforeThePositionFollows) {
-  Exploding keep(NonfinitePolicy::Keep, 1, false, "explicit_euler");
+  Exploding keep(NonfinitePolicy::Keep, 1, Passes::OnePass, "explicit_euler");
   const ParticlePool& kept = keep.system->pool();
   bool velocityFirst = false;
   for (int tick = 0; tick < 400 && finiteState(kept); ++tick) {
@@ -277,8 +335,8 @@ TEST(NonfiniteExceptions, RaisedExactlyWhenArithmeticOnFiniteValuesMakesANonFini
 // infinities there spread quietly, raising no exception); switched to stop, the next tick stops
 // on the rows that are non-finite by then. Switched back to keep, a stopped system stays stopped.
 TEST(NonfinitePolicySwitch, ACheckSwitchedOnAfterUncheckedTicksFindsWhatTheyMade) {
-  Exploding run(NonfinitePolicy::Keep, 1, false, "midpoint");
-  Exploding stop(NonfinitePolicy::Stop, 1, false, "midpoint");
+  Exploding run(NonfinitePolicy::Keep, 1, Passes::OnePass, "midpoint");
+  Exploding stop(NonfinitePolicy::Stop, 1, Passes::OnePass, "midpoint");
   while (!stop.system->nonfiniteStop()) stop.system->step();
   const std::int64_t first = stop.system->nonfiniteStop()->tick;
   run.system->stepTicks(first + 2);
@@ -369,6 +427,33 @@ TEST_P(NonfiniteOnePass, ANonFiniteUniformAccelerationStopsTheTickThatUsesIt) {
   ASSERT_TRUE(system->nonfiniteStop());
   EXPECT_EQ(system->nonfiniteStop()->tick, FailingUniformModule::kBadTick);
   EXPECT_EQ(system->nonfiniteStop()->particles, 3000u);
+}
+
+// A host's own local module that reads a table it was given, in which one value is NaN: nothing
+// raises an exception when that NaN is added, so modules are not arithmetic only unless they say
+// so (ForceModule::arithmeticOnly), and the force passes sum what they write.
+class TableModule : public ForceModule {
+ public:
+  static constexpr std::int64_t kBadTick = 5;
+  static constexpr std::uint64_t kBadId = 2100;
+  std::string_view typeName() const override { return "table"; }
+  void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override {
+    for (std::size_t r = rows.begin; r < rows.end; ++r) {
+      const bool bad = in.pool.id()[r] == kBadId && in.at.tick + 1 >= kBadTick;
+      acceleration.z[static_cast<Eigen::Index>(r - rows.begin)] += bad ? kNaN : 0.5f;
+    }
+  }
+};
+
+TEST_P(NonfiniteOnePass, ANaNFromAModulesTableStopsTheTickThatReadsIt) {
+  const auto& [integrator, threads] = GetParam();
+  auto system = quietEffect(integrator, threads, std::make_unique<TableModule>());
+  for (std::int64_t tick = 1; tick < TableModule::kBadTick; ++tick) system->step();
+  ASSERT_FALSE(system->nonfiniteStop());
+  system->step();
+  ASSERT_TRUE(system->nonfiniteStop());
+  EXPECT_EQ(system->nonfiniteStop()->tick, TableModule::kBadTick);
+  EXPECT_EQ(system->nonfiniteStop()->firstIds, (std::vector<std::uint64_t>{TableModule::kBadId}));
 }
 
 std::string onePassName(const ::testing::TestParamInfo<std::tuple<std::string, int>>& info) {
