@@ -53,6 +53,7 @@
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
+#include "fields/SpringNetwork.h"
 #include "integrators/SemiImplicitEuler.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Random.h"
@@ -242,11 +243,15 @@ class HandSoaLoop {
 
 // ---- tickfx side -----------------------------------------------------------------------------
 
-// With `tether`, an anchor spring after the drag: forces no scheme can form in its update loop
-// (ForceSet::uniformAndDrag), so every scheme takes its force passes.
+// Forces after the tick's own (gravity, wind, drag), which every scheme forms in its one update
+// loop (ForceSet::uniformAndDrag): with kTether an anchor spring (local: the force passes, tile
+// by tile), with kNetwork an empty spring network (not local: the force passes, each over all
+// rows in turn).
+enum Extra { kNone, kTether, kNetwork };
+
 std::unique_ptr<tickfx::ParticleSystem> makeSystem(
     std::size_t n, int threads, tickfx::NonfinitePolicy nonfinite = tickfx::NonfinitePolicy::Stop,
-    const std::string& integrator = "semi_implicit_euler", bool tether = false) {
+    const std::string& integrator = "semi_implicit_euler", Extra extra = kNone) {
   tickfx::SystemSettings settings;
   settings.nonfinite = nonfinite;
   settings.stepRateHz = kStepRateHz;
@@ -254,7 +259,10 @@ std::unique_ptr<tickfx::ParticleSystem> makeSystem(
   settings.maxParticles = n;
   settings.threads = threads;
   tickfx::ForceSet forces = makeForces();
-  if (tether) forces.add(std::make_unique<tickfx::AnchorSpring>(Eigen::Vector3f::Zero(), 0.5f));
+  if (extra == kTether) {
+    forces.add(std::make_unique<tickfx::AnchorSpring>(Eigen::Vector3f::Zero(), 0.5f));
+  }
+  if (extra == kNetwork) forces.add(std::make_unique<tickfx::SpringNetwork>());
   auto system = std::make_unique<tickfx::ParticleSystem>(
       settings, std::vector<tickfx::EmitterSettings>{}, std::move(forces));
   tickfx::ParticlePool& pool = system->editPool();
@@ -447,8 +455,10 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 }
 
 // Per integrator, step() on 1 thread with the non-finite check (NonfinitePolicy::Stop) and
-// without (Keep): under the tick's own forces, which every scheme forms in its one update loop,
-// and with an anchor spring added ("+spring"), which sends every scheme through its force passes.
+// without (Keep): under the tick's own forces, which every scheme forms in its one update loop
+// (checked by exceptions), with an anchor spring added ("+spring": the force passes tile by tile,
+// by exceptions) and with an empty spring network ("+network": the force passes over all rows,
+// by sums).
 // Two identical systems measured up to 3 % apart at 10⁴ and 13 % at 10⁶ with where their columns
 // sat, so each of kCheckCopies systems is timed both ways, switching its policy before each batch
 // (and running one untimed tick, so that a checked batch starts as a run's checked ticks do:
@@ -488,12 +498,14 @@ void runCheckCosts(const std::vector<std::size_t>& sizes, const bench::Timing& t
     return bench::median(all);
   };
   for (const std::size_t n : sizes) {
-    for (const bool tether : {false, true}) {
+    for (const Extra extra : {kNone, kTether, kNetwork}) {
       for (const std::string& name : tickfx::integratorNames()) {
-        const std::string label = name + (tether ? " +spring" : "");
+        const std::string label = name + (extra == kTether    ? " +spring"
+                                          : extra == kNetwork ? " +network"
+                                                              : "");
         std::vector<std::unique_ptr<tickfx::ParticleSystem>> systems;
         for (int i = 0; i < kCheckCopies; ++i) {
-          systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name, tether));
+          systems.push_back(makeSystem(n, 1, tickfx::NonfinitePolicy::Stop, name, extra));
         }
         std::vector<bench::Case> cases;
         for (int k = 0; k < kCases; ++k) {

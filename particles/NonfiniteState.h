@@ -50,7 +50,8 @@ struct NonfiniteEvent {
 
 /// Finds non-finite positions and velocities. An integrator's last update loop over a tile sums
 /// the values it writes as it writes them (integrators/CheckedRows.h) and calls scan() only for a
-/// tile whose sum is not finite; a scheme's one pass over rows that start finite tests the
+/// tile whose sum is not finite; over rows that start finite, a scheme's one pass, and its force
+/// passes under local, arithmetic-only forces (ForceModule::arithmeticOnly), test the
 /// floating-point exception flags after each tile instead (steppedRowsFinite()); the advection
 /// schemes call scan() for every tile once their passes are done with it, while the tile is in
 /// cache. scan() sums the tile's six columns (one add per
@@ -70,9 +71,9 @@ class NonfiniteCheck {
 
   /// Whether the rows a tick steps (all but those spawned for it) are known to be finite when it
   /// starts: the tick before them was checked and nothing has written the state since
-  /// (ParticleSystem keeps this; false by default). A scheme's one pass then checks them by the
-  /// floating-point exceptions its arithmetic raises (integrators/NonfiniteExceptions.h), at no
-  /// cost per value, and scans the spawned rows.
+  /// (ParticleSystem keeps this; false by default). Where the tick's other inputs are finite
+  /// constants too, a scheme then checks them by the floating-point exceptions its arithmetic
+  /// raises (integrators/NonfiniteExceptions.h), at no cost per value, and scans the spawned rows.
   bool steppedRowsFinite() const { return steppedRowsFinite_; }
   void setSteppedRowsFinite(bool finite) { steppedRowsFinite_ = finite; }
 

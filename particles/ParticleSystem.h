@@ -56,8 +56,8 @@ struct SystemSettings {
 /// which stop at the exact tick.
 ///
 /// Checked ticks (NonfinitePolicy::Stop, Kill) read, and clear when raised, the invalid, overflow
-/// and divide-by-zero floating-point exception flags of the threads they run on: a scheme's one
-/// pass checks the rows it steps by them (NonfiniteCheck::steppedRowsFinite()).
+/// and divide-by-zero floating-point exception flags of the threads they run on: the integrators
+/// check the rows they step by them where they can (NonfiniteCheck::steppedRowsFinite()).
 ///
 /// Not thread-safe: one thread drives a system. Inside a tick the system runs its loops in its
 /// own TBB arena, or on the host's executor (setTaskExecutor()); it never changes TBB's
