@@ -397,6 +397,15 @@ TEST_P(NonfiniteOnePass, ValuesWrittenBetweenTicksStopTheNextTick) {
   EXPECT_EQ(e.firstIds, (std::vector<std::uint64_t>{1200, 2500}));
 }
 
+// Steps `system` through the ticks before `tick` (it must not stop in them), then once more:
+// the event of that tick, or nullptr when it did not stop.
+const NonfiniteEvent* stopAtTick(ParticleSystem& system, std::int64_t tick) {
+  for (std::int64_t t = 1; t < tick; ++t) system.step();
+  EXPECT_FALSE(system.nonfiniteStop()) << "stopped before tick " << tick;
+  system.step();
+  return system.nonfiniteStop() ? &*system.nonfiniteStop() : nullptr;
+}
+
 // A uniform acceleration of (0, g, 0) that a host's own module gives, g NaN from the tick that
 // ends at kBadTick on (the one that starts at kBadTick − 1).
 class FailingUniformModule : public ForceModule {
@@ -421,12 +430,10 @@ class FailingUniformModule : public ForceModule {
 TEST_P(NonfiniteOnePass, ANonFiniteUniformAccelerationStopsTheTickThatUsesIt) {
   const auto& [integrator, threads] = GetParam();
   auto system = quietEffect(integrator, threads, std::make_unique<FailingUniformModule>());
-  for (std::int64_t tick = 1; tick < FailingUniformModule::kBadTick; ++tick) system->step();
-  ASSERT_FALSE(system->nonfiniteStop());
-  system->step();
-  ASSERT_TRUE(system->nonfiniteStop());
-  EXPECT_EQ(system->nonfiniteStop()->tick, FailingUniformModule::kBadTick);
-  EXPECT_EQ(system->nonfiniteStop()->particles, 3000u);
+  const NonfiniteEvent* e = stopAtTick(*system, FailingUniformModule::kBadTick);
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->tick, FailingUniformModule::kBadTick);
+  EXPECT_EQ(e->particles, 3000u);
 }
 
 // A host's own local module that reads a table it was given, in which one value is NaN: nothing
@@ -448,12 +455,10 @@ class TableModule : public ForceModule {
 TEST_P(NonfiniteOnePass, ANaNFromAModulesTableStopsTheTickThatReadsIt) {
   const auto& [integrator, threads] = GetParam();
   auto system = quietEffect(integrator, threads, std::make_unique<TableModule>());
-  for (std::int64_t tick = 1; tick < TableModule::kBadTick; ++tick) system->step();
-  ASSERT_FALSE(system->nonfiniteStop());
-  system->step();
-  ASSERT_TRUE(system->nonfiniteStop());
-  EXPECT_EQ(system->nonfiniteStop()->tick, TableModule::kBadTick);
-  EXPECT_EQ(system->nonfiniteStop()->firstIds, (std::vector<std::uint64_t>{TableModule::kBadId}));
+  const NonfiniteEvent* e = stopAtTick(*system, TableModule::kBadTick);
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->tick, TableModule::kBadTick);
+  EXPECT_EQ(e->firstIds, (std::vector<std::uint64_t>{TableModule::kBadId}));
 }
 
 std::string onePassName(const ::testing::TestParamInfo<std::tuple<std::string, int>>& info) {
