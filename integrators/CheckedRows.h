@@ -68,11 +68,6 @@ struct CheckedPair {
 template <class Lane>
 CheckedPair(Lane, Lane) -> CheckedPair<Lane>;
 
-template <class T>
-inline constexpr bool kIsCheckedPair = false;
-template <class Lane>
-inline constexpr bool kIsCheckedPair<CheckedPair<Lane>> = true;
-
 /// The value the check sums for what a kernel returned: a pair is added to itself first, so that
 /// the sums' loop-carried chain has one add a row group, not two.
 template <class Lane>
@@ -136,6 +131,17 @@ bool updateRows(const NonfiniteCheck* check, Eigen::Index n, const Kernel& kerne
                           : updateRowsChecked<false>(n, kernel, columns...);
 }
 
+/// `updateComponent(c)` (updateRows() over component c of `rows`, returning whether some value
+/// may be non-finite) for the three components, then, when one may be, the exact scan that flags
+/// the rows.
+template <class UpdateComponent>
+void updateComponents(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
+                      const UpdateComponent& updateComponent) {
+  bool suspect = false;
+  for (int c = 0; c < 3; ++c) suspect |= updateComponent(c);
+  if (suspect) check->scan(pool, rows.begin, rows.end);
+}
+
 /// An integrator's checked update of one tile: updateRows() over the three components of `rows`
 /// (`columnsOf(c)` gives component c's columns, in the kernel's order, as a tuple of pointers),
 /// then, when some value may be non-finite, the exact scan that flags the tile's rows.
@@ -143,12 +149,10 @@ template <class Kernel, class ColumnsOf>
 void updateTile(NonfiniteCheck* check, ParticlePool& pool, RowRange rows, const Kernel& kernel,
                 const ColumnsOf& columnsOf) {
   const Eigen::Index n = rows.count();
-  bool suspect = false;
-  for (int c = 0; c < 3; ++c) {
-    suspect |= std::apply(
-        [&](auto*... columns) { return updateRows(check, n, kernel, columns...); }, columnsOf(c));
-  }
-  if (suspect) check->scan(pool, rows.begin, rows.end);
+  updateComponents(check, pool, rows, [&](int c) {
+    return std::apply([&](auto*... columns) { return updateRows(check, n, kernel, columns...); },
+                      columnsOf(c));
+  });
 }
 
 /// The check of a tile by exceptions (see NonfiniteCheck::steppedRowsFinite()), once its passes
@@ -169,24 +173,23 @@ struct TileCheck {
   RowPass afterEachTile;
 };
 
-/// A TileCheck by exceptions: the update loops unchecked, checkByExceptions() after each tile.
-inline TileCheck checkTilesByExceptions(NonfiniteCheck& check, ParticlePool& pool,
-                                        const StepRows& rows) {
-  return {nullptr, [&check, &pool, fresh = rows.fresh](const Tile& tile) {
-            checkByExceptions(check, pool, tile.rows(), fresh);
+/// The TileCheck of a tick's passes: by exceptions (the update loops unchecked, checkByExceptions()
+/// after each tile) when the stepped rows start finite and `arithmeticOnly`: every other input of
+/// the tile's arithmetic is a finite constant, and the tile's passes run on one thread (so the
+/// flags of its thread are the tile's). Else by sums (or none, without `check`).
+inline TileCheck tileCheck(NonfiniteCheck* check, ParticlePool& pool, const StepRows& rows,
+                           bool arithmeticOnly) {
+  if (check == nullptr || !check->steppedRowsFinite() || !arithmeticOnly) return {check, {}};
+  return {nullptr, [check, &pool, fresh = rows.fresh](const Tile& tile) {
+            checkByExceptions(*check, pool, tile.rows(), fresh);
           }};
 }
 
-/// The TileCheck of a tick's force passes: by exceptions when the stepped rows start finite,
-/// every force is local (the passes of a tile then run on one thread, so the flags of its thread
-/// are the tile's) and arithmetic only (ForceSet::arithmeticOnly), else by sums (or none).
+/// The TileCheck of a tick's force passes: by exceptions when every force is local (fused tiles)
+/// and arithmetic only (ForceSet::arithmeticOnly).
 inline TileCheck forcePassCheck(NonfiniteCheck* check, ParticlePool& pool, const ForceSet& forces,
                                 const StepRows& rows) {
-  if (check != nullptr && check->steppedRowsFinite() && forces.isLocal() &&
-      forces.arithmeticOnly()) {
-    return checkTilesByExceptions(*check, pool, rows);
-  }
-  return {check, {}};
+  return tileCheck(check, pool, rows, forces.isLocal() && forces.arithmeticOnly());
 }
 
 }  // namespace tickfx

@@ -17,12 +17,6 @@ namespace tickfx {
 /// RowsAt) of one component (acceleration in m/s², a value of at's lane type; the columns as
 /// updateRowsChecked passes them) and returns what the check sums. `scratch` holds the acceleration
 /// of the force pass (one stage value).
-///
-/// A row that returns a CheckedPair makes its new position from the tick's start alone (explicit
-/// Euler: p + v·dt). Over rows that start finite (NonfiniteCheck::steppedRowsFinite()) that
-/// position is then non-finite only by an overflow, which raises its exception flag: the force
-/// passes sum the new velocity alone (it takes the force pass's acceleration, which a field or a
-/// host's module may make NaN without raising anything) and test the flags after each tile.
 template <class Row>
 void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                           const StepRows& rows, NonfiniteCheck* check, StageScratch& scratch,
@@ -39,35 +33,21 @@ void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const Step
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   const TileCheck tiles = forcePassCheck(check, pool, forces, rows);
-  runPasses(
-      rows, forces.isLocal(), scratch,
-      {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0),
-       [&](const Tile& tile) {
-         Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                  old = rowsOf(prev, tile.rows());
-         const auto update = [row](auto at, float* pos, float* vel, float* last, const float* acc) {
-           return row(at.load(acc), at, pos, vel, last);
-         };
-         const auto columnsOf = [&](int c) {
-           return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
-                             static_cast<const float*>(a[c].data()));
-         };
-         using Checked = decltype(update(RowsAt<float>{0}, nullptr, nullptr, nullptr, nullptr));
-         if constexpr (kIsCheckedPair<Checked>) {
-           if (tiles.sums != nullptr && tiles.sums->steppedRowsFinite()) {
-             takeNonfiniteExceptions();  // the force pass's own: only the update's are tested
-             const auto velocityOnly = [update](auto at, float* pos, float* vel, float* last,
-                                                const float* acc) {
-               return update(at, pos, vel, last, acc).velocity;
-             };
-             updateTile(tiles.sums, pool, tile.rows(), velocityOnly, columnsOf);
-             checkByExceptions(*tiles.sums, pool, tile.rows(), rows.fresh);
-             return;
-           }
-         }
-         updateTile(tiles.sums, pool, tile.rows(), update, columnsOf);
-       }},
-      tiles.afterEachTile);
+  runPasses(rows, forces.isLocal(), scratch,
+            {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0),
+             [&](const Tile& tile) {
+               Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
+                        old = rowsOf(prev, tile.rows());
+               const auto update = [row](auto at, float* pos, float* vel, float* last,
+                                         const float* acc) {
+                 return row(at.load(acc), at, pos, vel, last);
+               };
+               updateTile(tiles.sums, pool, tile.rows(), update, [&](int c) {
+                 return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
+                                   static_cast<const float*>(a[c].data()));
+               });
+             }},
+            tiles.afterEachTile);
 }
 
 }  // namespace tickfx

@@ -103,15 +103,13 @@ void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange ro
                           const TickForms& forms, const KernelFor& kernelFor,
                           const ColumnsOf& columnsOf) {
   const Eigen::Index n = rows.count();
-  bool suspect = false;
-  for (int c = 0; c < 3; ++c) {
-    suspect |= withFormAccelerations(forms, c, [&](const auto& accelerations) {
+  updateComponents(check, pool, rows, [&](int c) {
+    return withFormAccelerations(forms, c, [&](const auto& accelerations) {
       const auto kernel = kernelFor(accelerations);
       return std::apply([&](auto*... columns) { return updateRows(check, n, kernel, columns...); },
                         columnsOf(c));
     });
-  }
-  if (suspect) check->scan(pool, rows.begin, rows.end);
+  });
 }
 
 /// The one pass of a scheme over every tile of `rows`: `beforeTile(tile)` first (the rows spawned
@@ -128,15 +126,14 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  const bool byExceptions = check != nullptr && check->steppedRowsFinite() && forms.finite();
-  const TileCheck tileCheck =
-      byExceptions ? checkTilesByExceptions(*check, pool, rows) : TileCheck{check, {}};
+  // Fused tiles whose only other inputs are the forms: by exceptions when those are finite.
+  const TileCheck tiles = tileCheck(check, pool, rows, forms.finite());
   runPasses(rows, true, scratch, {[&](const Tile& tile) {
               beforeTile(tile);
               const RowRange r = tile.rows();
               Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
               std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
-              updateTileUnderForms(tileCheck.sums, pool, r, forms, kernelFor, [&](int c) {
+              updateTileUnderForms(tiles.sums, pool, r, forms, kernelFor, [&](int c) {
                 return std::apply(
                     [&](auto&... e) {
                       return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), e[c].data()...);
@@ -144,7 +141,7 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
                     more);
               });
             }},
-            tileCheck.afterEachTile);
+            tiles.afterEachTile);
 }
 
 /// runOnePass() of a scheme whose row update reads and writes the position, the velocity and

@@ -54,8 +54,8 @@ struct NonfiniteEvent {
 /// passes under local, arithmetic-only forces (ForceModule::arithmeticOnly), test the
 /// floating-point exception flags after each tile instead (steppedRowsFinite()); the advection
 /// schemes call scan() for every tile once their passes are done with it, while the tile is in
-/// cache. scan() sums the tile's six columns (one add per
-/// value), finite unless a value is not (or the sum overflows), and tests each row only then.
+/// cache. scan() sums the tile's six columns (one add per value), finite unless a value is not
+/// (or the sum overflows), and tests each row only then.
 /// Rows found get kFlag in the pool's dead flags. scan() may run on disjoint rows from several
 /// threads; what it flags does not depend on how rows are split.
 class NonfiniteCheck {

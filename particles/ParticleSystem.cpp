@@ -63,6 +63,7 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
       driver_(settings.stepRateHz, settings.maxTicksPerFrame, settings.overrunPolicy,
               settings.frameTiming),
       arena_(std::make_unique<ThreadArena>(settings.threads)) {
+  nonfiniteCheck_.setSteppedRowsFinite(true);  // no rows yet: the first tick's are all spawned
   if (settings.threads < 0) throw std::invalid_argument("threads must be >= 0");
   for (std::size_t i = 0; i < forces_.size() && springs_ == nullptr; ++i) {
     springs_ = dynamic_cast<SpringNetwork*>(&forces_.module(i));
@@ -228,7 +229,6 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
     begin = end;
   }
   NonfiniteCheck* const check = stop ? &nonfiniteCheck_ : nullptr;
-  nonfiniteCheck_.setSteppedRowsFinite(steppedRowsChecked_);
   parallelForTasks(blocks.size(), [&](std::size_t i) {
     const Block& block = blocks[i];
     if (stop && block.begin < startRows) {
@@ -276,7 +276,6 @@ void ParticleSystem::runTick(bool keepVelocities) {
   forces_.beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};
   const bool check = settings_.nonfinite != NonfinitePolicy::Keep;
-  nonfiniteCheck_.setSteppedRowsFinite(steppedRowsChecked_);
   integrator_->step(pool_, forces_, time, check ? &nonfiniteCheck_ : nullptr);
   if (nonfiniteCheck_.found()) takeNonfinite();
   pool_.markAllStepped();
@@ -287,7 +286,8 @@ void ParticleSystem::runTick(bool keepVelocities) {
 void ParticleSystem::endTicks(std::int64_t tick, bool keepVelocities) {
   tick_ = tick;
   // Checked and not stopped, the rows left are finite: a kill removes the rows found below.
-  steppedRowsChecked_ = settings_.nonfinite != NonfinitePolicy::Keep && !nonfiniteStop_;
+  nonfiniteCheck_.setSteppedRowsFinite(settings_.nonfinite != NonfinitePolicy::Keep &&
+                                       !nonfiniteStop_);
   pool_.updateAges(tick_, settings_.stepRateHz);
   if (keepVelocities) {
     pool_.applyRemovalTo(previousVelocity_);

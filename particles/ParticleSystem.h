@@ -146,9 +146,9 @@ class ParticleSystem {
   const ParticlePool& pool() const { return pool_; }
   /// The state to write between ticks (a restored checkpoint, a host's own edits). The next
   /// checked tick then checks every value it writes, as nothing says the state is still finite;
-  /// after it, the one passes check by floating-point exceptions again (NonfiniteCheck).
+  /// after it, the check by floating-point exceptions resumes (NonfiniteCheck).
   ParticlePool& editPool() {
-    steppedRowsChecked_ = false;
+    nonfiniteCheck_.setSteppedRowsFinite(false);
     return pool_;
   }
   const ForceSet& forces() const { return forces_; }
@@ -217,10 +217,9 @@ class ParticleSystem {
   // Under NonfinitePolicy::Stop, the state a fused frame started from, to go back to.
   struct FrameStart;
   std::unique_ptr<FrameStart> frameStart_;
+  // Also holds whether the rows the next tick steps are finite: the ticks so far were checked
+  // and editPool() has not been called since (set by endTicks()).
   NonfiniteCheck nonfiniteCheck_;
-  // Whether every row the next tick steps is finite: the ticks so far were checked and
-  // editPool() has not been called since.
-  bool steppedRowsChecked_ = true;
   std::optional<NonfiniteEvent> nonfiniteStop_;
   std::uint64_t nonfiniteKilled_ = 0;
 };

@@ -249,12 +249,12 @@ TEST_P(NonfiniteEveryScheme, StopsAtTheFirstNonFiniteTickNamingTheRowsOfTheUnche
       << integrator << " stayed finite for 400 ticks: the scene no longer explodes";
 }
 
-// A position that overflows while every velocity stays finite: 3.3e38 m at 4e37 m/s, no force
-// (the one pass) or an empty spring network (the force passes), 6.7e35 m a tick at 60 Hz, past
+// A position that overflows while every velocity stays finite: 3.3e38 m at 4e37 m/s in each
+// layout (Passes), 6.7e35 m a tick at 60 Hz, past
 // the largest float (3.40e38) in the 16th tick (RK4's v + 2·v2 + 2·v3 + v4 = 2.4e38 stays
 // finite); position Verlet's 2·p overflows in the first.
-// From the second tick on the rows start finite, so the check of the one pass, and of explicit
-// Euler's new position in the force passes, is the overflow flag alone.
+// From the second tick on the rows start finite, so the check of the one pass and of the tiles
+// is the overflow flag alone; the split passes sum the new position.
 TEST_P(NonfiniteEveryScheme, APositionThatOverflowsWithAFiniteVelocityStopsItsTick) {
   const auto& [integrator, passes] = GetParam();
   const auto make = [&, passes = passes, integrator = integrator](NonfinitePolicy policy) {
