@@ -4,7 +4,7 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "io/FrameTimes.h"
+#include "app/FrameTimes.h"
 #include "io/effect/EffectBuilder.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
@@ -35,16 +35,16 @@ std::vector<DriveCase> standardDriveCases(Flicks total, const std::vector<int>& 
       {"30 fps", {30, 1}}, {"30000/1001 fps", {30000, 1001}},
       {"60 fps", {60, 1}}, {"144 fps", {144, 1}}};
   for (const auto& [label, rate] : rates)
-    cases.push_back({label, io::fixedRateFrames(rate, total), 1});
+    cases.push_back({label, fixedRateFrames(rate, total), 1});
   for (std::uint64_t seed : {1u, 2u, 3u}) {
-    cases.push_back({"jitter " + std::to_string(seed), io::jitteredFrames(seed, total), 1});
+    cases.push_back({"jitter " + std::to_string(seed), jitteredFrames(seed, total), 1});
   }
   cases.push_back({recorded ? "frame-times file" : "recorded frames",
                    recorded ? *recorded : irregularFrames(total), 1});
   for (int threads : threadCounts) {
     if (threads == 1) continue;
-    cases.push_back({"60 fps", io::fixedRateFrames({60, 1}, total), threads});
-    cases.push_back({"jitter 1", io::jitteredFrames(1, total), threads});
+    cases.push_back({"60 fps", fixedRateFrames({60, 1}, total), threads});
+    cases.push_back({"jitter 1", jitteredFrames(1, total), threads});
   }
   return cases;
 }

@@ -15,8 +15,8 @@
 #include "app/HashLogRun.h"
 #include "app/LoadEffect.h"
 #include "app/ProgressLine.h"
-#include "io/AtomicFile.h"
-#include "io/FrameTimes.h"
+#include "io/util/AtomicFile.h"
+#include "app/FrameTimes.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
@@ -225,7 +225,7 @@ int logCommand(Arguments& args, const std::vector<std::string>& overrides,
     if (seconds) options.seconds = parseNumber(*seconds, "determinism: --seconds", 0.001, 3600.0);
     if (fps) {
       try {
-        options.fps = io::parseFrameRate(*fps);
+        options.fps = parseFrameRate(*fps);
       } catch (const std::invalid_argument& e) {
         throw UsageError(std::string("determinism: --fps: ") + e.what());
       }
@@ -282,7 +282,7 @@ int determinismCommand(Arguments& args) {
   std::optional<std::vector<Flicks>> recorded;
   if (frameTimes) {
     try {
-      recorded = io::readFrameTimes(*frameTimes);
+      recorded = readFrameTimes(*frameTimes);
     } catch (const std::runtime_error& e) {
       std::fprintf(stderr, "%s\n", e.what());
       return kExitUsage;

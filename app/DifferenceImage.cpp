@@ -7,14 +7,14 @@
 #include <limits>
 #include <vector>
 
-#include "io/preview/ColourMap.h"
-#include "io/preview/FrameRenderer.h"
-#include "io/preview/PinholeCamera.h"
-#include "io/preview/SceneGuides.h"
+#include "app/preview/ColourMap.h"
+#include "app/preview/FrameRenderer.h"
+#include "app/preview/PinholeCamera.h"
+#include "app/preview/SceneGuides.h"
 
 namespace tickfx::app {
 
-io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
+preview::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
                                 const std::string& labelA, const std::string& labelB,
                                 std::int64_t tick, int width, int height,
                                 DifferenceSummary* summary) {
@@ -26,7 +26,7 @@ io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
     const auto it = std::lower_bound(b.id.begin(), b.id.end(), a.id[i]);
     if (it != b.id.end() && *it == a.id[i]) {
       const double d =
-          (io::positionOf(a, i) - io::positionOf(b, static_cast<std::size_t>(it - b.id.begin())))
+          (preview::positionOf(a, i) - preview::positionOf(b, static_cast<std::size_t>(it - b.id.begin())))
               .norm();
       distance[i] = std::isnan(d) ? kMissing : d;
       if (std::isfinite(distance[i])) found.largest = std::max(found.largest, d);
@@ -37,32 +37,32 @@ io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
   for (const std::uint64_t id : b.id) {
     if (!std::binary_search(a.id.begin(), a.id.end(), id)) ++found.differing;
   }
-  std::vector<io::Rgb> colours(a.size());
+  std::vector<preview::Rgb> colours(a.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
-    colours[i] = io::viridis(!std::isfinite(distance[i]) ? 1.0
+    colours[i] = preview::viridis(!std::isfinite(distance[i]) ? 1.0
                              : found.largest > 0.0       ? distance[i] / found.largest
                                                          : 0.0);
   }
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
-  io::growBounds(a, lo, hi);
-  io::growBounds(b, lo, hi);
+  preview::growBounds(a, lo, hi);
+  preview::growBounds(b, lo, hi);
   if (!(lo.x() <= hi.x())) lo = hi = Eigen::Vector3d::Zero();
-  const io::PinholeCamera camera =
-      io::PinholeCamera::framing(lo, hi, io::upVector(io::UpAxis::Y), 40.0, width, height, 0.1);
-  io::RenderSettings settings;
-  settings.grid = io::GroundGrid::under(lo, hi, io::UpAxis::Y);
+  const preview::PinholeCamera camera =
+      preview::PinholeCamera::framing(lo, hi, preview::upVector(preview::UpAxis::Y), 40.0, width, height, 0.1);
+  preview::RenderSettings settings;
+  settings.grid = preview::GroundGrid::under(lo, hi, preview::UpAxis::Y);
   if (settings.grid) settings.axisLength = settings.grid->spacing;
   settings.size.diameterPixels = 4.0;
-  io::SplatImage image = io::renderFrame(camera, a, colours, {}, settings);
+  preview::SplatImage image = preview::renderFrame(camera, a, colours, {}, settings);
   const int scale = width >= 640 ? 2 : 1;
   char caption[320];
   std::snprintf(caption, sizeof caption,
                 "tick %" PRId64 "  t = %.4f s  %s against %s  %zu of %zu particles differ", tick,
                 a.timeSeconds, labelA.c_str(), labelB.c_str(), found.differing,
                 std::max(a.size(), b.size()));
-  io::drawCaption(image, caption, scale);
-  io::drawLegend(image, "distance (m)", 0.0, found.largest, scale);
+  preview::drawCaption(image, caption, scale);
+  preview::drawLegend(image, "distance (m)", 0.0, found.largest, scale);
   if (summary != nullptr) *summary = found;
   return image;
 }

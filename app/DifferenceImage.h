@@ -5,7 +5,7 @@
 #include <string>
 
 #include "io/cache/FrameData.h"
-#include "io/preview/SplatImage.h"
+#include "app/preview/SplatImage.h"
 
 namespace tickfx::app {
 
@@ -20,7 +20,7 @@ struct DifferenceSummary {
 /// particle only one run has at the top colour, over a ground grid, the camera framing both
 /// states. The caption names the tick and the runs (`labelA`, `labelB`); the legend gives the
 /// range in metres. Fills `summary` when given.
-io::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
+preview::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
                                 const std::string& labelA, const std::string& labelB,
                                 std::int64_t tick, int width, int height,
                                 DifferenceSummary* summary = nullptr);

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <fstream>
 
-#include "io/FrameTimes.h"
+#include "app/FrameTimes.h"
 #include "io/cache/FrameData.h"
 #include "io/effect/EffectBuilder.h"
 #include "particles/StateHash.h"
@@ -42,7 +42,7 @@ std::string compilerName() {
 // it returns false.
 template <typename OnFrame>
 void driveAsLogged(ParticleSystem& system, const io::HashLogHeader& h, OnFrame onFrame) {
-  io::FrameSchedule schedule = io::FrameSchedule::fixedRate(h.fps, h.length);
+  FrameSchedule schedule = FrameSchedule::fixedRate(h.fps, h.length);
   Flicks elapsed = 0;
   while (const std::optional<Flicks> d = schedule.next()) {
     system.advance(*d);

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "io/cache/HashLog.h"
+#include "io/state/HashLog.h"
 #include "io/effect/EffectSettings.h"
 
 namespace tickfx::app {

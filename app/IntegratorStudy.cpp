@@ -13,7 +13,7 @@
 #include "fields/Gravity.h"
 #include "fields/PeriodicWind.h"
 #include "integrators/Integrator.h"
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "particles/DetMath.h"
 #include "particles/ParticlePool.h"
 

@@ -15,14 +15,14 @@
 #include "app/Commands.h"
 #include "app/PreviewSource.h"
 #include "app/ProgressLine.h"
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/cache/FrameCaches.h"
-#include "io/preview/ColourBy.h"
-#include "io/preview/FfmpegMovie.h"
-#include "io/preview/FrameRenderer.h"
-#include "io/preview/GifFlipbook.h"
-#include "io/preview/PinholeCamera.h"
-#include "io/preview/SceneGuides.h"
+#include "app/preview/ColourBy.h"
+#include "app/preview/FfmpegMovie.h"
+#include "app/preview/FrameRenderer.h"
+#include "app/preview/GifFlipbook.h"
+#include "app/preview/PinholeCamera.h"
+#include "app/preview/SceneGuides.h"
 
 namespace tickfx::app {
 namespace {
@@ -72,7 +72,7 @@ const char* const kPreviewHelp =
     "Each frame has the name, the frame, its time and the particle count in its top-left corner.\n"
     "Exit codes: 0 ok, 2 bad arguments or input (nothing written), 1 failure at run time.\n";
 
-constexpr io::Rgb kBackground{24, 24, 28};
+constexpr preview::Rgb kBackground{24, 24, 28};
 constexpr std::int64_t kSheetCells = 64;
 constexpr double kFramingMargin = 0.1;
 
@@ -84,21 +84,21 @@ struct Size {
 Size parseSize(const std::string& text) {
   const UsageError refused("preview: --size: '" + text +
                            "' is not WxH with whole numbers from 1 to " +
-                           std::to_string(io::SplatImage::kMaxSide));
+                           std::to_string(preview::SplatImage::kMaxSide));
   const std::size_t x = text.find('x');
   if (x == std::string::npos) throw refused;
   try {
     return {
-        static_cast<int>(parseInteger(text.substr(0, x), "--size", 1, io::SplatImage::kMaxSide)),
-        static_cast<int>(parseInteger(text.substr(x + 1), "--size", 1, io::SplatImage::kMaxSide))};
+        static_cast<int>(parseInteger(text.substr(0, x), "--size", 1, preview::SplatImage::kMaxSide)),
+        static_cast<int>(parseInteger(text.substr(x + 1), "--size", 1, preview::SplatImage::kMaxSide))};
   } catch (const UsageError&) {
     throw refused;
   }
 }
 
-io::UpAxis parseUp(const std::string& text) {
-  if (text == "y") return io::UpAxis::Y;
-  if (text == "z") return io::UpAxis::Z;
+preview::UpAxis parseUp(const std::string& text) {
+  if (text == "y") return preview::UpAxis::Y;
+  if (text == "z") return preview::UpAxis::Z;
   throw UsageError("preview: --up: '" + text + "' (expected y or z)");
 }
 
@@ -120,10 +120,10 @@ struct RunExtent {
   double valueHi = -valueLo;
 
   void add(const io::FrameData& frame, const std::vector<double>& values) {
-    io::growBounds(frame, lo, hi);
+    preview::growBounds(frame, lo, hi);
     for (std::size_t i = 0; i < values.size(); ++i) {
       // The range of the particles the camera frames.
-      if (!std::isfinite(values[i]) || !io::positionOf(frame, i).allFinite()) continue;
+      if (!std::isfinite(values[i]) || !preview::positionOf(frame, i).allFinite()) continue;
       valueLo = std::min(valueLo, values[i]);
       valueHi = std::max(valueHi, values[i]);
     }
@@ -164,10 +164,10 @@ struct PreviewOptions {
   std::string colour;
   std::optional<std::string> frames;
   long long every = 1;
-  io::SplatSize splatSize;
+  preview::SplatSize splatSize;
   std::optional<Eigen::Vector3d> eye, target;
   double fov = 40.0;
-  io::UpAxis up = io::UpAxis::Y;
+  preview::UpAxis up = preview::UpAxis::Y;
   bool guides = true;
   bool sheet = false;
   bool gif = false;
@@ -175,9 +175,9 @@ struct PreviewOptions {
   std::size_t keepBytes = std::size_t{1} << 30;
 
   // The camera at --camera looking at `look`; a camera that sees nothing is a usage error.
-  io::PinholeCamera cameraAt(const Eigen::Vector3d& look, int width, int height) const {
+  preview::PinholeCamera cameraAt(const Eigen::Vector3d& look, int width, int height) const {
     try {
-      return io::PinholeCamera(*eye, look, io::upVector(up), fov, width, height);
+      return preview::PinholeCamera(*eye, look, preview::upVector(up), fov, width, height);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("preview: --camera: ") + e.what());
     }
@@ -222,7 +222,7 @@ PreviewOptions readOptions(Arguments& args) {
   if (lookat) o.target = parsePoint("--lookat", lookat);
   if (o.eye && o.target) o.cameraAt(*o.target, o.size.width, o.size.height);
   if (mp4) {
-    o.ffmpeg = io::findFfmpeg();
+    o.ffmpeg = preview::findFfmpeg();
     if (!o.ffmpeg) {
       throw UsageError(
           "preview: --mp4 needs ffmpeg, which is not installed (Debian: apt-get install ffmpeg; "
@@ -244,7 +244,7 @@ class ContactSheet {
     cellHeight_ = std::max(1, size.height / 4);
     columns_ = static_cast<int>(std::min<std::int64_t>(4, cells_));
     const std::int64_t rows = (cells_ + columns_ - 1) / columns_;
-    if (rows * cellHeight_ > io::SplatImage::kMaxSide) {
+    if (rows * cellHeight_ > preview::SplatImage::kMaxSide) {
       throw UsageError("preview: --sheet: " + std::to_string(cells_) +
                        " frames make a sheet too tall (use a smaller --size or a larger --every)");
     }
@@ -254,7 +254,7 @@ class ContactSheet {
   // Whether the index-th rendered frame has a cell.
   bool takes(std::int64_t index) const { return index % stride_ == 0; }
   // Copies `cell` (cellWidth × cellHeight) into the index-th rendered frame's cell.
-  void place(std::int64_t index, const io::SplatImage& cell) {
+  void place(std::int64_t index, const preview::SplatImage& cell) {
     const std::int64_t at = index / stride_;
     const int x0 = static_cast<int>(at % columns_) * cellWidth_;
     const int y0 = static_cast<int>(at / columns_) * cellHeight_;
@@ -262,7 +262,7 @@ class ContactSheet {
       for (int x = 0; x < cellWidth_; ++x) image_->set(x0 + x, y0 + y, cell.at(x, y));
     }
   }
-  const io::SplatImage& image() const { return *image_; }
+  const preview::SplatImage& image() const { return *image_; }
   std::int64_t cells() const { return cells_; }
   int cellWidth() const { return cellWidth_; }
   int cellHeight() const { return cellHeight_; }
@@ -270,7 +270,7 @@ class ContactSheet {
  private:
   std::int64_t stride_ = 1, cells_ = 1;
   int cellWidth_ = 1, cellHeight_ = 1, columns_ = 1;
-  std::optional<io::SplatImage> image_;
+  std::optional<preview::SplatImage> image_;
 };
 
 // The frames the first walk saw that the second renders, kept while they fit in the budget
@@ -304,7 +304,7 @@ class KeptFrames {
 
 // The first walk: the whole run's extent (for a camera that holds still and one colour range),
 // and the frames `wanted` takes, counted and kept where they fit.
-RunExtent scanRun(PreviewSource& source, const io::ColourBy& colour,
+RunExtent scanRun(PreviewSource& source, const preview::ColourBy& colour,
                   const std::function<bool(std::int64_t)>& wanted, std::int64_t& rendered,
                   KeptFrames& kept) {
   RunExtent extent;
@@ -329,7 +329,7 @@ RunExtent scanRun(PreviewSource& source, const io::ColourBy& colour,
 
 // "NAME  frame F  t = T s  N particles  grid G m": what each frame says in its corner.
 std::string captionOf(const PreviewSource& source, const io::FrameData& frame,
-                      const io::RenderSettings& settings) {
+                      const preview::RenderSettings& settings) {
   char time[48] = "";
   if (source.knowsTimes()) std::snprintf(time, sizeof time, "  t = %.3f s", frame.timeSeconds);
   // The grid's spacing: the scale at a glance.
@@ -356,13 +356,13 @@ int previewCommand(Arguments& args) {
     throw UsageError("preview: --set changes an effect file; " + options.input +
                      " is a cache folder");
   }
-  const io::ColourBy colour = [&] {
+  const preview::ColourBy colour = [&] {
     try {
       const io::FrameData sample = source->sample();
-      if (!options.colour.empty()) return io::ColourBy::parse(options.colour, sample);
-      const std::vector<std::string> choices = io::ColourBy::choices(sample);
+      if (!options.colour.empty()) return preview::ColourBy::parse(options.colour, sample);
+      const std::vector<std::string> choices = preview::ColourBy::choices(sample);
       const bool hasCd = std::find(choices.begin(), choices.end(), "Cd") != choices.end();
-      return io::ColourBy::parse(hasCd ? "Cd" : "speed", sample);
+      return preview::ColourBy::parse(hasCd ? "Cd" : "speed", sample);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("preview: --color: ") + e.what());
     }
@@ -398,10 +398,10 @@ int previewCommand(Arguments& args) {
   const Eigen::Vector3d centre = 0.5 * (extent.lo + extent.hi);
   const auto cameraFor = [&](int width, int height) {
     return options.eye ? options.cameraAt(options.target.value_or(centre), width, height)
-                       : io::PinholeCamera::framing(extent.lo, extent.hi, io::upVector(options.up),
+                       : preview::PinholeCamera::framing(extent.lo, extent.hi, preview::upVector(options.up),
                                                     options.fov, width, height, kFramingMargin);
   };
-  std::optional<io::PinholeCamera> camera, cellCamera;
+  std::optional<preview::PinholeCamera> camera, cellCamera;
   std::optional<ContactSheet> sheet;
   try {
     camera.emplace(cameraFor(size.width, size.height));
@@ -414,26 +414,26 @@ int previewCommand(Arguments& args) {
     throw;
   }
 
-  io::RenderSettings settings;
+  preview::RenderSettings settings;
   settings.background = kBackground;
   settings.size = options.splatSize;
   if (options.guides) {
-    settings.grid = io::GroundGrid::under(extent.lo, extent.hi, options.up);
+    settings.grid = preview::GroundGrid::under(extent.lo, extent.hi, options.up);
     if (settings.grid) settings.axisLength = settings.grid->spacing;
   }
   const bool legend = options.guides && !colour.ownColours();
   const int textScale = size.width >= 640 ? 2 : 1;
-  const auto render = [&](const io::PinholeCamera& view, const io::FrameData& frame,
+  const auto render = [&](const preview::PinholeCamera& view, const io::FrameData& frame,
                           const IdPairs& lines) {
-    return io::renderFrame(view, frame, colour.colours(frame, extent.valueLo, extent.valueHi),
+    return preview::renderFrame(view, frame, colour.colours(frame, extent.valueLo, extent.valueHi),
                            lines, settings);
   };
-  std::optional<io::GifFlipbook> gif;
+  std::optional<preview::GifFlipbook> gif;
   if (options.gif) {
-    gif.emplace(size.width, size.height, io::GifFlipbook::delayFor(source->fps()),
+    gif.emplace(size.width, size.height, preview::GifFlipbook::delayFor(source->fps()),
                 settings.background);
   }
-  std::optional<io::FfmpegMovie> movie;
+  std::optional<preview::FfmpegMovie> movie;
   if (options.ffmpeg) {
     movie.emplace(*options.ffmpeg, outDir / "flipbook.mp4", size.width, size.height, source->fps());
   }
@@ -444,9 +444,9 @@ int previewCommand(Arguments& args) {
   std::future<void> encoding;
   const auto renderOne = [&](const io::FrameData& frame, const IdPairs& lines) {
     const std::int64_t f = frame.frame;
-    io::SplatImage image = render(*camera, frame, lines);
-    io::drawCaption(image, captionOf(*source, frame, settings), textScale);
-    if (legend) io::drawLegend(image, colour.title(), extent.valueLo, extent.valueHi, textScale);
+    preview::SplatImage image = render(*camera, frame, lines);
+    preview::drawCaption(image, captionOf(*source, frame, settings), textScale);
+    if (legend) preview::drawLegend(image, colour.title(), extent.valueLo, extent.valueHi, textScale);
     // The previous frame's PNG (and flipbook frame) is encoded on a thread of its own while this
     // one simulates and renders: one frame in flight, so files and flipbook frames keep their
     // order.
@@ -457,8 +457,8 @@ int previewCommand(Arguments& args) {
       if (movie) movie->add(done);
     });
     if (sheet && sheet->takes(written)) {
-      io::SplatImage cell = render(*cellCamera, frame, lines);
-      io::drawCaption(cell, "frame " + std::to_string(f), 1);
+      preview::SplatImage cell = render(*cellCamera, frame, lines);
+      preview::drawCaption(cell, "frame " + std::to_string(f), 1);
       sheet->place(written, cell);
     }
     ++written;
@@ -491,7 +491,7 @@ int previewCommand(Arguments& args) {
   }
   if (gif) {
     std::printf("flipbook: %s (%zu frames, %d/100 s each)\n", (outDir / "flipbook.gif").c_str(),
-                gif->frameCount(), io::GifFlipbook::delayFor(source->fps()));
+                gif->frameCount(), preview::GifFlipbook::delayFor(source->fps()));
   }
   if (movie) std::printf("movie: %s\n", (outDir / "flipbook.mp4").c_str());
   return kExitOk;

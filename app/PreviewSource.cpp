@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "app/LoadEffect.h"
-#include "io/FrameTimes.h"
+#include "app/FrameTimes.h"
 #include "io/cache/CacheFolder.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLoader.h"
@@ -41,9 +41,9 @@ class EffectFrames final : public PreviewSource {
   void walk(std::int64_t last, const std::function<bool(std::int64_t)>& wanted,
             const std::function<void(const io::FrameData&, const IdPairs&)>& visit) override {
     if (!system_) system_ = io::buildOfflineSystem(effect_, std::nullopt);
-    const Flicks length = io::lengthOfFrames(
+    const Flicks length = lengthOfFrames(
         effect_.output.fps, static_cast<std::int64_t>(frames_.size()), "output length");
-    io::FrameSchedule schedule = io::FrameSchedule::fixedRate(effect_.output.fps, length);
+    FrameSchedule schedule = FrameSchedule::fixedRate(effect_.output.fps, length);
     while (const std::optional<Flicks> d = schedule.next()) {
       system_->advance(*d);
       const std::int64_t f = schedule.framesDone();

@@ -14,15 +14,15 @@
 #include "app/Interrupt.h"
 #include "app/LoadEffect.h"
 #include "app/ProgressLine.h"
-#include "io/AtomicFile.h"
-#include "io/FrameTimes.h"
+#include "io/util/AtomicFile.h"
+#include "app/FrameTimes.h"
 #include "io/cache/BackgroundWriter.h"
-#include "io/cache/Checkpoint.h"
+#include "io/state/Checkpoint.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameCaches.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/PlyCache.h"
-#include "io/cache/StateDump.h"
+#include "io/state/StateDump.h"
 #include "io/cache/VdbPointCache.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
@@ -88,7 +88,7 @@ std::vector<io::CacheFormat> parseFormats(const std::string& text) {
 }
 
 struct FramePlan {
-  io::FrameSchedule schedule;
+  FrameSchedule schedule;
   std::string description;
 };
 
@@ -108,13 +108,13 @@ FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::
   if (jitter && frames) throw UsageError("run: --jitter needs a length in --seconds, not --frames");
 
   if (frameTimes) {
-    return {io::FrameSchedule::recorded(io::readFrameTimes(*frameTimes)),
+    return {FrameSchedule::recorded(readFrameTimes(*frameTimes)),
             "frame times from " + *frameTimes};
   }
   FrameRate rate = output.fps;
   if (fps) {
     try {
-      rate = io::parseFrameRate(*fps);
+      rate = parseFrameRate(*fps);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("run: --fps: ") + e.what());
     }
@@ -124,19 +124,19 @@ FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::
     total = flicksFromSeconds(parseNumber(*seconds, "run: --seconds", 0.0, io::kMaxRunSeconds));
   } else if (frames) {
     const long long count = parseInteger(*frames, "run: --frames", 0, io::kMaxRunFrames);
-    total = io::lengthOfFrames(rate, count, "run: --frames");
+    total = lengthOfFrames(rate, count, "run: --frames");
   } else {
-    total = io::lengthOfFrames(output.fps, output.frameCount(), "output length");
+    total = lengthOfFrames(output.fps, output.frameCount(), "output length");
   }
   if (jitter) {
     const auto seed =
         static_cast<std::uint64_t>(parseInteger(*jitter, "run: --jitter", 0, INT64_MAX));
-    return {io::FrameSchedule::jittered(seed, total), "jittered frames (seed " + *jitter + ")"};
+    return {FrameSchedule::jittered(seed, total), "jittered frames (seed " + *jitter + ")"};
   }
   const std::string rateText =
       std::to_string(rate.numerator) +
       (rate.denominator == 1 ? "" : "/" + std::to_string(rate.denominator));
-  return {io::FrameSchedule::fixedRate(rate, total), "at " + rateText + " fps"};
+  return {FrameSchedule::fixedRate(rate, total), "at " + rateText + " fps"};
 }
 
 // A --vdb-* option's value, by the names VdbCacheOptions gives.
@@ -259,7 +259,7 @@ int runCommand(Arguments& args) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitUsage;
   }
-  io::FrameSchedule& schedule = plan->schedule;
+  FrameSchedule& schedule = plan->schedule;
 
   std::int64_t every = 0;
   if (checkpointEvery)

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "app/Commands.h"
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/effect/EffectSettings.h"
 
 namespace {

@@ -42,10 +42,10 @@
 #include <vector>
 
 #include "BenchHarness.h"
-#include "fields/AnalyticField.h"
+#include "fields/vdb/AnalyticField.h"
 #include "fields/ForceSet.h"
-#include "fields/VectorField.h"
-#include "fields/VectorFieldGrids.h"
+#include "fields/vdb/VectorField.h"
+#include "fields/vdb/VectorFieldGrids.h"
 #include "integrators/Integrator.h"
 
 namespace {

@@ -73,7 +73,7 @@
 #include <vector>
 
 #include "BenchHarness.h"
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/cache/BackgroundWriter.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameCaches.h"

@@ -1,6 +1,6 @@
 // Preview render speed (issue 14, item 5): 10⁶ particles to a 1280×720 PNG through the
-// preview's own path: colour each particle by speed (io::ColourBy), render the frame
-// (io::renderFrame: ground grid and axis marks, every particle projected through the camera, the
+// preview's own path: colour each particle by speed (preview::ColourBy), render the frame
+// (preview::renderFrame: ground grid and axis marks, every particle projected through the camera, the
 // splats sorted far to near and drawn in parallel bands of rows), encode the PNG. One and all
 // threads; the median of the repeats.
 //
@@ -20,10 +20,10 @@
 #include <vector>
 
 #include "io/cache/FrameData.h"
-#include "io/preview/ColourBy.h"
-#include "io/preview/FrameRenderer.h"
-#include "io/preview/PinholeCamera.h"
-#include "io/preview/SplatImage.h"
+#include "app/preview/ColourBy.h"
+#include "app/preview/FrameRenderer.h"
+#include "app/preview/PinholeCamera.h"
+#include "app/preview/SplatImage.h"
 
 namespace {
 
@@ -39,16 +39,16 @@ double seconds(Clock::time_point from) {
 }
 
 // One frame, timed by stage; `bytes` gets the PNG's size (and keeps the work from being elided).
-Timing renderOnce(const tickfx::io::FrameData& frame, const tickfx::io::PinholeCamera& camera,
-                  const tickfx::io::RenderSettings& settings, std::size_t& bytes) {
+Timing renderOnce(const tickfx::io::FrameData& frame, const tickfx::preview::PinholeCamera& camera,
+                  const tickfx::preview::RenderSettings& settings, std::size_t& bytes) {
   Timing t;
   auto start = Clock::now();
-  const tickfx::io::ColourBy speed = tickfx::io::ColourBy::parse("speed", frame);
-  const std::vector<tickfx::io::Rgb> colours = speed.colours(frame, 0.0, 1.8);
+  const tickfx::preview::ColourBy speed = tickfx::preview::ColourBy::parse("speed", frame);
+  const std::vector<tickfx::preview::Rgb> colours = speed.colours(frame, 0.0, 1.8);
   t.colour = seconds(start);
   start = Clock::now();
-  const tickfx::io::SplatImage image =
-      tickfx::io::renderFrame(camera, frame, colours, {}, settings);
+  const tickfx::preview::SplatImage image =
+      tickfx::preview::renderFrame(camera, frame, colours, {}, settings);
   t.render = seconds(start);
   start = Clock::now();
   bytes = image.png().size();
@@ -79,10 +79,10 @@ int main(int argc, char** argv) {
     frame.velocity.y[r] = u(random);
     frame.velocity.z[r] = u(random);
   }
-  const auto camera = tickfx::io::PinholeCamera::framing({-3, 0, -1}, {3, 2, 1},
+  const auto camera = tickfx::preview::PinholeCamera::framing({-3, 0, -1}, {3, 2, 1},
                                                          Eigen::Vector3d::UnitY(), 40.0, 1280, 720);
-  tickfx::io::RenderSettings settings;
-  settings.grid = tickfx::io::GroundGrid::under({-3, 0, -1}, {3, 2, 1}, tickfx::io::UpAxis::Y);
+  tickfx::preview::RenderSettings settings;
+  settings.grid = tickfx::preview::GroundGrid::under({-3, 0, -1}, {3, 2, 1}, tickfx::preview::UpAxis::Y);
   settings.axisLength = 1.0;
   const int all = tbb::info::default_concurrency();
   std::vector<std::pair<int, Timing>> results;

@@ -33,14 +33,14 @@ set(TICKFX_CORE_PUBLIC_HEADERS
 # COMPONENTS vdb (tickfx::vdb): vector fields from OpenVDB grids (their headers include none of
 # OpenVDB's).
 set(TICKFX_VDB_PUBLIC_HEADERS
-  fields/AnalyticField.h
-  fields/VectorField.h
+  fields/vdb/AnalyticField.h
+  fields/vdb/VectorField.h
 )
 
 # COMPONENTS effects (tickfx::effects): effect files, loadEffect(), caches.
 set(TICKFX_EFFECTS_PUBLIC_HEADERS
-  io/AtomicFile.h
-  io/Fingerprint.h
+  io/util/AtomicFile.h
+  io/util/Fingerprint.h
   io/cache/BackgroundWriter.h
   io/cache/CacheFormat.h
   io/cache/CsvCache.h

@@ -14,8 +14,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "fields/VdbGridFile.h"
-#include "fields/VectorFieldGrids.h"
+#include "fields/vdb/VdbGridFile.h"
+#include "fields/vdb/VectorFieldGrids.h"
 
 namespace tickfx::vdb_test {
 namespace {

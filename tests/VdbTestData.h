@@ -22,8 +22,8 @@
 #include <utility>
 #include <vector>
 
-#include "fields/AnalyticField.h"
-#include "fields/VectorField.h"
+#include "fields/vdb/AnalyticField.h"
+#include "fields/vdb/VectorField.h"
 
 namespace tickfx::vdb_test {
 
@@ -155,7 +155,7 @@ struct GridProbe {
   std::vector<bool> active;   // whether each voxel asked for is on
 };
 
-/// Reads grid `grid` of `path` with readVdbGrid (fields/VdbGridFile.h: the code under test, in
+/// Reads grid `grid` of `path` with readVdbGrid (fields/vdb/VdbGridFile.h: the code under test, in
 /// tickfx_vdb) and looks up each voxel of `at` in what it returns. Grid types other than
 /// GridType's throw std::runtime_error; readVdbGrid's errors pass through.
 GridProbe probeGridReadByTickfx(const std::filesystem::path& path, const std::string& grid,
@@ -172,7 +172,7 @@ std::unique_ptr<VectorField> oneVoxelFrames(const VectorField::Settings& setting
 
 /// The comparison oracle for advection: openvdb::tools::PointAdvect<Vec3fGrid,
 /// std::vector<Vec3f>, false> (no constraint) advects `points` through bakeGrid(field, bake)
-/// (fields/VectorFieldGrids.h, tickfx's bake, the grid bakeVectorField samples): one
+/// (fields/vdb/VectorFieldGrids.h, tickfx's bake, the grid bakeVectorField samples): one
 /// advect(points, dt, 1) call for each dt of `steps` (seconds), at integration order `order`
 /// (1 to 4), threaded or not (every option set explicitly: the copy constructor and some paths
 /// leave members unset). Returns the points where PointAdvect leaves them, in order.

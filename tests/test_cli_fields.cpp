@@ -14,8 +14,8 @@
 
 #include "CliTestSupport.h"
 #include "VdbTestData.h"
-#include "fields/AnalyticField.h"
-#include "fields/VectorField.h"
+#include "fields/vdb/AnalyticField.h"
+#include "fields/vdb/VectorField.h"
 
 namespace fs = std::filesystem;
 

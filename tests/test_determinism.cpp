@@ -16,7 +16,7 @@
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
-#include "io/FrameTimes.h"
+#include "app/FrameTimes.h"
 #include "io/cache/FrameData.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectParser.h"
@@ -192,7 +192,7 @@ TEST(FirstDivergence, NamesTheFirstTickAndTheRunsThatDiffer) {
 
 TEST(FirstDivergence, ADifferentSeedIsCaughtAtTheFirstTickWithParticles) {
   io::EffectSettings effect = load(fs::path(TICKFX_SOURCE_DIR) / "samples/fountain.toml");
-  const DriveCase drive{"60 fps", io::fixedRateFrames({60, 1}, kFlicksPerSecond / 2), 1};
+  const DriveCase drive{"60 fps", app::fixedRateFrames({60, 1}, kFlicksPerSecond / 2), 1};
   std::vector<DriveTrace> traces{traceDrive(effect, drive)};
   effect.simulation.seed += 1;
   traces.push_back(traceDrive(effect, drive));
@@ -205,22 +205,22 @@ TEST(StateAfterTick, IsTheSameStateWhateverTheFramesAndThreads) {
   const io::EffectSettings effect = load(fs::path(TICKFX_SOURCE_DIR) / "samples/fountain.toml");
   const Flicks half = kFlicksPerSecond / 2;
   const io::FrameData a =
-      stateAfterTick(effect, {"24 fps", io::fixedRateFrames({24, 1}, half), 1}, 37);
-  const io::FrameData b = stateAfterTick(effect, {"jitter 2", io::jitteredFrames(2, half), 2}, 37);
+      stateAfterTick(effect, {"24 fps", app::fixedRateFrames({24, 1}, half), 1}, 37);
+  const io::FrameData b = stateAfterTick(effect, {"jitter 2", app::jitteredFrames(2, half), 2}, 37);
   ASSERT_GT(a.size(), 100u);  // 2000 particles a second for 37/120 s
   EXPECT_EQ(io::frameHash(a), io::frameHash(b));
   EXPECT_DOUBLE_EQ(a.timeSeconds, 37.0 / 120.0);
-  EXPECT_EQ(stateAfterTick(effect, {"24 fps", io::fixedRateFrames({24, 1}, half), 1}, 61).size(),
+  EXPECT_EQ(stateAfterTick(effect, {"24 fps", app::fixedRateFrames({24, 1}, half), 1}, 61).size(),
             0u)
       << "half a second is 60 ticks: there is no tick 61";
 }
 
 TEST(DifferenceImage, ColoursEachParticleByTheDistanceToItsTwin) {
   io::EffectSettings effect = load(fs::path(TICKFX_SOURCE_DIR) / "samples/fountain.toml");
-  const DriveCase drive{"60 fps", io::fixedRateFrames({60, 1}, kFlicksPerSecond / 2), 1};
+  const DriveCase drive{"60 fps", app::fixedRateFrames({60, 1}, kFlicksPerSecond / 2), 1};
   const io::FrameData a = stateAfterTick(effect, drive, 40);
   DifferenceSummary same;
-  const io::SplatImage agreeing = renderDifference(a, a, "'a'", "'b'", 40, 320, 180, &same);
+  const preview::SplatImage agreeing = renderDifference(a, a, "'a'", "'b'", 40, 320, 180, &same);
   EXPECT_EQ(same.differing, 0u);
   EXPECT_EQ(same.largest, 0.0);
   // Another seed: the same ids, elsewhere.
@@ -228,7 +228,7 @@ TEST(DifferenceImage, ColoursEachParticleByTheDistanceToItsTwin) {
   const io::FrameData b = stateAfterTick(effect, drive, 40);
   ASSERT_EQ(b.id, a.id);
   DifferenceSummary parted;
-  const io::SplatImage differing = renderDifference(a, b, "'a'", "'b'", 40, 320, 180, &parted);
+  const preview::SplatImage differing = renderDifference(a, b, "'a'", "'b'", 40, 320, 180, &parted);
   EXPECT_EQ(parted.differing, a.size());
   double largest = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) {

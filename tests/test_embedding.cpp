@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "io/cache/Checkpoint.h"
+#include "io/state/Checkpoint.h"
 #include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"

@@ -26,14 +26,14 @@
 #include <vector>
 
 #include "ObliqueTestSupport.h"
-#include "fields/AnalyticField.h"
+#include "fields/vdb/AnalyticField.h"
 #include "fields/AnchorSpring.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
 #include "fields/SpringNetwork.h"
-#include "fields/VectorField.h"
+#include "fields/vdb/VectorField.h"
 #include "particles/ParallelFor.h"
 
 namespace tickfx::oblique {

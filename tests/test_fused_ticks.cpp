@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
-#include "fields/AnalyticField.h"
+#include "fields/vdb/AnalyticField.h"
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"

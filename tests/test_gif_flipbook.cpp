@@ -22,11 +22,13 @@
 #include <string>
 #include <vector>
 
-#include "io/AtomicFile.h"
-#include "io/preview/GifFlipbook.h"
-#include "io/preview/SplatImage.h"
+#include "io/util/AtomicFile.h"
+#include "app/preview/GifFlipbook.h"
+#include "app/preview/SplatImage.h"
 
-namespace tickfx::io {
+namespace tickfx::preview {
+
+using io::WriteError;
 namespace {
 
 const Rgb kBlack{0, 0, 0}, kWhite{255, 255, 255}, kRed{255, 0, 0}, kGrey64{64, 64, 64},
@@ -410,4 +412,4 @@ TEST_F(GifFlipbookFile, RefusesAFolderThatDoesNotExistAndWritesNothing) {
 }
 
 }  // namespace
-}  // namespace tickfx::io
+}  // namespace tickfx::preview

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "CliTestSupport.h"
-#include "io/cache/Checkpoint.h"
+#include "io/state/Checkpoint.h"
 #include "particles/StateHash.h"
 
 namespace {

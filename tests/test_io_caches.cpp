@@ -13,7 +13,7 @@
 #include <utility>
 
 #include "fields/Gravity.h"
-#include "io/FrameTimes.h"
+#include "app/FrameTimes.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/PlyCache.h"
@@ -197,23 +197,23 @@ TEST_F(Caches, AFailedWriteLeavesTheOldFileAndNoTemporary) {
 TEST(FrameTimes, SchedulesEndExactlyWhereAsked) {
   const Flicks fiveSeconds = 5 * kFlicksPerSecond;
   for (std::uint64_t seed : {1u, 2u, 3u}) {
-    const std::vector<Flicks> frames = jitteredFrames(seed, fiveSeconds);
+    const std::vector<Flicks> frames = app::jitteredFrames(seed, fiveSeconds);
     EXPECT_EQ(std::accumulate(frames.begin(), frames.end(), Flicks{0}), fiveSeconds);
     for (std::size_t i = 0; i + 1 < frames.size(); ++i) {
       EXPECT_GE(frames[i], kFlicksPerSecond / 240);
       EXPECT_LE(frames[i], kFlicksPerSecond / 10);
     }
-    EXPECT_EQ(frames, jitteredFrames(seed, fiveSeconds)) << "a pure function of the seed";
+    EXPECT_EQ(frames, app::jitteredFrames(seed, fiveSeconds)) << "a pure function of the seed";
   }
-  EXPECT_NE(jitteredFrames(1, fiveSeconds), jitteredFrames(2, fiveSeconds));
-  const std::vector<Flicks> ntsc = fixedRateFrames(parseFrameRate("30000/1001"), fiveSeconds);
+  EXPECT_NE(app::jitteredFrames(1, fiveSeconds), app::jitteredFrames(2, fiveSeconds));
+  const std::vector<Flicks> ntsc = app::fixedRateFrames(app::parseFrameRate("30000/1001"), fiveSeconds);
   EXPECT_EQ(ntsc.size(), 150u);  // 149 whole frames of 1001/30000 s and a shorter last one
   EXPECT_EQ(ntsc.front(), 23'543'520);
   EXPECT_EQ(std::accumulate(ntsc.begin(), ntsc.end(), Flicks{0}), fiveSeconds);
-  EXPECT_THROW(parseFrameRate("0"), std::invalid_argument);
-  EXPECT_THROW(parseFrameRate("24/"), std::invalid_argument);
+  EXPECT_THROW(app::parseFrameRate("0"), std::invalid_argument);
+  EXPECT_THROW(app::parseFrameRate("24/"), std::invalid_argument);
   // 705600000 = 2⁹·3²·5⁵·7²: 1/11 s is not a whole number of flicks.
-  EXPECT_THROW(parseFrameRate("11"), std::invalid_argument);
+  EXPECT_THROW(app::parseFrameRate("11"), std::invalid_argument);
 }
 
 }  // namespace

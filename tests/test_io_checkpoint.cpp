@@ -21,7 +21,7 @@
 #include "CoreTestSupport.h"
 #include "LittleEndianBytes.h"
 #include "fields/Gravity.h"
-#include "io/cache/Checkpoint.h"
+#include "io/state/Checkpoint.h"
 #include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 

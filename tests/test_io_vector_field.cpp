@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "fields/AnalyticField.h"
+#include "fields/vdb/AnalyticField.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"

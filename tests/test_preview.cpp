@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "io/preview/ColourMap.h"
-#include "io/preview/PinholeCamera.h"
-#include "io/preview/PixelFont.h"
-#include "io/preview/SplatImage.h"
+#include "app/preview/ColourMap.h"
+#include "app/preview/PinholeCamera.h"
+#include "app/preview/PixelFont.h"
+#include "app/preview/SplatImage.h"
 
-namespace tickfx::io {
+namespace tickfx::preview {
 namespace {
 
 const Rgb kBlack{0, 0, 0}, kRed{255, 0, 0}, kBlue{0, 0, 255};
@@ -248,4 +248,4 @@ TEST(Viridis, RunsFromDarkPurpleToYellow) {
 }
 
 }  // namespace
-}  // namespace tickfx::io
+}  // namespace tickfx::preview

@@ -8,21 +8,23 @@
 #include <string>
 #include <vector>
 
-#include "io/FrameTimes.h"
+#include "app/FrameTimes.h"
 #include "io/cache/CacheFolder.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectParser.h"
-#include "io/preview/ColourBy.h"
-#include "io/preview/ColourMap.h"
-#include "io/preview/FrameRenderer.h"
-#include "io/preview/PinholeCamera.h"
-#include "io/preview/SceneGuides.h"
-#include "io/preview/SplatImage.h"
+#include "app/preview/ColourBy.h"
+#include "app/preview/ColourMap.h"
+#include "app/preview/FrameRenderer.h"
+#include "app/preview/PinholeCamera.h"
+#include "app/preview/SceneGuides.h"
+#include "app/preview/SplatImage.h"
 #include "particles/ParticleSystem.h"
 
-namespace tickfx::io {
+namespace tickfx::preview {
+
+using namespace io;  // the frames and caches a preview reads
 namespace {
 
 namespace fs = std::filesystem;
@@ -198,9 +200,9 @@ TEST(PinholeCamera, FramingASampleKeepsEveryParticleOfEveryFrameInside) {
     ASSERT_TRUE(load.ok()) << sample;
     std::vector<Eigen::Vector3d> points;
     const auto system = buildOfflineSystem(*load.effect, std::nullopt);
-    FrameSchedule schedule = FrameSchedule::fixedRate(
+    app::FrameSchedule schedule = app::FrameSchedule::fixedRate(
         load.effect->output.fps,
-        lengthOfFrames(load.effect->output.fps, load.effect->output.frameCount(), "length"));
+        app::lengthOfFrames(load.effect->output.fps, load.effect->output.frameCount(), "length"));
     while (const auto d = schedule.next()) {
       system->advance(*d);
       const FrameData f = captureFrame(*system, schedule.framesDone(), 0.0);
@@ -275,4 +277,4 @@ TEST_F(CacheFolderTest, RefusesAFolderWithoutFrames) {
 }
 
 }  // namespace
-}  // namespace tickfx::io
+}  // namespace tickfx::preview

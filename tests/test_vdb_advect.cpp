@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "VdbTestData.h"
-#include "fields/AnalyticField.h"
+#include "fields/vdb/AnalyticField.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
-#include "fields/VectorField.h"
+#include "fields/vdb/VectorField.h"
 #include "integrators/Integrator.h"
 #include "particles/ParticlePool.h"
 #include "particles/ParticleSystem.h"

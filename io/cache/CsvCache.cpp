@@ -10,7 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/cache/RowBlocks.h"
 
 namespace tickfx::io {

@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/cache/CacheFormat.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/VdbPointCache.h"

@@ -1,6 +1,6 @@
 #include "io/cache/FrameData.h"
 
-#include "io/Fingerprint.h"
+#include "io/util/Fingerprint.h"
 #include "particles/ParticleSystem.h"
 
 namespace tickfx::io {

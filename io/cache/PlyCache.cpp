@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/cache/RowBlocks.h"
 
 namespace tickfx::io {

@@ -3,7 +3,7 @@
 
 #include <filesystem>
 
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/cache/FrameData.h"
 
 namespace tickfx::io {

@@ -26,9 +26,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "fields/VdbGridFile.h"
-#include "io/AtomicFile.h"
-#include "io/Fingerprint.h"
+#include "fields/vdb/VdbGridFile.h"
+#include "io/util/AtomicFile.h"
+#include "io/util/Fingerprint.h"
 
 namespace tickfx::io {
 namespace {

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "io/AtomicFile.h"
+#include "io/util/AtomicFile.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/VdbCacheOptions.h"
 

@@ -16,7 +16,7 @@
 #include <toml++/toml.h>
 
 #include "integrators/Integrator.h"
-#include "io/Fingerprint.h"
+#include "io/util/Fingerprint.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/VdbPointCache.h"
 #include "io/effect/EditDistance.h"

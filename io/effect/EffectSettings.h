@@ -10,7 +10,7 @@
 #include <variant>
 #include <vector>
 
-#include "fields/VectorField.h"
+#include "fields/vdb/VectorField.h"
 #include "io/cache/CacheFormat.h"
 #include "io/cache/VdbCacheOptions.h"
 #include "io/effect/SourceMap.h"
@@ -51,7 +51,7 @@ struct AnchorSpringSettings {
   double damping = 0.0;                            // N·s/m
 };
 
-/// The `bake` table of a vector field: an analytic field (fields/AnalyticField.h) baked into
+/// The `bake` table of a vector field: an analytic field (fields/vdb/AnalyticField.h) baked into
 /// grids in memory when the effect is built, so that an effect needs no .vdb file. Only the
 /// parameters of `kind` are used; the others keep their defaults.
 struct FieldBakeSettings {
@@ -86,7 +86,7 @@ std::string_view fieldKindName(FieldBakeSettings::Kind kind);
 /// Every bake kind, in the order of FieldBakeSettings::Kind.
 const std::vector<std::string>& fieldKindNames();
 
-/// `type = "vector_field"`: a Vec3 grid sampled in world space (fields/VectorField.h), from a
+/// `type = "vector_field"`: a Vec3 grid sampled in world space (fields/vdb/VectorField.h), from a
 /// .vdb file (or a {frame} sequence of them) or baked in memory from `bake`. Exactly one of
 /// `file` and `bake` is set.
 struct VectorFieldSettings {

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "fields/AnalyticField.h"
-#include "fields/VectorField.h"
+#include "fields/vdb/AnalyticField.h"
+#include "fields/vdb/VectorField.h"
 #include "io/effect/EffectSettings.h"
 
 namespace tickfx::io {

@@ -19,8 +19,8 @@
 
 #include "../LittleEndianBytes.h"
 #include "FuzzScratch.h"
-#include "io/Fingerprint.h"
-#include "io/cache/Checkpoint.h"
+#include "io/util/Fingerprint.h"
+#include "io/state/Checkpoint.h"
 #include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 

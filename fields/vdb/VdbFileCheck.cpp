@@ -1,0 +1,850 @@
+#include "fields/vdb/VdbFileCheck.h"
+
+#include <blosc.h>
+#include <openvdb/io/GridDescriptor.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/points/AttributeArray.h>
+#include <openvdb/points/AttributeSet.h>
+#include <openvdb/points/PointDataGrid.h>
+#include <openvdb/points/StreamCompression.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace tickfx {
+namespace {
+
+using Kind = VdbFileError::Kind;
+
+// File formats (OPENVDB_FILE_VERSION_*): per-grid compression and mask-compressed node values
+// from 222, multi-pass PointDataGrids from 224, which OpenVDB 10 writes.
+constexpr std::uint32_t kOldestFormat = 222;
+constexpr std::uint32_t kPointsFormat = 224;
+constexpr std::uint32_t kNewestFormat = 224;
+// Compression flags of a grid (io::COMPRESS_*).
+constexpr std::uint32_t kZip = 0x1, kActiveMask = 0x2, kBlosc = 0x4;
+// A PointDataGrid leaf's voxel values: 512 uint32 offsets.
+constexpr std::uint64_t kLeafOffsetBytes = 512 * 4;
+constexpr std::size_t kLeafMaskBytes = 64;
+
+[[noreturn]] void unreadable(const std::string& what) {
+  throw VdbFileError(Kind::Unreadable, what);
+}
+
+/// Reads little-endian values (x86-64, as OpenVDB writes them) from [pos, end) of the file. A read
+/// past `end` is "the file is truncated" in the file's header and descriptors, and corruption in a
+/// grid (its descriptor says where it ends, so a size read inside it that runs further is wrong).
+class Cursor {
+ public:
+  Cursor(const std::string& file, std::size_t pos, std::size_t end, bool inGrid)
+      : file_(file), pos_(pos), end_(end), inGrid_(inGrid) {}
+
+  std::size_t pos() const { return pos_; }
+  std::uint64_t left() const { return end_ - pos_; }
+
+  [[noreturn]] void corrupt(std::size_t at, const std::string& what) const {
+    unreadable("the file is corrupt at byte " + std::to_string(at) + ": " + what);
+  }
+  const char* take(std::uint64_t n) {
+    if (n > left()) {
+      if (!inGrid_) unreadable("the file is truncated");
+      corrupt(pos_, "a size that runs past the grid's end at byte " + std::to_string(end_));
+    }
+    const char* p = file_.data() + pos_;
+    pos_ += static_cast<std::size_t>(n);
+    return p;
+  }
+  template <class T>
+  T get() {
+    T v;
+    std::memcpy(&v, take(sizeof v), sizeof v);
+    return v;
+  }
+  /// io::readString: a uint32 length and the bytes.
+  std::string string() {
+    const auto n = get<std::uint32_t>();
+    return std::string(take(n), n);
+  }
+
+ private:
+  const std::string& file_;
+  std::size_t pos_;
+  std::size_t end_;
+  bool inGrid_;
+};
+
+std::uint64_t bitsOn(const char* mask, std::size_t bytes) {
+  std::uint64_t n = 0;
+  for (std::size_t i = 0; i < bytes; ++i) n += std::popcount(static_cast<unsigned char>(mask[i]));
+  return n;
+}
+
+bool bitOn(const char* mask, std::size_t i) {
+  return (static_cast<unsigned char>(mask[i / 8]) >> (i % 8)) & 1u;
+}
+
+/// A blosc block OpenVDB decompresses with blosc_decompress_ctx, which takes the block's length
+/// from its own header: safe only when blosc validates that header against the block's real length
+/// (`bytes`). Then the block must decompress to `expected` bytes, or (`padded`) to the 128 bytes
+/// OpenVDB pads smaller point arrays to.
+///
+/// The block is decompressed here once, as OpenVDB will: a header can be sound over a damaged body,
+/// and OpenVDB throwing from the middle of a paged attribute read leaks the page handles its
+/// AttributeArray keeps in a union (no destructor runs for them).
+void checkBlosc(const Cursor& in, std::size_t at, const char* block, std::uint64_t bytes,
+                std::uint64_t expected, bool padded) {
+  std::size_t nbytes = 0;
+  if (bytes < BLOSC_MIN_HEADER_LENGTH || blosc_cbuffer_validate(block, bytes, &nbytes) != 0) {
+    in.corrupt(at, "a blosc block of " + std::to_string(bytes) + " bytes that blosc refuses");
+  }
+  const auto pad = static_cast<std::uint64_t>(openvdb::compression::BLOSC_PAD_BYTES);
+  if (nbytes != expected && !(padded && expected <= pad && nbytes == pad)) {
+    in.corrupt(at, "a blosc block holding " + std::to_string(nbytes) + " bytes where " +
+                       std::to_string(expected) + " are expected");
+  }
+  // nbytes is now bounded by the structure the file declares, which the cursor has checked.
+  std::vector<char> out(nbytes);
+  const int got = blosc_decompress_ctx(block, out.data(), out.size(), /*numinternalthreads=*/1);
+  if (got < 0 || static_cast<std::size_t>(got) != nbytes) {
+    in.corrupt(at, "a blosc block of " + std::to_string(bytes) + " bytes that does not decompress");
+  }
+}
+
+/// What a grid's metadata says about how its values are stored.
+struct MetadataFound {
+  bool halfFloat = false;  // is_saved_as_half_float: real values are stored as half floats
+};
+
+/// io::DelayedLoadMetadata::readValue (the "file_delayed_load" OpenVDB 6.2 and later write).
+void checkDelayedLoad(Cursor& in, std::uint32_t numBytes, std::uint64_t leafBound) {
+  // io::DelayedLoadMetadata::readValue: nothing for 0 bytes; a leaf count; per-leaf mask bytes and
+  // compressed sizes, each raw or a blosc block; unknown bytes up to numBytes skipped.
+  if (numBytes == 0) return;
+  const std::size_t start = in.pos();
+  const auto count = in.get<std::uint32_t>();
+  if (count > leafBound) {
+    in.corrupt(start, "delayed-load metadata for " + std::to_string(count) +
+                          " leaves, more than the grid can hold");
+  }
+  for (const std::uint64_t itemSize : {std::uint64_t{1}, std::uint64_t{8}}) {
+    const std::size_t at = in.pos();
+    const auto bytes = in.get<std::uint32_t>();
+    if (itemSize == 8 && bytes == std::numeric_limits<std::uint32_t>::max()) break;  // no sizes
+    if (bytes > 0) {
+      const char* block = in.take(bytes);
+      checkBlosc(in, at + 4, block, bytes, count * itemSize, /*padded=*/true);
+    } else {
+      in.take(count * itemSize);
+    }
+  }
+  const std::uint64_t total = in.pos() - start;
+  if (total > numBytes) {
+    in.corrupt(start, "delayed-load metadata of " + std::to_string(total) + " bytes where " +
+                          std::to_string(numBytes) + " are declared");
+  }
+  in.take(numBytes - total);
+}
+
+/// MetaMap::readMeta: a count, then per entry a name, a type name, a byte count and the value.
+/// Registered types are read as OpenVDB reads them (a fixed size whatever the count says, so the
+/// count must be that size; strings and io::DelayedLoadMetadata by their own layout); unknown types
+/// as raw bytes. `leafBound` bounds the leaf count a DelayedLoadMetadata may claim.
+MetadataFound checkMetadata(Cursor& in, std::uint64_t leafBound) {
+  MetadataFound found;
+  const auto count = in.get<std::uint32_t>();
+  std::set<std::string> names;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const std::size_t at = in.pos();
+    const std::string name = in.string();
+    const std::string type = in.string();
+    const auto size = in.get<std::uint32_t>();
+    if (name.empty() || !names.insert(name).second) {
+      in.corrupt(at, "metadata named \"" + name + "\" (expected unique, non-empty names)");
+    }
+    if (type == openvdb::io::DelayedLoadMetadata::staticTypeName()) {
+      checkDelayedLoad(in, size, leafBound);
+      continue;
+    }
+    if (type == openvdb::StringMetadata::staticTypeName() ||
+        !openvdb::Metadata::isRegisteredType(type)) {
+      in.take(size);  // a string's bytes, or an unknown type's raw bytes
+      continue;
+    }
+    const openvdb::Index32 expected = openvdb::Metadata::createMetadata(type)->size();
+    if (size != expected) {
+      in.corrupt(at, "metadata \"" + name + "\" of type " + type + " in " + std::to_string(size) +
+                         " bytes (expected " + std::to_string(expected) + ")");
+    }
+    const char* value = in.take(size);
+    const bool isBool = type == openvdb::BoolMetadata::staticTypeName();
+    if (isBool && static_cast<unsigned char>(value[0]) > 1) {
+      in.corrupt(at, "metadata \"" + name + "\" is a bool that is neither 0 nor 1");
+    }
+    if (name == openvdb::GridBase::META_SAVE_HALF_FLOAT) {
+      if (!isBool) in.corrupt(at, "metadata \"" + name + "\" of type " + type + " (expected bool)");
+      found.halfFloat = value[0] != 0;
+    }
+  }
+  return found;
+}
+
+/// math::Transform::read: a map type and its values (every one a finite double).
+void checkTransform(Cursor& in) {
+  static const std::map<std::string, std::size_t> kLinearMapDoubles = {
+      {openvdb::math::AffineMap::mapType(), 16},
+      {openvdb::math::UnitaryMap::mapType(), 16},
+      {openvdb::math::ScaleMap::mapType(), 15},
+      {openvdb::math::UniformScaleMap::mapType(), 15},
+      {openvdb::math::TranslationMap::mapType(), 3},
+      {openvdb::math::ScaleTranslateMap::mapType(), 18},
+      {openvdb::math::UniformScaleTranslateMap::mapType(), 18},
+  };
+  auto doubles = [&](std::size_t n, std::size_t at) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::isfinite(in.get<double>())) in.corrupt(at, "a transform that is not finite");
+    }
+  };
+  const std::size_t at = in.pos();
+  const std::string type = in.string();
+  if (type == openvdb::math::NonlinearFrustumMap::mapType()) {
+    doubles(6 + 2, at);  // its box, taper and depth, then its linear part, written as an AffineMap
+    const std::size_t second = in.pos();
+    if (in.string() != openvdb::math::AffineMap::mapType()) {
+      in.corrupt(second, "a frustum transform whose linear part is not an AffineMap");
+    }
+    doubles(16, at);
+    return;
+  }
+  const auto it = kLinearMapDoubles.find(type);
+  if (it == kLinearMapDoubles.end()) in.corrupt(at, "a transform of unknown type \"" + type + "\"");
+  doubles(it->second, at);
+}
+
+/// What a grid's values are: their size in bytes, and the size of the half floats OpenVDB stores
+/// real values as in a grid saved as half (io::RealToHalf).
+struct ValueLayout {
+  std::size_t size;
+  std::size_t halfSize;
+};
+
+/// Checks one grid from its start (the compression flags) to its end: metadata, transform, tree
+/// topology (RootNode, InternalNode 5 and 4, LeafNode 3) and buffers, regular or PointDataGrid.
+class GridCheck {
+ public:
+  GridCheck(Cursor& in, ValueLayout value, bool points, std::uint64_t gridBytes)
+      : in_(in), value_(value), points_(points), gridBytes_(gridBytes) {}
+
+  /// Checks up to the buffers and returns where they begin.
+  std::size_t topology() {
+    const std::size_t at = in_.pos();
+    compression_ = in_.get<std::uint32_t>();  // Archive::readGridCompression
+    if (compression_ & ~(kZip | kActiveMask | kBlosc)) {
+      in_.corrupt(at, "unknown compression flags " + std::to_string(compression_));
+    }
+    half_ = checkMetadata(in_, gridBytes_ / kLeafMaskBytes).halfFloat && value_.halfSize != 0;
+    checkTransform(in_);
+    root();
+    return in_.pos();
+  }
+
+  void buffers() {
+    if (points_) {
+      pointBuffers();
+      return;
+    }
+    for (const std::array<char, kLeafMaskBytes>& mask : leafMasks_) {
+      leafMask(mask);
+      values(512, mask.data(), kLeafMaskBytes);
+    }
+  }
+
+ private:
+  // ---- topology ------------------------------------------------------------------------------
+
+  void root() {
+    const std::size_t at = in_.pos();
+    if (in_.get<std::int32_t>() != 1) in_.corrupt(at, "a tree with other than one buffer");
+    in_.take(value_.size);  // the background value
+    const auto tiles = in_.get<std::uint32_t>();
+    const auto children = in_.get<std::uint32_t>();
+    // The root's table is a std::map: OpenVDB writes tiles, then children, each in the map's
+    // order, and reads buffers in that order. Keys in order, unique and node-aligned keep the
+    // file's order the reading order and every lookup finding its node.
+    std::vector<openvdb::Coord> tileKeys;
+    for (std::uint32_t i = 0; i < tiles; ++i) {
+      const openvdb::Coord key = rootKey(tileKeys);
+      in_.take(value_.size);
+      const std::size_t active = in_.pos();
+      if (in_.get<std::uint8_t>() > 1) in_.corrupt(active, "a tile that is neither on nor off");
+      tileKeys.push_back(key);
+    }
+    std::vector<openvdb::Coord> childKeys;
+    for (std::uint32_t i = 0; i < children; ++i) {
+      const std::size_t keyAt = in_.pos();
+      const openvdb::Coord key = rootKey(childKeys);
+      if (std::binary_search(tileKeys.begin(), tileKeys.end(), key)) {
+        in_.corrupt(keyAt, "a child of the root where it has a tile");
+      }
+      childKeys.push_back(key);
+      internal(5);
+    }
+  }
+
+  openvdb::Coord rootKey(const std::vector<openvdb::Coord>& before) {
+    const std::size_t at = in_.pos();
+    openvdb::Coord key;
+    for (int c = 0; c < 3; ++c) key[c] = in_.get<std::int32_t>();
+    constexpr std::int32_t kAlign = (1 << 12) - 1;  // a root child spans 2^(5+4+3) voxels
+    if ((key[0] & kAlign) || (key[1] & kAlign) || (key[2] & kAlign) ||
+        (!before.empty() && !(before.back() < key))) {
+      in_.corrupt(at, "a root node entry out of order or not aligned to its node");
+    }
+    return key;
+  }
+
+  void internal(int log2) {
+    const std::size_t bytes = (std::size_t{1} << (3 * log2)) / 8;
+    const std::size_t at = in_.pos();
+    const char* childMask = in_.take(bytes);
+    const char* valueMask = in_.take(bytes);
+    for (std::size_t i = 0; i < bytes; ++i) {
+      if (childMask[i] & valueMask[i]) in_.corrupt(at, "a node value that is both child and tile");
+    }
+    values(std::uint64_t{1} << (3 * log2), valueMask, bytes);
+    for (std::size_t i = 0; i < bytes * 8; ++i) {
+      if (!bitOn(childMask, i)) continue;
+      if (log2 == 5) {
+        internal(4);
+      } else {
+        std::array<char, kLeafMaskBytes> mask;
+        std::memcpy(mask.data(), in_.take(kLeafMaskBytes), kLeafMaskBytes);
+        leafMasks_.push_back(mask);
+      }
+    }
+  }
+
+  // ---- values (io::readCompressedValues, io::readData) ------------------------------------------
+
+  void values(std::uint64_t count, const char* valueMask, std::size_t maskBytes) {
+    const std::size_t at = in_.pos();
+    const auto layout = in_.get<std::int8_t>();
+    if (layout < 0 || layout > 6) in_.corrupt(at, "unknown node value compression");
+    if (layout == 2 || layout == 4 || layout == 5) in_.take(value_.size);  // an inactive value
+    if (layout == 5) in_.take(value_.size);                                // a second one
+    if (layout >= 3 && layout <= 5) in_.take(maskBytes);                   // which is which
+    // With mask compression, only the active values are stored.
+    const std::uint64_t stored =
+        (compression_ & kActiveMask) && layout != 6 ? bitsOn(valueMask, maskBytes) : count;
+    if (half_ && stored == 0) return;  // io::HalfReader reads nothing then
+    data(stored * (half_ ? value_.halfSize : value_.size));
+  }
+
+  void data(std::uint64_t bytes) {
+    if (!(compression_ & (kBlosc | kZip))) {
+      in_.take(bytes);
+      return;
+    }
+    const std::size_t at = in_.pos();
+    const auto n = in_.get<std::int64_t>();
+    if (n <= 0) {
+      // Stored raw: OpenVDB reads -n bytes into its buffer of `bytes` before comparing the two.
+      if (n == std::numeric_limits<std::int64_t>::min() ||
+          static_cast<std::uint64_t>(-n) != bytes) {
+        in_.corrupt(at, "a block of " + std::to_string(n) + " bytes where " +
+                            std::to_string(bytes) + " are expected");
+      }
+      in_.take(bytes);
+      return;
+    }
+    const char* block = in_.take(static_cast<std::uint64_t>(n));
+    // zlib is given the block's length and the buffer's size, and OpenVDB compares what it gets:
+    // a zip block needs no more. Blosc trusts the block's header.
+    if (compression_ & kBlosc) {
+      checkBlosc(in_, at + 8, block, static_cast<std::uint64_t>(n), bytes, /*padded=*/false);
+    }
+  }
+
+  void leafMask(const std::array<char, kLeafMaskBytes>& topology) {
+    // LeafNode::readBuffers reads the value mask again from a stream; OpenVDB writes it twice the
+    // same, and values() counts the one in the topology.
+    const std::size_t at = in_.pos();
+    if (std::memcmp(in_.take(kLeafMaskBytes), topology.data(), kLeafMaskBytes) != 0) {
+      in_.corrupt(at, "a leaf's value mask unlike the one in the tree's topology");
+    }
+  }
+
+  // ---- PointDataGrid buffers (points::PointDataLeafNode::readBuffers) ---------------------------
+
+  /// An attribute array as TypedAttributeArray::readMetadata leaves it.
+  struct Array {
+    bool uniform = false;
+    bool paged = false;
+    std::uint64_t stored = 0;    // its bytes in the file (compressed or not)
+    std::uint64_t expected = 0;  // the bytes of its data: (uniform ? 1 : dataSize()) * storage size
+    std::size_t page = 0;        // paged: its page in its attribute's stream
+  };
+  struct Page {
+    std::int32_t compressed;  // > 0: a blosc block of that many bytes; < 0: raw, -that many
+    std::int32_t uncompressed;
+    bool loaded = false;
+  };
+  /// compression::PagedInputStream: the pages of one attribute index across the leaves.
+  struct PagedStream {
+    std::int64_t byteIndex = 0;
+    std::int64_t uncompressed = 0;
+    std::vector<Page> pages;
+  };
+  struct PointLeaf {
+    std::shared_ptr<const std::vector<std::size_t>> storage;  // per attribute, from the descriptor
+    std::vector<Array> arrays;
+  };
+
+  void pointBuffers() {
+    // Grid::readBuffers: a pass count, then every leaf once per pass.
+    const std::size_t at = in_.pos();
+    const auto passes = in_.get<std::uint16_t>();
+    // OpenVDB writes 2n + 4 passes for leaves of at most n attributes, and none for no leaves.
+    if (passes == 0 ? !leafMasks_.empty() : passes < 4 || passes % 2 != 0) {
+      in_.corrupt(at, std::to_string(passes) + " passes over " + std::to_string(leafMasks_.size()) +
+                          " leaves");
+    }
+    const std::uint32_t attributes = passes == 0 ? 0 : (passes - 4u) / 2u;
+    std::vector<PointLeaf> leaves(leafMasks_.size());
+    std::map<std::uint32_t, PagedStream> streams;
+    for (std::uint32_t pass = 0; pass < passes; ++pass) {
+      bool matching = false;  // the shared descriptor (the "hasMatchingDescriptor" aux data)
+      std::shared_ptr<const std::vector<std::size_t>> shared;
+      for (std::size_t l = 0; l < leaves.size(); ++l) {
+        PointLeaf& leaf = leaves[l];
+        const auto count = static_cast<std::uint32_t>(leaf.arrays.size());
+        if (pass == 0) {
+          in_.get<std::uint16_t>();  // the voxel buffer's size, for seeking
+        } else if (pass == 1) {
+          const std::size_t descriptorAt = in_.pos();
+          if (matching) {
+            leaf.storage = shared;
+          } else {
+            const auto header = in_.get<std::uint8_t>();
+            if (header > 3) in_.corrupt(descriptorAt, "unknown point leaf header flags");
+            leaf.storage = descriptor();
+            if (header & 1) {
+              matching = true;
+              shared = leaf.storage;
+            }
+            if (header & 2) in_.take(in_.get<std::uint64_t>());  // bytes for future use
+          }
+          if (leaf.storage->size() > attributes) {
+            in_.corrupt(descriptorAt, "a leaf of " + std::to_string(leaf.storage->size()) +
+                                          " attributes in " + std::to_string(passes) + " passes");
+          }
+          for (const std::size_t storage : *leaf.storage) leaf.arrays.push_back(array(storage));
+        } else if (pass < attributes + 2) {
+          if (pass - 2 < count) sizes(streams[pass - 2], leaf.arrays[pass - 2]);
+        } else if (pass == attributes + 2) {
+          voxels(leafMasks_[l]);
+        } else if (pass < 2 * attributes + 3) {
+          const std::uint32_t a = pass - attributes - 3;
+          if (a < count) contents(streams[a], leaf.arrays[a]);
+          if (pass > attributes + 3) streams.erase(a - 1);
+        } else if (pass < 2 * count + 4) {
+          streams.erase(pass - attributes - 4);
+        }
+      }
+    }
+  }
+
+  /// AttributeSet::Descriptor::read: types (name and codec), the names and positions of the
+  /// attributes, groups, and default-value metadata. Returns each attribute's storage size.
+  std::shared_ptr<const std::vector<std::size_t>> descriptor() {
+    std::size_t at = in_.pos();
+    const auto count = in_.get<std::uint64_t>();
+    if (count > in_.left() / 8) in_.corrupt(at, std::to_string(count) + " attributes");
+    auto storage = std::make_shared<std::vector<std::size_t>>();
+    for (std::uint64_t i = 0; i < count; ++i) {
+      at = in_.pos();
+      openvdb::NamePair type;
+      type.first = in_.string();
+      type.second = in_.string();
+      storage->push_back(storageSize(at, type));
+    }
+    std::vector<bool> seen(count, false);
+    std::set<std::string> names;
+    for (std::uint64_t i = 0; i < count; ++i) {
+      at = in_.pos();
+      const std::string name = in_.string();
+      const auto pos = in_.get<std::uint64_t>();
+      if (!openvdb::points::AttributeSet::Descriptor::validName(name) ||
+          !names.insert(name).second || pos >= count || seen[pos]) {
+        in_.corrupt(at, "attribute \"" + name + "\" at position " + std::to_string(pos) + " of " +
+                            std::to_string(count) +
+                            " (expected unique valid names, one a position)");
+      }
+      seen[pos] = true;
+    }
+    at = in_.pos();
+    const auto groups = in_.get<std::uint64_t>();
+    if (groups > in_.left() / 12) in_.corrupt(at, std::to_string(groups) + " groups");
+    names.clear();
+    for (std::uint64_t i = 0; i < groups; ++i) {
+      at = in_.pos();
+      const std::string name = in_.string();
+      in_.get<std::uint64_t>();  // its bit among the group attributes' bits
+      if (!openvdb::points::AttributeSet::Descriptor::validName(name) ||
+          !names.insert(name).second) {
+        in_.corrupt(at, "group \"" + name + "\" (expected unique valid names)");
+      }
+    }
+    checkMetadata(in_, 0);
+    return storage;
+  }
+
+  std::size_t storageSize(std::size_t at, const openvdb::NamePair& type) {
+    const auto known = storageSizes_.find(type);
+    if (known != storageSizes_.end()) return known->second;
+    if (!openvdb::points::AttributeArray::isRegistered(type)) {
+      in_.corrupt(at, "an attribute of unknown type \"" + type.first + "\" (codec \"" +
+                          type.second + "\")");
+    }
+    const std::size_t size = openvdb::points::AttributeArray::create(type, 1, 1)->storageTypeSize();
+    storageSizes_.emplace(type, size);
+    return size;
+  }
+
+  /// TypedAttributeArray::readMetadata.
+  Array array(std::size_t storage) {
+    const std::size_t at = in_.pos();
+    const auto bytes = in_.get<std::uint64_t>();
+    const auto flags = in_.get<std::uint8_t>();
+    const auto serialization = in_.get<std::uint8_t>();
+    const auto size = in_.get<std::uint32_t>();
+    const std::uint32_t stride =
+        serialization & 0x1 ? in_.get<std::uint32_t>() : 1;  // WRITESTRIDED
+    // Flags OpenVDB writes: transient, hidden, (old) out of core, constant stride, streaming.
+    if (bytes < 6 || flags >= 0x20 || serialization >= 0x10) {
+      in_.corrupt(at, "attribute array metadata OpenVDB cannot have written");
+    }
+    Array a;
+    a.uniform = serialization & 0x2;  // WRITEUNIFORM
+    a.paged = serialization & 0x8;    // WRITEPAGED
+    a.stored = bytes - 6;             // less the flags and the size
+    // dataSize(), which OpenVDB computes in 32 bits: size · stride, or the total size.
+    const std::uint64_t values = flags & 0x8 ? std::uint64_t{size} * stride : stride;
+    if (values > std::numeric_limits<std::uint32_t>::max()) {
+      in_.corrupt(at, "an attribute array of " + std::to_string(values) + " values");
+    }
+    a.expected = (a.uniform ? 1 : values) * storage;
+    // A paged array takes exactly its data's bytes from its page; a uniform one is stored raw.
+    if ((a.paged || a.uniform) && a.stored != a.expected) {
+      in_.corrupt(at, "an attribute array of " + std::to_string(a.stored) + " bytes where " +
+                          std::to_string(a.expected) + " are expected");
+    }
+    // PageHandle::read asserts a size of at least 1 and fits it in an int.
+    if (a.paged && (a.expected == 0 || a.expected > std::numeric_limits<std::int32_t>::max())) {
+      in_.corrupt(at, "a paged attribute array of " + std::to_string(a.expected) + " bytes");
+    }
+    return a;
+  }
+
+  /// The size pass of a paged array (PagedInputStream::createHandle): a new page header when the
+  /// stream's page is used up, then a handle on the array's bytes in that page.
+  void sizes(PagedStream& s, Array& a) {
+    if (!a.paged) return;
+    if (s.byteIndex == s.uncompressed) {
+      const std::size_t at = in_.pos();
+      Page page;
+      page.compressed = in_.get<std::int32_t>();
+      page.uncompressed = page.compressed > 0 ? in_.get<std::int32_t>() : -page.compressed;
+      // Page::readHeader asserts both are non-zero.
+      if (page.compressed == 0 || page.compressed == std::numeric_limits<std::int32_t>::min() ||
+          page.uncompressed <= 0) {
+        in_.corrupt(at, "an attribute page header of " + std::to_string(page.compressed) + " and " +
+                            std::to_string(page.uncompressed) + " bytes");
+      }
+      s.pages.push_back(page);
+      s.uncompressed = page.uncompressed;
+      s.byteIndex = 0;
+    }
+    // The handle must lie in the page (createHandle asserts this before the next handle).
+    if (static_cast<std::int64_t>(a.expected) > s.uncompressed - s.byteIndex) {
+      in_.corrupt(in_.pos(), "an attribute array of " + std::to_string(a.expected) +
+                                 " bytes past the end of its page of " +
+                                 std::to_string(s.uncompressed) + " bytes");
+    }
+    a.page = s.pages.size() - 1;
+    s.byteIndex += static_cast<std::int64_t>(a.expected);
+  }
+
+  /// The buffer pass of an array: PagedInputStream::read then PageHandle::read for a paged one,
+  /// TypedAttributeArray::readBuffers for another.
+  void contents(PagedStream& s, const Array& a) {
+    const std::size_t at = in_.pos();
+    if (!a.paged) {
+      std::uint8_t blosc = 0;
+      if (!a.uniform) blosc = in_.get<std::uint8_t>();
+      if (blosc > 1) in_.corrupt(at, "an attribute array compressed in an unknown way");
+      const char* block = in_.take(a.stored);
+      if (blosc == 1) {
+        checkBlosc(in_, at + 1, block, a.stored, a.expected, /*padded=*/true);
+      } else if (a.stored != a.expected) {
+        in_.corrupt(at, "an attribute array of " + std::to_string(a.stored) + " bytes where " +
+                            std::to_string(a.expected) + " are expected");
+      }
+      return;
+    }
+    if (s.pages.empty() || s.byteIndex > s.uncompressed) {
+      in_.corrupt(at, "attribute pages that do not match their headers");
+    }
+    if (s.byteIndex == s.uncompressed) {
+      // The stream reads the page of this array's handle: it must be the next one not yet read
+      // (reading a page twice asserts).
+      Page& page = s.pages[a.page];
+      if (page.loaded) in_.corrupt(at, "attribute pages that do not match their headers");
+      s.uncompressed = page.uncompressed;
+      if (page.compressed > 0) {
+        const auto bytes = static_cast<std::uint64_t>(page.compressed);
+        const char* block = in_.take(bytes);
+        checkBlosc(in_, at, block, bytes, static_cast<std::uint64_t>(page.uncompressed),
+                   /*padded=*/true);
+      } else {
+        in_.take(static_cast<std::uint64_t>(page.uncompressed));
+      }
+      page.loaded = true;
+      s.byteIndex = 0;
+    }
+    s.byteIndex += static_cast<std::int64_t>(a.expected);
+    // PageHandle::read copies from the page's buffer: a page never read has none.
+    if (!s.pages[a.page].loaded) in_.corrupt(at, "attribute pages that do not match their headers");
+  }
+
+  /// The voxel pass: the value mask again, then the offsets (the readCompressedValues of
+  /// PointDataIndex32: a 16-bit size, 0xFFFF for raw, else a blosc block).
+  void voxels(const std::array<char, kLeafMaskBytes>& mask) {
+    leafMask(mask);
+    const std::size_t at = in_.pos();
+    const auto bytes = in_.get<std::uint16_t>();
+    if (bytes == std::numeric_limits<std::uint16_t>::max()) {
+      in_.take(kLeafOffsetBytes);
+      return;
+    }
+    const char* block = in_.take(bytes);
+    checkBlosc(in_, at + 2, block, bytes, kLeafOffsetBytes, /*padded=*/false);
+  }
+
+  Cursor& in_;
+  ValueLayout value_;
+  bool points_;
+  std::uint64_t gridBytes_;
+  std::uint32_t compression_ = 0;
+  bool half_ = false;
+  std::vector<std::array<char, kLeafMaskBytes>> leafMasks_;  // in reading order
+  std::map<openvdb::NamePair, std::size_t> storageSizes_;
+};
+
+/// The grids GridCheck knows: OpenVDB's numeric and vector trees, and PointDataGrid.
+struct GridKind {
+  ValueLayout value;
+  bool points;
+};
+
+const std::map<std::string, GridKind>& gridKinds() {
+  static const std::map<std::string, GridKind> kinds = {
+      {openvdb::FloatGrid::gridType(), {{4, 2}, false}},
+      {openvdb::DoubleGrid::gridType(), {{8, 2}, false}},
+      {openvdb::Int32Grid::gridType(), {{4, 0}, false}},
+      {openvdb::Int64Grid::gridType(), {{8, 0}, false}},
+      {openvdb::Vec3IGrid::gridType(), {{12, 0}, false}},
+      {openvdb::Vec3SGrid::gridType(), {{12, 6}, false}},
+      {openvdb::Vec3DGrid::gridType(), {{24, 6}, false}},
+      {openvdb::points::PointDataGrid::gridType(), {{4, 0}, true}},
+  };
+  return kinds;
+}
+
+/// One GridDescriptor (GridDescriptor::read): names, type, and where the grid lies.
+struct Descriptor {
+  std::string uniqueName;
+  std::string type;  // as in the file, "_HalfFloat" included
+  std::string parent;
+  std::int64_t gridPos = 0, blockPos = 0, endPos = 0;
+  std::string gridName() const { return openvdb::io::GridDescriptor::stripSuffix(uniqueName); }
+};
+
+/// Checks the grid described by `d`, beginning at `begin` and ending by `end`; returns where its
+/// buffers begin and where it ends.
+std::pair<std::size_t, std::size_t> checkGrid(const std::string& file, std::uint32_t format,
+                                              const Descriptor& d, std::size_t begin,
+                                              std::size_t end) {
+  std::string type = d.type;
+  const std::string half = "_HalfFloat";  // GridDescriptor::HALF_FLOAT_TYPENAME_SUFFIX
+  if (type.size() >= half.size() && type.compare(type.size() - half.size(), half.size(), half) == 0)
+    type.erase(type.size() - half.size());
+  const auto kind = gridKinds().find(type);
+  if (kind == gridKinds().end()) {
+    unreadable("a grid of type " + type + ", which tickfx does not read (it reads vector, number " +
+               "and point data grids)");
+  }
+  if (!d.parent.empty()) {
+    unreadable("an instance of grid '" + openvdb::io::GridDescriptor::nameAsString(d.parent) +
+               "' (sharing its tree), which tickfx does not read");
+  }
+  if (kind->second.points && format < kPointsFormat) {
+    unreadable("point data in OpenVDB file format " + std::to_string(format) + " (expected " +
+               std::to_string(kPointsFormat) + ")");
+  }
+  Cursor in(file, begin, end, /*inGrid=*/true);
+  GridCheck grid(in, kind->second.value, kind->second.points, end - begin);
+  const std::size_t block = grid.topology();
+  grid.buffers();
+  return {block, in.pos()};
+}
+
+}  // namespace
+
+std::string extractCheckedVdbGrid(const std::string& file, const std::string& name) {
+  Cursor in(file, 0, file.size(), /*inGrid=*/false);
+  // ---- header (io::Archive::readHeader) ----
+  if (file.size() < 8 || in.get<std::int64_t>() != openvdb::OPENVDB_MAGIC) {
+    throw VdbFileError(Kind::NotVdb, "not an OpenVDB file");
+  }
+  const auto format = in.get<std::uint32_t>();
+  if (format < kOldestFormat || format > kNewestFormat) {
+    unreadable("OpenVDB file format " + std::to_string(format) + " (expected " +
+               std::to_string(kOldestFormat) + " to " + std::to_string(kNewestFormat) +
+               ", OpenVDB 3.0 to 10)");
+  }
+  const auto libraryMajor = in.get<std::uint32_t>();
+  const auto libraryMinor = in.get<std::uint32_t>();
+  const bool hasOffsets = in.get<char>() != 0;
+  // The UUID, as text that boost::uuids reads whole (it would skip white space).
+  const std::size_t uuidAt = in.pos();
+  const char* uuid = in.take(36);
+  for (std::size_t i = 0; i < 36; ++i) {
+    const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
+    if (dash ? uuid[i] != '-' : !std::isxdigit(static_cast<unsigned char>(uuid[i]))) {
+      in.corrupt(uuidAt, "a file UUID that is not one");
+    }
+  }
+  checkMetadata(in, file.size() / kLeafMaskBytes);
+
+  // ---- grid descriptors (io::File::readGridDescriptors), and with them the grid we want ----
+  const std::size_t countAt = in.pos();
+  const auto count = in.get<std::int32_t>();
+  if (count < 0) in.corrupt(countAt, std::to_string(count) + " grids");
+  std::vector<Descriptor> grids;
+  for (std::int32_t i = 0; i < count; ++i) {
+    const std::size_t at = in.pos();
+    Descriptor d;
+    d.uniqueName = in.string();
+    d.type = in.string();
+    d.parent = in.string();
+    d.gridPos = in.get<std::int64_t>();
+    d.blockPos = in.get<std::int64_t>();
+    d.endPos = in.get<std::int64_t>();
+    if (!hasOffsets) {
+      // A stream (io::Stream writes no offsets): the grid follows, and only reading it tells where
+      // it ends. The grids before the one we want must be of kinds this can read.
+      const auto [block, end] = checkGrid(file, format, d, in.pos(), file.size());
+      d.gridPos = static_cast<std::int64_t>(in.pos());
+      d.blockPos = static_cast<std::int64_t>(block);
+      d.endPos = static_cast<std::int64_t>(end);
+      grids.push_back(d);
+      if (d.gridName() == name) break;
+      in.take(end - in.pos());
+      continue;
+    }
+    const auto size = static_cast<std::int64_t>(file.size());
+    if (d.endPos > size) {
+      unreadable("the file is truncated: a grid ends at byte " + std::to_string(d.endPos) + " of " +
+                 std::to_string(size));
+    }
+    if (d.gridPos != static_cast<std::int64_t>(in.pos()) || d.blockPos < d.gridPos ||
+        d.endPos < d.blockPos) {
+      in.corrupt(at, "grid offsets " + std::to_string(d.gridPos) + ", " +
+                         std::to_string(d.blockPos) + ", " + std::to_string(d.endPos) +
+                         " (expected increasing, from the end of the descriptor)");
+    }
+    grids.push_back(d);
+    in.take(static_cast<std::uint64_t>(d.endPos - d.gridPos));
+  }
+
+  // io::File::findDescriptor: the first grid of that name, or "name[N]" for the N-th of a name.
+  const Descriptor* wanted = nullptr;
+  for (const Descriptor& d : grids) {
+    if (d.gridName() == name) {
+      wanted = &d;
+      break;
+    }
+  }
+  if (wanted == nullptr) {
+    const std::string unique = openvdb::io::GridDescriptor::stringAsUniqueName(name);
+    for (const Descriptor& d : grids) {
+      if (unique != name && (d.uniqueName == unique || d.uniqueName == name)) {
+        wanted = &d;
+        break;
+      }
+    }
+  }
+  if (wanted == nullptr) {
+    // The names as io::File lists them: sorted, as given by name.
+    std::vector<std::string> names;
+    for (const Descriptor& d : grids) names.push_back(d.gridName());
+    std::vector<std::size_t> order(grids.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return names[a] < names[b]; });
+    std::string list;
+    for (const std::size_t i : order) {
+      list += (list.empty() ? "" : ", ") +
+              openvdb::io::GridDescriptor::nameAsString(grids[i].uniqueName);
+    }
+    throw VdbFileError(Kind::NoSuchGrid, list.empty()
+                                             ? "the file holds no grids: empty or truncated"
+                                             : "the file has: " + list);
+  }
+  const auto gridPos = static_cast<std::size_t>(wanted->gridPos);
+  const auto endPos = static_cast<std::size_t>(wanted->endPos);
+  if (hasOffsets) {
+    const auto [block, end] = checkGrid(file, format, *wanted, gridPos, endPos);
+    if (block != static_cast<std::size_t>(wanted->blockPos) || end != endPos) {
+      unreadable("the file is corrupt: the grid's topology ends at byte " + std::to_string(block) +
+                 " and its data at byte " + std::to_string(end) + " where its descriptor says " +
+                 std::to_string(wanted->blockPos) + " and " + std::to_string(endPos));
+    }
+  }
+
+  // ---- the stream OpenVDB reads: a header, no metadata, the one descriptor, the grid ----
+  std::string stream;
+  auto put = [&](const auto& v) { stream.append(reinterpret_cast<const char*>(&v), sizeof v); };
+  auto putString = [&](const std::string& s) {
+    put(static_cast<std::uint32_t>(s.size()));
+    stream += s;
+  };
+  put(static_cast<std::int64_t>(openvdb::OPENVDB_MAGIC));
+  put(format);
+  put(libraryMajor);
+  put(libraryMinor);
+  put(char{0});  // no grid offsets: a stream
+  stream.append(uuid, 36);
+  put(std::uint32_t{0});  // file metadata: none (tickfx reads none)
+  put(std::int32_t{1});   // one grid
+  putString(wanted->uniqueName);
+  putString(wanted->type);
+  putString(wanted->parent);
+  for (int i = 0; i < 3; ++i) put(std::int64_t{0});
+  stream.append(file, gridPos, endPos - gridPos);
+  return stream;
+}
+
+}  // namespace tickfx

@@ -1,0 +1,499 @@
+#include "io/state/Checkpoint.h"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <type_traits>
+#include <vector>
+
+#include "io/util/AtomicFile.h"
+#include "particles/StateHash.h"
+
+namespace tickfx::io {
+namespace {
+
+constexpr std::string_view kCheckpointMagic = "TICKFXCK";
+constexpr std::size_t kHeaderBytes = 32;  // magic, version, flags, length, effect hash
+constexpr std::size_t kTrailerBytes = 8;  // checksum
+constexpr std::size_t kMinimumBytes = kHeaderBytes + kTrailerBytes;
+constexpr std::size_t kVersionOffset = 8;
+constexpr std::size_t kFlagsOffset = 12;
+constexpr std::size_t kLengthOffset = 16;
+constexpr std::size_t kEffectHashOffset = 24;
+
+// The float columns in file order; writer and reader share this list so they cannot disagree.
+// f gets null for the acceleration of a pool that does not keep it: zeros in the file.
+template <typename Pool, typename F>
+void forEachFloatColumn(Pool& pool, F&& f) {
+  for (auto* c :
+       {&pool.position(), &pool.velocity(), &pool.previousPosition(), &pool.acceleration()}) {
+    const bool absent = c == &pool.acceleration() && !pool.keepsAcceleration();
+    for (int k = 0; k < 3; ++k) f(absent ? nullptr : &(*c)[k]);
+  }
+  for (auto* c : {&pool.age(), &pool.lifetime(), &pool.mass(), &pool.inverseMass()}) f(c);
+}
+constexpr int kFloatColumns = 16;
+constexpr int kFirstAccelerationColumn = 9;  // after position, velocity, previous position
+
+std::uint64_t loadU64(const char* p) {
+  std::uint64_t v = 0;
+  for (int i = 7; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(p[i]);
+  return v;
+}
+
+std::uint32_t loadU32(const char* p) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(p[i]);
+  return v;
+}
+
+// Bulk copies of whole columns: a memcpy on little-endian hosts (all the supported ones), byte
+// by byte elsewhere so the file stays the same everywhere.
+template <typename T>
+void appendLittleEndian(std::string& out, const T* values, std::size_t count) {
+  static_assert(sizeof(T) == 4 || sizeof(T) == 8);
+  if constexpr (std::endian::native == std::endian::little) {
+    out.append(reinterpret_cast<const char*>(values), count * sizeof(T));
+  } else {
+    for (std::size_t i = 0; i < count; ++i) {
+      unsigned char bytes[sizeof(T)] = {};
+      std::memcpy(bytes, &values[i], sizeof(T));
+      for (std::size_t b = sizeof(T); b-- > 0;) out.push_back(static_cast<char>(bytes[b]));
+    }
+  }
+}
+
+template <typename T>
+void loadLittleEndian(const char* in, T* values, std::size_t count) {
+  static_assert(sizeof(T) == 4 || sizeof(T) == 8);
+  if constexpr (std::endian::native == std::endian::little) {
+    if (count > 0) std::memcpy(values, in, count * sizeof(T));
+  } else {
+    for (std::size_t i = 0; i < count; ++i) {
+      unsigned char bytes[sizeof(T)] = {};
+      for (std::size_t b = 0; b < sizeof(T); ++b)
+        bytes[sizeof(T) - 1 - b] = static_cast<unsigned char>(in[i * sizeof(T) + b]);
+      std::memcpy(&values[i], bytes, sizeof(T));
+    }
+  }
+}
+
+class Writer {
+ public:
+  void u32(std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  }
+  void u64(std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  }
+  void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
+  void str(std::string_view s) {
+    u32(static_cast<std::uint32_t>(s.size()));
+    bytes_.append(s);
+  }
+  template <typename T>
+  void column(const T* values, std::size_t count) {
+    appendLittleEndian(bytes_, values, count);
+  }
+  void patchU64(std::size_t offset, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) bytes_[offset + i] = static_cast<char>((v >> (8 * i)) & 0xff);
+  }
+  std::string& bytes() { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+// Only ever reached for a file whose checksum matched, i.e. one a writer of this version got
+// wrong or someone crafted: every read is bounds-checked all the same.
+struct Malformed {
+  std::string what;
+};
+
+class CheckpointReader {
+ public:
+  explicit CheckpointReader(std::string_view bytes) : bytes_(bytes) {}
+
+  std::uint32_t u32(const char* what) { return loadU32(take(4, what)); }
+  std::uint64_t u64(const char* what) { return loadU64(take(8, what)); }
+  std::int64_t i64(const char* what) { return static_cast<std::int64_t>(u64(what)); }
+  std::string_view str(const char* what) {
+    const std::uint32_t n = u32(what);
+    return {take(n, what), n};
+  }
+  /// The raw bytes of `count` values of `width` bytes each.
+  const char* column(std::size_t count, std::size_t width, const char* what) {
+    if (count > (bytes_.size() - pos_) / width)
+      throw Malformed{std::string("it ends inside ") + what};
+    return take(count * width, what);
+  }
+  std::size_t remaining() const { return bytes_.size() - pos_; }
+
+ private:
+  const char* take(std::size_t n, const char* what) {
+    if (n > bytes_.size() - pos_) throw Malformed{std::string("it ends inside ") + what};
+    const char* p = bytes_.data() + pos_;
+    pos_ += n;
+    return p;
+  }
+
+  std::string_view bytes_;
+  std::size_t pos_ = 0;
+};
+
+// Everything the file says, parsed and checked but not yet applied; the columns still point
+// into the file's bytes.
+// A spring on file: ids a and b, then rest length, stiffness, damping and break ratio as float
+// bits.
+constexpr std::size_t kSpringBytes = 8 + 8 + 4 * 4;
+
+struct Parsed {
+  std::int64_t stepRateHz = 0;
+  std::string_view integrator;
+  std::uint64_t maxParticles = 0;
+  std::int64_t maxTicksPerFrame = 0;
+  std::uint32_t overrunPolicy = 0;
+  std::int64_t tick = 0;
+  std::int64_t ticksIssued = 0, ticksDropped = 0, ticksDue = 0, remainder = 0;
+  CheckpointInfo info;
+  std::uint64_t size = 0, nextId = 0, droppedSpawns = 0;
+  const char* floats[kFloatColumns] = {};
+  const char* ids = nullptr;
+  const char* births = nullptr;
+  const char* tickStartVelocities = nullptr;  // x, y, z columns, or none
+  std::vector<std::pair<std::string_view, const char*>> attributes;
+  std::vector<Spring> springs;
+  std::uint64_t springsBroken = 0;
+};
+
+Parsed parsePayload(std::string_view payload) {
+  CheckpointReader r(payload);
+  Parsed p;
+  p.stepRateHz = r.i64("the step rate");
+  p.integrator = r.str("the integrator name");
+  p.maxParticles = r.u64("max particles");
+  p.maxTicksPerFrame = r.i64("max ticks per frame");
+  p.overrunPolicy = r.u32("the overrun policy");
+  p.tick = r.i64("the tick count");
+  p.ticksIssued = r.i64("the driver state");
+  p.ticksDropped = r.i64("the driver state");
+  p.ticksDue = r.i64("the driver state");
+  p.remainder = r.i64("the driver state");
+  p.info.frame = r.i64("the frame count");
+  p.info.elapsed = r.i64("the elapsed time");
+  p.size = r.u64("the particle count");
+  p.nextId = r.u64("the next id");
+  p.droppedSpawns = r.u64("the dropped-spawn count");
+  const std::uint32_t attributes = r.u32("the attribute count");
+  for (const char*& column : p.floats) column = r.column(p.size, 4, "the particle columns");
+  p.ids = r.column(p.size, 8, "the id column");
+  p.births = r.column(p.size, 8, "the birth-tick column");
+  const std::uint32_t hasVelocities = r.u32("the tick-start velocities flag");
+  if (hasVelocities > 1) throw Malformed{"a tick-start velocities flag that is not 0 or 1"};
+  if (hasVelocities == 1) {
+    p.tickStartVelocities = r.column(p.size, 12, "the tick-start velocity columns");
+  }
+  for (std::uint32_t a = 0; a < attributes; ++a) {
+    const std::string_view name = r.str("an attribute name");
+    p.attributes.emplace_back(name, r.column(p.size, 4, "an attribute column"));
+  }
+  const std::uint64_t springs = r.u64("the spring count");
+  p.springsBroken = r.u64("the broken-spring count");
+  if (springs > r.remaining() / kSpringBytes) throw Malformed{"it ends inside the springs"};
+  p.springs.resize(static_cast<std::size_t>(springs));
+  for (Spring& spring : p.springs) {
+    spring.a = r.u64("a spring");
+    spring.b = r.u64("a spring");
+    const std::uint32_t fields[4] = {r.u32("a spring"), r.u32("a spring"), r.u32("a spring"),
+                                     r.u32("a spring")};
+    std::memcpy(&spring.restLength, &fields[0], 4);
+    std::memcpy(&spring.stiffness, &fields[1], 4);
+    std::memcpy(&spring.damping, &fields[2], 4);
+    std::memcpy(&spring.breakRatio, &fields[3], 4);
+  }
+  if (r.remaining() != 0) {
+    throw Malformed{std::to_string(r.remaining()) + " bytes follow the last spring"};
+  }
+  if (p.tick < 0) throw Malformed{"negative tick count"};
+  if (p.overrunPolicy > 1)
+    throw Malformed{"unknown overrun policy " + std::to_string(p.overrunPolicy)};
+  return p;
+}
+
+std::string_view policyName(std::uint32_t policy) { return policy == 0 ? "drop" : "fall_behind"; }
+std::uint32_t policyCode(OverrunPolicy policy) {
+  return policy == OverrunPolicy::DropExcess ? 0u : 1u;
+}
+
+std::string nameList(const std::vector<std::string>& names) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < names.size(); ++i) text += (i > 0 ? ", " : "") + names[i];
+  return text + "]";
+}
+
+// The first way `system` differs from the one that wrote `p`, or nothing.
+std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& system) {
+  const ParticlePool& pool = system.pool();
+  auto written = [](std::string_view key, const auto& found, const auto& expected) {
+    auto text = [](const auto& v) {
+      if constexpr (std::is_arithmetic_v<std::decay_t<decltype(v)>>)
+        return std::to_string(v);
+      else
+        return std::string(v);
+    };
+    return "checkpoint was written with simulation." + std::string(key) + " " + text(found) +
+           " (expected " + text(expected) + ")";
+  };
+  if (p.stepRateHz != system.settings().stepRateHz) {
+    return written("step_rate", p.stepRateHz, system.settings().stepRateHz);
+  }
+  if (p.integrator != system.integrator().name()) {
+    return written("integrator", p.integrator, system.integrator().name());
+  }
+  if (p.maxParticles != pool.maxParticles()) {
+    return written("max_particles", p.maxParticles,
+                   static_cast<std::uint64_t>(pool.maxParticles()));
+  }
+  if (p.maxTicksPerFrame != system.driver().maxTicksPerAdvance()) {
+    return written("max_ticks_per_frame", p.maxTicksPerFrame, system.driver().maxTicksPerAdvance());
+  }
+  if (p.overrunPolicy != policyCode(system.driver().policy())) {
+    return written("overrun", policyName(p.overrunPolicy),
+                   policyName(policyCode(system.driver().policy())));
+  }
+  // Both ways round, so that a crafted file naming one attribute twice cannot leave another
+  // unrestored.
+  bool same = p.attributes.size() == pool.attributeCount();
+  for (const auto& [name, values] : p.attributes) {
+    same = same && pool.findAttribute(std::string(name)) != ParticlePool::npos;
+  }
+  for (std::size_t a = 0; same && a < pool.attributeCount(); ++a) {
+    same = std::any_of(p.attributes.begin(), p.attributes.end(),
+                       [&](const auto& stored) { return stored.first == pool.attributeName(a); });
+  }
+  if (!same) {
+    std::vector<std::string> stored, expected;
+    for (const auto& a : p.attributes) stored.emplace_back(a.first);
+    for (std::size_t a = 0; a < pool.attributeCount(); ++a)
+      expected.push_back(pool.attributeName(a));
+    return "checkpoint has particle attributes " + nameList(stored) + " (expected " +
+           nameList(expected) + ")";
+  }
+  if (!p.springs.empty() && system.springs() == nullptr) {
+    return "checkpoint has " + std::to_string(p.springs.size()) +
+           " springs (expected none: this effect has no structures)";
+  }
+  if (!system.driver().canRestore(p.ticksIssued, p.ticksDropped, p.ticksDue, p.remainder)) {
+    return "checkpoint is malformed (a driver state no run reaches: ticks issued " +
+           std::to_string(p.ticksIssued) + ", dropped " + std::to_string(p.ticksDropped) +
+           ", due " + std::to_string(p.ticksDue) + ", remainder " + std::to_string(p.remainder) +
+           " flicks)";
+  }
+  if (p.size > pool.maxParticles()) {
+    return "checkpoint is malformed (" + std::to_string(p.size) +
+           " particles, more than max_particles " + std::to_string(pool.maxParticles()) + ")";
+  }
+  std::vector<std::uint64_t> ids(static_cast<std::size_t>(p.size));
+  std::vector<std::int64_t> births(ids.size());
+  loadLittleEndian(p.ids, ids.data(), ids.size());
+  loadLittleEndian(p.births, births.data(), births.size());
+  if (auto problem = ParticlePool::restoreProblem(ids, births, p.nextId, p.tick)) {
+    return "checkpoint is malformed (" + *problem + ")";
+  }
+  return std::nullopt;
+}
+
+// Nothing in here may throw once the pool has room: the state is replaced whole or not at all.
+void apply(const Parsed& p, ParticleSystem& system) {
+  ParticlePool& pool = system.editPool();
+  const auto n = static_cast<std::size_t>(p.size);
+  // Velocity Verlet's a(t) makes the pool keep an acceleration column (all zeros need none);
+  // like reserve(), an allocation that changes no value of the state.
+  for (int k = 0; k < 3 && !pool.keepsAcceleration(); ++k) {
+    const char* bytes = p.floats[kFirstAccelerationColumn + k];
+    if (std::any_of(bytes, bytes + 4 * n, [](char b) { return b != 0; })) pool.keepAcceleration();
+  }
+  pool.reserve(n);  // the other allocation, changing no state either
+  pool.resizeForRestore(n, p.nextId, p.droppedSpawns);
+  int c = 0;
+  forEachFloatColumn(pool, [&](FloatColumn* column) {
+    if (column != nullptr) loadLittleEndian(p.floats[c], column->data(), n);
+    ++c;
+  });
+  loadLittleEndian(p.ids, pool.id().data(), n);
+  loadLittleEndian(p.births, pool.birthTick().data(), n);
+  for (const auto& [name, values] : p.attributes) {
+    loadLittleEndian(values, pool.attribute(pool.findAttribute(std::string(name))).data(), n);
+  }
+  // Between ticks no particle is flagged; a used target may have stale flags past its old size.
+  std::fill_n(pool.dead().begin(), n, std::uint8_t{0});
+  if (system.springs() != nullptr) system.springs()->restore(p.springs, p.springsBroken);
+  system.driver().restore(p.ticksIssued, p.ticksDropped, p.ticksDue, p.remainder);
+  Vec3Column velocities;
+  if (p.tickStartVelocities != nullptr) {
+    velocities.resize(static_cast<Eigen::Index>(n));
+    for (int k = 0; k < 3; ++k)
+      loadLittleEndian(p.tickStartVelocities + k * 4 * n, velocities[k].data(), n);
+  }
+  system.restoreClock(p.tick, p.tickStartVelocities != nullptr ? &velocities : nullptr);
+}
+
+[[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
+  throw std::runtime_error(path.string() + ": error: " + what);
+}
+
+std::string readWholeFile(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) fail(path, "cannot open checkpoint (no such file)");
+  if (std::filesystem::is_directory(status))
+    fail(path, "cannot read checkpoint (it is a directory)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, std::string("cannot open checkpoint (") + std::strerror(errno) + ")");
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (size < 0 || !in) fail(path, "cannot read checkpoint (cannot tell its size)");
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.read(bytes.data(), size);
+  if (in.gcount() != size) fail(path, "cannot read checkpoint (read error)");
+  return bytes;
+}
+
+}  // namespace
+
+void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,
+                     const CheckpointInfo& info) {
+  const ParticlePool& pool = system.pool();
+  const FixedStepDriver& driver = system.driver();
+  const std::size_t n = pool.size();
+  Writer w;
+  w.bytes().append(kCheckpointMagic);
+  w.u32(kCheckpointVersion);
+  w.u32(0);  // flags: none defined in version 1
+  w.u64(0);  // the file length, patched below
+  w.u64(info.effectHash);
+
+  w.i64(system.settings().stepRateHz);
+  w.str(system.integrator().name());
+  w.u64(pool.maxParticles());
+  w.i64(driver.maxTicksPerAdvance());
+  w.u32(policyCode(driver.policy()));
+  w.i64(system.tickCount());
+  w.i64(driver.ticksIssued());
+  w.i64(driver.ticksDroppedTotal());
+  w.i64(driver.ticksDue());
+  w.i64(driver.remainder());
+  w.i64(info.frame);
+  w.i64(info.elapsed);
+  w.u64(n);
+  w.u64(pool.nextId());
+  w.u64(pool.droppedSpawns());
+  w.u32(static_cast<std::uint32_t>(pool.attributeCount()));
+  const FloatColumn zeros =
+      pool.keepsAcceleration() ? FloatColumn() : FloatColumn::Zero(static_cast<Eigen::Index>(n));
+  forEachFloatColumn(pool, [&](const FloatColumn* column) {
+    w.column(column != nullptr ? column->data() : zeros.data(), n);
+  });
+  w.column(pool.id().data(), n);
+  w.column(pool.birthTick().data(), n);
+  // What render copies interpolate velocities from, so that a resumed run's caches match.
+  const Vec3Column* velocities = system.tickStartVelocities();
+  w.u32(velocities != nullptr ? 1 : 0);
+  if (velocities != nullptr) {
+    for (int c = 0; c < 3; ++c) w.column((*velocities)[c].data(), n);
+  }
+  for (std::size_t a = 0; a < pool.attributeCount(); ++a) {
+    w.str(pool.attributeName(a));
+    w.column(pool.attribute(a).data(), n);
+  }
+  const std::vector<Spring> none;
+  const std::vector<Spring>& springs = system.springs() ? system.springs()->springs() : none;
+  w.u64(springs.size());
+  w.u64(system.springs() ? system.springs()->brokenCount() : 0);
+  for (const Spring& spring : springs) {
+    w.u64(spring.a);
+    w.u64(spring.b);
+    for (float value : {spring.restLength, spring.stiffness, spring.damping, spring.breakRatio}) {
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, &value, 4);
+      w.u32(bits);
+    }
+  }
+
+  w.patchU64(kLengthOffset, w.bytes().size() + kTrailerBytes);
+  w.u64(fingerprint(w.bytes()));
+  writeFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out.write(w.bytes().data(), static_cast<std::streamsize>(w.bytes().size()));
+      },
+      Durability::Synced);
+}
+
+CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
+                              std::uint64_t expectedEffectHash) {
+  const std::string bytes = readWholeFile(path);
+  const std::size_t found = bytes.size();
+  auto truncated = [&](const std::string& expected) {
+    fail(path, "checkpoint is truncated (expected " + expected + " bytes, found " +
+                   std::to_string(found) + ")");
+  };
+
+  // A prefix of the magic (an empty file included) is what an interrupted copy leaves: call it
+  // truncated; anything else is some other file.
+  if (bytes.compare(0, kCheckpointMagic.size(), kCheckpointMagic, 0,
+                    std::min(found, kCheckpointMagic.size())) != 0) {
+    fail(path, "not a tickfx checkpoint (it does not start with TICKFXCK)");
+  }
+  if (found < kFlagsOffset) truncated("at least " + std::to_string(kMinimumBytes));
+  const std::uint32_t version = loadU32(bytes.data() + kVersionOffset);
+  if (version != kCheckpointVersion) {
+    fail(path, "checkpoint format version " + std::to_string(version) + " (this build reads " +
+                   std::to_string(kCheckpointVersion) + ")");
+  }
+  if (found < kEffectHashOffset) truncated("at least " + std::to_string(kMinimumBytes));
+  const std::uint32_t flags = loadU32(bytes.data() + kFlagsOffset);
+  if (flags != 0) {
+    fail(path, "checkpoint has unknown flags " + std::to_string(flags) +
+                   " (this build reads files with flags 0)");
+  }
+  const std::uint64_t length = loadU64(bytes.data() + kLengthOffset);
+  if (length < kMinimumBytes) {
+    fail(path, "checkpoint header is damaged (file length " + std::to_string(length) +
+                   ", expected at least " + std::to_string(kMinimumBytes) + ")");
+  }
+  if (found < length) truncated(std::to_string(length));
+  if (found > length) {
+    fail(path, "checkpoint is longer than its header says (expected " + std::to_string(length) +
+                   " bytes, found " + std::to_string(found) + ")");
+  }
+  const std::string_view covered(bytes.data(), found - kTrailerBytes);
+  if (fingerprint(covered) != loadU64(bytes.data() + found - kTrailerBytes)) {
+    fail(path, "checksum mismatch (the file is corrupted)");
+  }
+  const std::uint64_t effectHash = loadU64(bytes.data() + kEffectHashOffset);
+  if (effectHash != expectedEffectHash) {
+    fail(path, "checkpoint was written for another effect (effect hash " + hashToHex(effectHash) +
+                   ", expected " + hashToHex(expectedEffectHash) + ")");
+  }
+
+  Parsed parsed;
+  try {
+    parsed = parsePayload(covered.substr(kHeaderBytes));
+  } catch (const Malformed& m) {
+    fail(path, "checkpoint is malformed (" + m.what + ")");
+  }
+  parsed.info.effectHash = effectHash;
+  if (const std::optional<std::string> why = mismatch(parsed, system)) fail(path, *why);
+  apply(parsed, system);
+  return parsed.info;
+}
+
+}  // namespace tickfx::io

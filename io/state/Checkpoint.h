@@ -1,0 +1,79 @@
+// Checkpoints: the whole simulation state in one file, so that a run can stop and resume and
+// still reach the state hash of the uninterrupted run.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "io/util/Fingerprint.h"
+#include "particles/Clock.h"
+#include "particles/ParticleSystem.h"
+
+namespace tickfx::io {
+
+/// What the caller stores beside the simulation state and gets back on resume.
+struct CheckpointInfo {
+  /// Fingerprint of the effect (file bytes and overrides, see fingerprint()), computed by the
+  /// caller; a checkpoint is only ever read back into the effect it was written for.
+  std::uint64_t effectHash = 0;
+  /// Frames completed when the checkpoint was written.
+  std::int64_t frame = 0;
+  /// Flicks of frame time fed to the driver so far.
+  Flicks elapsed = 0;
+};
+
+/// The format version this build writes and the only one it reads.
+inline constexpr std::uint32_t kCheckpointVersion = 2;
+
+/// Writes the state of `system` (after its last completed tick) and `info` to `path`.
+///
+/// The file appears whole or not at all, and is on the disk before this returns
+/// (io::writeFileAtomically with Durability::Synced: after a crash or a power loss `path` holds
+/// the old checkpoint or this one, whole). When writing fails, an existing `path` is left as it
+/// was and no temporary stays behind; throws io::WriteError "PATH: error: cannot write (REASON)".
+///
+/// Layout, version 2, every integer little-endian, floats as their IEEE-754 bits:
+///
+///     header   "TICKFXCK"  u32 version  u32 flags (0)  u64 file length  u64 effect hash
+///     payload  i64 step rate (Hz)   str integrator   u64 max particles
+///              i64 max ticks per frame   u32 overrun policy (0 drop excess, 1 fall behind)
+///              i64 tick count   i64 ticks issued   i64 ticks dropped   i64 ticks due
+///              i64 driver remainder
+///              i64 frame   i64 elapsed (flicks)
+///              u64 particle count n   u64 next id   u64 dropped spawns   u32 attribute count
+///              f32[n] × 16: position, velocity, previous position, acceleration (x, y, z each),
+///                           age, lifetime, mass, inverse mass
+///              u64[n] id   i64[n] birth tick
+///              u32 1 with f32[n] × 3: velocity at the start of the newest tick (x, y, z; what
+///                  render copies interpolate from), or u32 0 without
+///              per attribute: str name, f32[n] values
+///              u64 spring count s   u64 springs broken so far
+///              s × (u64 id a, u64 id b, f32 rest length, f32 stiffness, f32 damping, f32 break
+///              ratio)
+///     trailer  u64 checksum: fingerprint() of every byte before it
+///
+/// where str is a u32 byte count followed by that many UTF-8 bytes.
+void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,
+                     const CheckpointInfo& info);
+
+/// Reads the checkpoint at `path` into `system` and returns the stored info.
+///
+/// The whole file is read and verified before `system` is touched: magic, version, length,
+/// checksum, `expectedEffectHash`, then that `system` was built from matching settings (step
+/// rate, integrator, max particles, max ticks per frame, overrun policy, the same attribute
+/// names, springs only where the effect has structures). Only then are the pool (every column and
+/// attribute, size, next id, dropped spawns), the spring network, the driver (ticks issued, ticks
+/// dropped, ticks due, remainder), the tick count and the tick-start velocities replaced, so
+/// `system` continues, and renders, exactly as the system that wrote the file would have.
+/// (Version 1 files, which lack the driver's ticks due, are refused.)
+///
+/// On any refusal throws std::runtime_error "PATH: error: what (expected)", e.g.
+/// "ckpt.bin: error: checkpoint is truncated (expected 5120 bytes, found 1000)", and `system` is
+/// left exactly as it was.
+CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
+                              std::uint64_t expectedEffectHash);
+
+}  // namespace tickfx::io
