@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include "fields/ForceSet.h"
 #include <cstdio>
 #include <filesystem>
 #include <string>

@@ -13,6 +13,7 @@
 #include "io/effect/EffectLoader.h"
 #include "io/effect/EffectParser.h"
 #include "particles/ParticleSystem.h"
+#include "fields/SpringNetwork.h"
 
 namespace tickfx::app {
 namespace {

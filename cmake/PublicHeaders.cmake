@@ -14,13 +14,16 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   particles/ParticleSystem.h
   particles/Random.h
   particles/RenderDestination.h
+  particles/RowViews.h
   particles/SettingProblem.h
+  particles/Spring.h
   particles/StateHash.h
   particles/Structure.h
   particles/TaskExecutor.h
-  integrators/Advection.h
+  particles/TickInstant.h
+  integrators/AdvectionScheme.h
   integrators/Integrator.h
-  integrators/StagePasses.h
+  integrators/StepRows.h
   fields/AnchorSpring.h
   fields/ForceModule.h
   fields/ForceSet.h
@@ -37,8 +40,10 @@ set(TICKFX_VDB_PUBLIC_HEADERS
   fields/vdb/VectorField.h
 )
 
-# COMPONENTS effects (tickfx::effects): effect files, loadEffect(), caches.
+# COMPONENTS effects (tickfx::effects): effect files, loadEffect(), caches, and the umbrella
+# <tickfx/tickfx.h> (installed as include/tickfx/tickfx.h).
 set(TICKFX_EFFECTS_PUBLIC_HEADERS
+  include/tickfx/tickfx.h
   io/util/AtomicFile.h
   io/util/Fingerprint.h
   io/cache/BackgroundWriter.h

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "particles/ParallelFor.h"
+#include "particles/Assert.h"
 
 namespace tickfx {
 namespace {
@@ -92,6 +93,7 @@ void SpringNetwork::rebuild(const ParticlePool& pool) {
       continue;
     }
     breakable_ = breakable_ || spring.breakRatio > 0.0f;
+    TICKFX_ASSERT(ra < n && rb < n, "a spring end past the pool's rows");
     ends_.push_back(Ends{ra, rb, static_cast<std::uint32_t>(kept)});
     springs_[kept++] = spring;
   }
@@ -104,6 +106,7 @@ void SpringNetwork::rebuild(const ParticlePool& pool) {
     ++first_[e.b + 1];
   }
   for (std::size_t r = 0; r < n; ++r) first_[r + 1] += first_[r];
+  TICKFX_ASSERT(first_[n] == 2 * ends_.size(), "a spring link table that lost an end");
   links_.resize(first_[n]);
   std::vector<std::uint32_t> fill(first_.begin(), first_.end() - 1);
   for (const Ends& e : ends_) {
@@ -126,6 +129,7 @@ void SpringNetwork::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& ac
     for (std::uint32_t l = first_[i]; l < first_[i + 1]; ++l) {
       const Spring& s = springs_[links_[l].spring];
       const std::size_t j = links_[l].other;
+      TICKFX_ASSERT(j + 1 < first_.size(), "a spring link past the rows of its table");
       const Eigen::Vector3f pj = p.at(j), vj = v.at(j);
       const float dx = pj.x() - pi.x(), dy = pj.y() - pi.y(), dz = pj.z() - pi.z();
       const float length = std::sqrt(dx * dx + dy * dy + dz * dz);

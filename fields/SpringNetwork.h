@@ -5,20 +5,9 @@
 #include <vector>
 
 #include "fields/ForceModule.h"
+#include "particles/Spring.h"
 
 namespace tickfx {
-
-/// A spring between the particles with ids `a` and `b`. Units: metres, N/m, N·s/m.
-struct Spring {
-  std::uint64_t a = 0;
-  std::uint64_t b = 0;
-  float restLength = 1.0f;  // metres
-  float stiffness = 1.0f;   // k, N/m
-  float damping = 0.0f;     // c, N·s/m, along the spring
-  /// The spring breaks, for good, at the start of a tick where its length exceeds
-  /// breakRatio · restLength; 0 means it never breaks.
-  float breakRatio = 0.0f;
-};
 
 /// Damped Hooke springs between particles: on particle i, from its spring to j,
 ///   F = (k · (|d| − L) + c · (v_j − v_i)·d̂) · d̂,   d = p_j − p_i,   a_i += F / m_i.

@@ -1,7 +1,7 @@
 // The non-finite check folded into an integrator's last update loop over a tile (see
 // NonfiniteCheck): the values a row has just written are still in registers, so testing them
-// costs about nothing, where a separate pass re-reading the tile cost 11 % of a semi-implicit
-// Euler tick at 10⁴ particles.
+// there costs about nothing, where a separate pass would read the tile again
+// (docs/performance.md, the non-finite check).
 #pragma once
 
 #include <Eigen/Core>
@@ -88,15 +88,12 @@ Lane checkedValue(const CheckedPair<Lane>& pair) {
 /// finds nothing and only time is lost. Returns whether some returned value may be non-finite
 /// (always false without kCheck).
 ///
-/// The sums are two Lanes4 in registers, one for each half of an 8-row group, so each is one add
-/// an iteration from its last value. Written as a float array (the scalar kernel run 8 times for
-/// the compiler to vectorise), they lived on the stack: two more loads and stores an iteration,
-/// which made the check cost velocity Verlet's one pass 16 to 20 % of its tick.
+/// The sums are two Lanes4 that must stay in registers, one for each half of an 8-row group, so
+/// each is one add an iteration from its last value; sums the compiler keeps on the stack cost
+/// loads and stores every iteration.
 ///
-/// Not inlined: inlined into an integrator's tile lambda, the checked and unchecked loops were
-/// placed so differently that the checked tick measured 4 to 9 % slower for reasons that had
-/// nothing to do with the check (tick_bench, 10⁴ particles); as functions of their own they
-/// measure the same.
+/// Not inlined, so that the checked and unchecked loops are compiled and placed alike and a
+/// measured difference between them is the check's (docs/performance.md).
 template <bool kCheck, class Kernel, class... Column>
 [[gnu::noinline]] bool updateRowsChecked(Eigen::Index n, const Kernel& kernel,
                                          Column* __restrict... columns) {

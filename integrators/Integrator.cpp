@@ -1,5 +1,7 @@
 #include "integrators/Integrator.h"
 
+#include "integrators/Advection.h"
+
 namespace tickfx {
 
 Integrator::Integrator() = default;

@@ -8,12 +8,14 @@
 #include <vector>
 
 #include "fields/ForceSet.h"
-#include "integrators/Advection.h"
-#include "integrators/StagePasses.h"
+#include "integrators/AdvectionScheme.h"
+#include "integrators/StepRows.h"
 #include "particles/NonfiniteState.h"
 #include "particles/ParticlePool.h"
 
 namespace tickfx {
+
+class Advection;  // integrators/Advection.h, internal
 
 /// The tick being integrated: from t = tick/rate to (tick+1)/rate seconds.
 struct StepTime {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fields/ForceSet.h"
+#include "integrators/StepRows.h"
 
 namespace tickfx {
 
@@ -63,21 +64,6 @@ class Tile {
 
 /// One pass of an integrator over a tile: a force evaluation or a state update.
 using RowPass = std::function<void(const Tile&)>;
-
-/// The rows one integrator step advances: every row of the pool, in parallel (a tick), or one
-/// block of rows on the calling thread (a fused frame, whose caller runs its blocks in parallel
-/// and takes each through all the frame's ticks).
-struct StepRows {
-  RowRange rows;
-  /// Rows [fresh, rows.end) were spawned this tick: schemes with history start them on their own.
-  std::size_t fresh = 0;
-  /// Run on the calling thread: the caller parallelises.
-  bool serial = false;
-  /// Every row of `pool`, its unstepped rows fresh, in parallel.
-  static StepRows wholePool(const ParticlePool& pool) {
-    return {RowRange{0, pool.size()}, pool.firstUnstepped(), false};
-  }
-};
 
 /// Runs `passes` over `rows`. With `fused` (every force local) each tile of Tile::kRows rows runs
 /// all passes in turn while its rows and stage values are in L1/L2 cache; otherwise each pass

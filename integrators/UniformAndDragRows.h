@@ -118,7 +118,7 @@ void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange ro
 /// velocity, the previous position and the `extra` columns of the tile. Checked (`check` set),
 /// it sums what the kernels return, or, when the stepped rows start finite and the forms are
 /// finite, runs the kernels unchecked and tests the exception flags after each tile: the sums are
-/// one add per value, up to 12 % of a one-pass tick (midpoint at 10⁴), the flags one test a tile.
+/// one add per value, the flags one test a tile (their costs: docs/performance.md).
 template <class KernelFor, class BeforeTile, class... Extra>
 void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
                 NonfiniteCheck* check, const TickForms& forms, const KernelFor& kernelFor,

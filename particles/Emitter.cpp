@@ -8,6 +8,7 @@
 #include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
 #include "particles/Random.h"
+#include "particles/Assert.h"
 
 namespace tickfx {
 namespace {
@@ -126,12 +127,16 @@ std::uint64_t Emitter::serialBefore(std::int64_t tick) const {
 std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick) const {
   const std::uint64_t first = serialBefore(tick);
   const std::uint64_t last = serialBefore(tick + 1);
+  // Serials are counted from tick 0, so a later tick never has made fewer particles.
+  TICKFX_ASSERT(first <= last, "an emitter's serials going backwards");
+  TICKFX_ASSERT(pool.size() <= pool.maxParticles(), "a pool past its maxParticles");
   // Particles the pool has no room for are counted, not sampled.
   const std::uint64_t room = pool.maxParticles() - pool.size();
   const std::uint64_t tried = std::min<std::uint64_t>(last - first, room);
   // Every particle is a pure function of its serial: the rows are reserved in serial order, then
   // filled in parallel blocks, with the bits of one spawn() after another.
   const std::size_t firstRow = pool.appendRows(static_cast<std::size_t>(tried), tick);
+  TICKFX_ASSERT(firstRow + tried == pool.size(), "an emitter's rows not at the pool's end");
   parallelForRows(static_cast<std::size_t>(tried), [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) pool.setRow(firstRow + k, sample(seed, first + k));
   });

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "particles/ExactTime.h"
+#include "particles/Assert.h"
 
 namespace tickfx {
 namespace {
@@ -52,6 +53,12 @@ AdvanceResult FixedStepDriver::advance(Flicks frame) {
     result.ticksPending = excess;
   }
   ticksIssued_ += result.ticks;
+  // The clock's invariants: its fraction of a tick is in [0, 1) tick, it never owes a negative
+  // count, and nothing is issued past what is due (plus the tick a frame between ticks shows).
+  TICKFX_ASSERT(remainder_ >= 0 && remainder_ < kFlicksPerSecond, "a clock remainder past a tick");
+  TICKFX_ASSERT(result.ticks >= 0 && result.ticksDropped >= 0 && result.ticksPending >= 0,
+                "a negative tick count from advance()");
+  TICKFX_ASSERT(ticksIssued_ <= target(), "ticks issued past the clock's target");
   result.alpha = alpha();
   return result;
 }
@@ -71,6 +78,7 @@ float FixedStepDriver::alpha() const {
   }
   const float a = exact::fractionToFloat(static_cast<exact::u128>(offset),
                                          static_cast<exact::u128>(kFlicksPerSecond));
+  TICKFX_ASSERT(offset >= 0 && offset < kFlicksPerSecond, "a frame offset outside the tick");
   // Rounding can take offset/F within half an ulp of 1 up to 1.0f.
   return a < 1.0f || timing_ == FrameTiming::AtFrameTime ? a : std::nextafter(1.0f, 0.0f);
 }

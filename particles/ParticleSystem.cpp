@@ -8,6 +8,9 @@
 #include <emmintrin.h>
 #endif
 
+#include "fields/ForceSet.h"
+#include "fields/SpringNetwork.h"
+#include "integrators/Integrator.h"
 #include "particles/Clock.h"
 #include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
@@ -58,18 +61,18 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     : settings_(settings),
       pool_(settings.maxParticles),
       emitters_(makeEmitters(emitters, settings.stepRateHz)),
-      forces_(std::move(forces)),
+      forces_(std::make_unique<ForceSet>(std::move(forces))),
       integrator_(makeIntegrator(settings.integrator)),
       driver_(settings.stepRateHz, settings.maxTicksPerFrame, settings.overrunPolicy,
               settings.frameTiming),
       arena_(std::make_unique<ThreadArena>(settings.threads)) {
   nonfiniteCheck_.setSteppedRowsFinite(true);  // no rows yet: the first tick's are all spawned
   if (settings.threads < 0) throw std::invalid_argument("threads must be >= 0");
-  for (std::size_t i = 0; i < forces_.size() && springs_ == nullptr; ++i) {
-    springs_ = dynamic_cast<SpringNetwork*>(&forces_.module(i));
+  for (std::size_t i = 0; i < forces_->size() && springs_ == nullptr; ++i) {
+    springs_ = dynamic_cast<SpringNetwork*>(&forces_->module(i));
   }
   if (!structures.empty() && springs_ == nullptr) {
-    springs_ = static_cast<SpringNetwork*>(&forces_.add(std::make_unique<SpringNetwork>()));
+    springs_ = static_cast<SpringNetwork*>(&forces_->add(std::make_unique<SpringNetwork>()));
   }
   for (std::size_t i = 0; i < structures.size(); ++i) {
     // Built now, not at the structure's birth tick: bad settings fail the construction, and the
@@ -179,7 +182,7 @@ struct ParticleSystem::FrameStart {
 
 bool ParticleSystem::fusesTicks(std::int64_t ticks) const {
   if (ticks < 2 || tickObserver_ || settings_.nonfinite == NonfinitePolicy::Kill ||
-      !forces_.interleavesTicks()) {
+      !forces_->interleavesTicks()) {
     return false;
   }
   for (const PendingStructure& p : structures_) {
@@ -205,8 +208,8 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
     bornBy[static_cast<std::size_t>(j)] = pool_.size();
   }
   const std::size_t rows = pool_.size();
-  integrator_->prepare(pool_, forces_);
-  forces_.beginTick(pool_, first);  // no module's own tables; whether any particle is pinned
+  integrator_->prepare(pool_, *forces_);
+  forces_->beginTick(pool_, first);  // no module's own tables; whether any particle is pinned
   const bool stop = settings_.nonfinite == NonfinitePolicy::Stop;
   if (stop) {
     if (!frameStart_) frameStart_ = std::make_unique<FrameStart>();
@@ -244,7 +247,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
                                 : j == 0             ? std::max(block.begin, stepped)
                                                      : block.begin;
       const StepRows blockRows{RowRange{block.begin, block.end}, std::min(fresh, block.end), true};
-      integrator_->stepRows(pool_, forces_, StepTime{first + j, settings_.stepRateHz}, blockRows,
+      integrator_->stepRows(pool_, *forces_, StepTime{first + j, settings_.stepRateHz}, blockRows,
                             check);
     }
   });
@@ -273,13 +276,13 @@ void ParticleSystem::runTick(bool keepVelocities) {
     previousVelocity_.resize(n);
     for (int c = 0; c < 3; ++c) previousVelocity_[c] = pool_.velocity()[c].head(n);
   }
-  forces_.beginTick(pool_, tick_);
+  forces_->beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};
   const bool check = settings_.nonfinite != NonfinitePolicy::Keep;
-  integrator_->step(pool_, forces_, time, check ? &nonfiniteCheck_ : nullptr);
+  integrator_->step(pool_, *forces_, time, check ? &nonfiniteCheck_ : nullptr);
   if (nonfiniteCheck_.found()) takeNonfinite();
   pool_.markAllStepped();
-  forces_.endTick(pool_, time.stage(2));
+  forces_->endTick(pool_, time.stage(2));
   endTicks(tick_ + 1, keepVelocities);
 }
 

@@ -9,8 +9,6 @@
 #include <string_view>
 #include <vector>
 
-#include "fields/ForceSet.h"
-#include "integrators/Integrator.h"
 #include "particles/Emitter.h"
 #include "particles/FixedStepDriver.h"
 #include "particles/NonfiniteState.h"
@@ -20,6 +18,12 @@
 
 namespace tickfx {
 
+// The system composes the layers above particles/: its forces (fields/ForceSet.h) and its scheme
+// (integrators/Integrator.h). This header only declares them; a host that builds a system
+// includes fields/ForceSet.h for the ForceSet it hands over.
+class ForceSet;
+class Integrator;
+class SpringNetwork;
 class TaskExecutor;
 
 /// Settings of a whole simulation (the [simulation] table of an effect file).
@@ -151,7 +155,7 @@ class ParticleSystem {
     nonfiniteCheck_.setSteppedRowsFinite(false);
     return pool_;
   }
-  const ForceSet& forces() const { return forces_; }
+  const ForceSet& forces() const { return *forces_; }
   const Integrator& integrator() const { return *integrator_; }
   const FixedStepDriver& driver() const { return driver_; }
   FixedStepDriver& driver() { return driver_; }
@@ -189,14 +193,14 @@ class ParticleSystem {
   SystemSettings settings_;
   ParticlePool pool_;
   std::vector<Emitter> emitters_;
-  ForceSet forces_;
+  std::unique_ptr<ForceSet> forces_;  // never null
   std::unique_ptr<Integrator> integrator_;
   struct PendingStructure {
     StructureBuild build;  // built (so validated) once, by the constructor; born at `tick`
     std::int64_t tick;
   };
   std::vector<PendingStructure> structures_;
-  SpringNetwork* springs_ = nullptr;  // owned by forces_
+  SpringNetwork* springs_ = nullptr;  // owned by *forces_
   FixedStepDriver driver_;
   class ThreadArena;  // the TBB arena, kept out of this header
   std::unique_ptr<ThreadArena> arena_;

@@ -9,9 +9,9 @@
 #include <variant>
 #include <vector>
 
-#include "fields/SpringNetwork.h"
 #include "particles/ParticlePool.h"
 #include "particles/SettingProblem.h"
+#include "particles/Spring.h"
 
 namespace tickfx {
 

@@ -7,6 +7,7 @@
 #include "fields/LinearDrag.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
+#include "fields/ForceSet.h"
 
 int main() {
   using namespace tickfx;

@@ -6,6 +6,7 @@
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
+#include "fields/ForceSet.h"
 
 namespace tickfx {
 namespace {

@@ -18,6 +18,7 @@
 #include "particles/Emitter.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Structure.h"
+#include "fields/ForceSet.h"
 
 namespace tickfx::io {
 

@@ -14,6 +14,8 @@
 
 #include "io/util/AtomicFile.h"
 #include "particles/StateHash.h"
+#include "integrators/Integrator.h"
+#include "fields/SpringNetwork.h"
 
 namespace tickfx::io {
 namespace {

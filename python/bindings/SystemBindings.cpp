@@ -18,6 +18,7 @@
 #include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 #include "python/bindings/Bindings.h"
+#include "fields/ForceSet.h"
 
 namespace tickfx::python {
 namespace {

@@ -7,8 +7,7 @@
 #include <cstdio>
 #include <vector>
 
-#include <tickfx/io/effect/EffectLoader.h>
-#include <tickfx/particles/StateHash.h>
+#include <tickfx/tickfx.h>
 
 int main(int argc, char** argv) {
   if (argc != 2) {

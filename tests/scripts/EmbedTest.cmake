@@ -30,6 +30,7 @@ endif()
 # Exactly the listed public headers, no internal one.
 include(${SOURCE_DIR}/cmake/PublicHeaders.cmake)
 set(expected ${TICKFX_CORE_PUBLIC_HEADERS} ${TICKFX_VDB_PUBLIC_HEADERS} ${TICKFX_EFFECTS_PUBLIC_HEADERS})
+list(TRANSFORM expected REPLACE "^include/tickfx/" "")
 list(SORT expected)
 file(GLOB_RECURSE installed RELATIVE ${prefix}/include/tickfx ${prefix}/include/tickfx/*)
 list(SORT installed)
@@ -37,7 +38,16 @@ if(NOT installed STREQUAL expected)
   message(FATAL_ERROR "installed headers:\n  ${installed}\nexpected (cmake/PublicHeaders.cmake):\n  ${expected}")
 endif()
 
-# Each header alone (twice: include guards), as a host includes it.
+# Only include/ goes on a host's include path: installed headers include each other as
+# <tickfx/...>, never by a bare "particles/..." path that would need include/tickfx there too.
+foreach(header ${installed})
+  file(STRINGS ${prefix}/include/tickfx/${header} bare REGEX "#include \"")
+  if(bare)
+    message(FATAL_ERROR "include/tickfx/${header} includes by a bare path:\n${bare}")
+  endif()
+endforeach()
+
+# Each header alone (twice: include guards), as a host includes it, and the umbrella.
 set(headers_dir ${WORK_DIR}/headers)
 set(sources "")
 foreach(header ${installed})

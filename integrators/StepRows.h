@@ -1,0 +1,26 @@
+// Which rows one integrator step advances.
+#pragma once
+
+#include <cstddef>
+
+#include "particles/ParticlePool.h"
+#include "particles/RowViews.h"
+
+namespace tickfx {
+
+/// The rows one integrator step advances: every row of the pool, in parallel (a tick), or one
+/// block of rows on the calling thread (a fused frame, whose caller runs its blocks in parallel
+/// and takes each through all the frame's ticks).
+struct StepRows {
+  RowRange rows;
+  /// Rows [fresh, rows.end) were spawned this tick: schemes with history start them on their own.
+  std::size_t fresh = 0;
+  /// Run on the calling thread: the caller parallelises.
+  bool serial = false;
+  /// Every row of `pool`, its unstepped rows fresh, in parallel.
+  static StepRows wholePool(const ParticlePool& pool) {
+    return {RowRange{0, pool.size()}, pool.firstUnstepped(), false};
+  }
+};
+
+}  // namespace tickfx
