@@ -22,7 +22,7 @@
 //                TBB range).
 // Both run inside a tbb::task_arena of the case's thread count. Each batch first restores the
 // starting points (a 12 MB copy, the same for both), so every batch times the same trajectory.
-// The two give bitwise identical positions (checked below and in tests/test_vdb_advect.cpp).
+// The two give bitwise identical positions (checked below and in tests/core/test_vdb_advect.cpp).
 //
 // Output: the table, then one line a figure, `name: value unit (ratios, targets)`.
 #include <openvdb/openvdb.h>

@@ -22,6 +22,7 @@
 #include "io/effect/EffectParser.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
+#include "fields/ForceSet.h"
 
 namespace fs = std::filesystem;
 

@@ -216,6 +216,41 @@ TEST(FrameTime, OnATickTheFrameIsTheTicksOwnState) {
   }
 }
 
+// Between ticks a shown position is exactly what ParticleSystem::interpolatedPositions()
+// documents: previous + (current − previous) · α, in float, for every row, with α the driver's
+// fraction computed from integers (60 Hz ticks, 50 fps frames: α = 0.2, 0.4, 0.6, 0.8, then a
+// tick). Velocities interpolate the same way between the tick's start and end velocities.
+TEST(FrameTime, BetweenTicksAShownValueIsPreviousPlusAlphaTimesTheStep) {
+  SystemSettings settings = test::referenceSettings();
+  const auto system = test::referenceSystem(settings);  // 60 Hz, emitting, gravity and wind
+  const Flicks frame = frameDuration(FrameRate{50, 1});
+  int between = 0;
+  for (int f = 1; f <= 50; ++f) {
+    system->advance(frame);
+    const float alpha = system->alpha();
+    const float expectedAlpha = static_cast<float>((f * 6) % 5) / 5.0f;
+    if (f % 5 == 0) {
+      ASSERT_EQ(alpha, 1.0f) << "frame " << f;
+      continue;
+    }
+    ASSERT_EQ(alpha, expectedAlpha) << "frame " << f;
+    ++between;
+    const Shown shown = Shown::of(*system);
+    const ParticlePool& pool = system->pool();
+    const Vec3Column* start = system->tickStartVelocities();
+    ASSERT_NE(start, nullptr) << "advance() keeps the velocities a frame between ticks needs";
+    for (int c = 0; c < 3; ++c) {
+      for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(pool.size()); ++i) {
+        const float p = pool.previousPosition()[c][i], q = pool.position()[c][i];
+        ASSERT_EQ(shown.position[c][i], p + (q - p) * alpha) << "frame " << f << ", row " << i;
+        const float u = (*start)[c][i], v = pool.velocity()[c][i];
+        ASSERT_EQ(shown.velocity[c][i], u + (v - u) * alpha) << "frame " << f << ", row " << i;
+      }
+    }
+  }
+  EXPECT_EQ(between, 40);
+}
+
 // Between ticks k and k + 1 a frame shows the particles alive after tick k + 1: one born in that
 // tick from its birth state (age = the time since its birth), one that dies in it not at all.
 TEST(FrameTime, BirthsAndDeathsBetweenTwoTicks) {

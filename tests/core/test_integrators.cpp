@@ -14,6 +14,7 @@
 
 #include "CoreTestSupport.h"
 #include "fields/LinearDrag.h"
+#include "integrators/Integrator.h"
 
 namespace tickfx {
 namespace {

@@ -16,7 +16,7 @@
 #include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"
-#include "tests/WorkerPool.h"
+#include "WorkerPool.h"
 
 namespace tickfx {
 namespace {

@@ -16,7 +16,7 @@
 #include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"
-#include "tests/WorkerPool.h"
+#include "WorkerPool.h"
 
 namespace tickfx::io {
 namespace {

@@ -18,6 +18,7 @@
 #include "io/cache/FrameData.h"
 #include "io/cache/PlyCache.h"
 #include "particles/ParticleSystem.h"
+#include "fields/ForceSet.h"
 
 namespace fs = std::filesystem;
 

@@ -24,6 +24,8 @@
 #include "io/state/Checkpoint.h"
 #include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
+#include "integrators/Integrator.h"
+#include "fields/SpringNetwork.h"
 
 namespace fs = std::filesystem;
 

@@ -17,6 +17,7 @@
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
+#include "fields/SpringNetwork.h"
 
 namespace tickfx::io {
 namespace {

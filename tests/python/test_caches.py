@@ -1,5 +1,7 @@
 # read_cache / write_cache: every attribute back bit for bit, in every format, for caches the
 # command line wrote and caches the module wrote.
+from fractions import Fraction
+
 import numpy as np
 import pytest
 import tickfx
@@ -197,3 +199,21 @@ def test_unreadable_caches_raise_cache_error(tmp_path, cli_frames):
     with pytest.raises(tickfx.CacheError):
         tickfx.write_cache(tmp_path / "no" / "such" / "dir.csv",
                            {"P": np.zeros((1, 3), np.float32), "id": np.zeros(1, np.int64)})
+
+
+def test_frames_between_ticks_are_the_cli_caches(cli, samples, tmp_path):
+    """The fountain ticks at 120 Hz; at 50 fps four frames in five fall between two ticks and show
+    interpolated positions, velocities and ages. Each frame Python captures equals the CLI's
+    cache of it, bit for bit (the frames compared above all fall on ticks)."""
+    out = tmp_path / "cli"
+    run_cli(cli, "run", samples / "fountain.toml", "--fps", "50", "--frames", "25",
+            "--format", "csv", "--out", out, "--quiet")
+    system = tickfx.load_effect(samples / "fountain.toml")
+    between = 0
+    for number in range(1, 26):
+        system.advance(Fraction(1, 50))
+        if system.alpha < 1:
+            between += 1
+        assert_same_bits(tickfx.read_cache(out / f"frame_{number:04d}.csv"), system.capture())
+    assert between == 20
+    assert system.count > 100

@@ -19,6 +19,7 @@
 #include "particles/ParticlePool.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Random.h"
+#include "fields/SpringNetwork.h"
 
 namespace tickfx::test {
 
