@@ -6,7 +6,7 @@ TICKFX_BUILD=${TICKFX_BUILD:-$TICKFX_ROOT/build}
 
 # Everything tickfx builds with, from Debian's archive only.
 TICKFX_PACKAGES=(
-  cmake ninja-build g++ clang pkg-config
+  cmake ninja-build g++ clang clang-format pkg-config
   libeigen3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenvdb-dev libopenvdb-tools libboost-dev libboost-iostreams-dev zlib1g-dev
