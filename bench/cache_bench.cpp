@@ -33,14 +33,14 @@
 // whatever the writer; the bench prints the memory so the reader can tell which case holds.
 // In a VM whose balloon reports free pages to the host (virtio-balloon free page reporting),
 // memory left free for a couple of seconds goes back to the host and the next write into it
-// faults it in again: 800 MB took 0.16 s right after a delete and 0.7 s after 5 s idle on the
-// 2-core guest. Files of 10⁷ particles take seconds, so their rows, dd's too, vary the most.
+// faults it in again, so a write is slower the longer the memory it fills stayed free. Files of
+// 10⁷ particles take seconds, so their rows, dd's too, vary the most.
 //
 // Timing: the cases of one format take turns batch by batch, a tick being one file, and a case's
 // figure is the median over its batches of the time per file (BenchHarness.h). Each file has a
 // name of its own and the files are deleted between batches (each case's `after`), outside the
-// timed part: deleting costs 0.03 s per GB while its pages are dirty and 0.2 s per GB once written
-// back (ext4), as much as dd's whole write, so timing it would pull every ratio towards 1.
+// timed part: deleting a file can cost as much as dd's whole write of it, more once its pages are
+// written back, so timing it would pull every ratio towards 1.
 //
 // Output: the tables, then one line a figure, `name: value unit (ratios, targets)`.
 #include <fcntl.h>
