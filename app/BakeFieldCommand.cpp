@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "app/Commands.h"
@@ -120,64 +121,73 @@ std::string numberText(double v) {
   return buffer;
 }
 
-}  // namespace
+// ---- settings -------------------------------------------------------------------------------
 
-int bakeFieldCommand(Arguments& args) {
-  if (args.flag("--help")) {
-    std::fputs(kBakeFieldHelp, stdout);
-    return kExitOk;
-  }
-  const auto out = args.value("--out");
-  const auto voxelSize = args.value("--voxel-size");
-  const auto bounds = args.value("--bounds");
-  const auto grid = args.value("--grid");
-  const bool staggered = args.flag("--staggered");
-  const auto background = args.value("--background");
-  const auto frames = args.value("--frames");
-  const auto fps = args.value("--fps");
-  const auto padding = args.value("--frame-padding");
+// The command line as given: every option read (in a fixed order: a value may look like an
+// option), nothing checked yet.
+struct BakeArguments {
+  std::optional<std::string> out, voxelSize, bounds, grid, background, frames, fps, padding;
+  bool staggered = false;
   std::map<std::string, std::string> given;  // the kinds' options, by name
+  std::string kind;
+};
+
+BakeArguments readBakeArguments(Arguments& args) {
+  BakeArguments a;
+  a.out = args.value("--out");
+  a.voxelSize = args.value("--voxel-size");
+  a.bounds = args.value("--bounds");
+  a.grid = args.value("--grid");
+  a.staggered = args.flag("--staggered");
+  a.background = args.value("--background");
+  a.frames = args.value("--frames");
+  a.fps = args.value("--fps");
+  a.padding = args.value("--frame-padding");
   for (const auto& [kind, options] : kindOptions()) {
     for (const std::string& option : options) {
-      if (const auto v = args.value(option)) given[option] = *v;
+      if (const auto v = args.value(option)) a.given[option] = *v;
     }
   }
-  const std::string kind =
-      args.positionals(1,
-                       "a field kind: tickfx bake-field KIND --out FILE.vdb (KIND: uniform, "
-                       "vortex, shear or curl-noise)")[0];
+  a.kind = args.positionals(1,
+                            "a field kind: tickfx bake-field KIND --out FILE.vdb (KIND: uniform, "
+                            "vortex, shear or curl-noise)")[0];
+  return a;
+}
 
-  // Everything is checked before anything is written.
+// The kind's index in kindOptions(); UsageError for an unknown kind or another kind's option.
+std::size_t checkKind(const BakeArguments& a) {
   std::vector<std::string> kinds;
-  const std::vector<std::string>* own = nullptr;
+  std::optional<std::size_t> index;
   for (const auto& [name, options] : kindOptions()) {
+    if (name == a.kind) index = kinds.size();
     kinds.push_back(name);
-    if (name == kind) own = &options;
   }
-  if (own == nullptr) {
-    const std::optional<std::string> guess = io::closestMatch(kind, kinds);
-    throw UsageError("bake-field: unknown kind '" + kind + "' " +
+  if (!index) {
+    const std::optional<std::string> guess = io::closestMatch(a.kind, kinds);
+    throw UsageError("bake-field: unknown kind '" + a.kind + "' " +
                      (guess ? "(did you mean '" + *guess + "'?)"
                             : "(expected " + joinWords(kinds, " or ") + ")"));
   }
-  for (const auto& [option, value] : given) {
-    if (std::find(own->begin(), own->end(), option) == own->end()) {
-      throw UsageError("bake-field: " + option + " does not apply to kind '" + kind +
-                       "' (its options: " + joinWords(*own, " and ") + ")");
+  const std::vector<std::string>& own = kindOptions()[*index].second;
+  for (const auto& [option, value] : a.given) {
+    if (std::find(own.begin(), own.end(), option) == own.end()) {
+      throw UsageError("bake-field: " + option + " does not apply to kind '" + a.kind +
+                       "' (its options: " + joinWords(own, " and ") + ")");
     }
   }
-  if (!out || out->empty()) throw UsageError("bake-field: --out FILE.vdb is required");
+  return *index;
+}
 
-  io::FieldBakeSettings bake;
-  for (std::size_t k = 0; k < kinds.size(); ++k) {
-    if (kinds[k] == kind) bake.kind = static_cast<io::FieldBakeSettings::Kind>(k);
-  }
+const std::string kBakePrefix = "bake-field: ";
+
+// The kind's own options, onto `bake`'s defaults.
+void readKindOptions(const std::map<std::string, std::string>& given, io::FieldBakeSettings& bake) {
   const auto option = [&](const char* name) -> std::optional<std::string> {
     const auto it = given.find(name);
     if (it == given.end()) return std::nullopt;
     return it->second;
   };
-  const std::string p = "bake-field: ";
+  const std::string& p = kBakePrefix;
   if (const auto v = option("--velocity")) bake.velocity = parseVector(*v, p + "--velocity");
   if (const auto v = option("--centre")) bake.centre = parseVector(*v, p + "--centre");
   if (const auto v = option("--axis")) bake.axis = parseVector(*v, p + "--axis", true);
@@ -203,52 +213,94 @@ int bakeFieldCommand(Arguments& args) {
   if (const auto v = option("--evolution")) {
     bake.evolution = parseNumber(*v, p + "--evolution", 0.0, kBig);
   }
+}
 
-  if (voxelSize) bake.voxelSize = parsePositive(*voxelSize, p + "--voxel-size", kBig);
-  if (bounds) {
-    const std::vector<double> b =
-        parseNumberList(*bounds, p + "--bounds", 6, "x0,y0,z0,x1,y1,z1", -kBig, kBig);
-    for (int c = 0; c < 3; ++c) {
-      if (b[c + 3] < b[c]) {
-        const std::string axis(1, "xyz"[c]);
-        throw UsageError(p + "--bounds: " + axis + "1 = " + numberText(b[c + 3]) + " is below " +
-                         axis + "0 = " + numberText(b[c]) +
-                         " (expected x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1 and z0 <= z1)");
-      }
+// --bounds: x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1 and z0 <= z1.
+void readBounds(const std::string& text, io::FieldBakeSettings& bake) {
+  const std::string& p = kBakePrefix;
+  const std::vector<double> b =
+      parseNumberList(text, p + "--bounds", 6, "x0,y0,z0,x1,y1,z1", -kBig, kBig);
+  for (int c = 0; c < 3; ++c) {
+    if (b[c + 3] < b[c]) {
+      const std::string axis(1, "xyz"[c]);
+      throw UsageError(p + "--bounds: " + axis + "1 = " + numberText(b[c + 3]) + " is below " +
+                       axis + "0 = " + numberText(b[c]) +
+                       " (expected x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1 and z0 <= z1)");
     }
-    bake.min = Eigen::Vector3d(b[0], b[1], b[2]);
-    bake.max = Eigen::Vector3d(b[3], b[4], b[5]);
   }
-  bake.staggered = staggered;
-  if (background) bake.background = parseVector(*background, p + "--background");
-  const std::string gridName = grid.value_or("vel");
-  if (gridName.empty()) throw UsageError(p + "--grid: the grid needs a name");
+  bake.min = Eigen::Vector3d(b[0], b[1], b[2]);
+  bake.max = Eigen::Vector3d(b[3], b[4], b[5]);
+}
 
-  // The sequence: frame numbers, times and files.
-  if (frames && !fps)
-    throw UsageError(p + "--frames needs --fps (the sequence's frames per second)");
-  if (fps && !frames) throw UsageError(p + "--fps needs --frames A..B");
-  if (padding && !frames) throw UsageError(p + "--frame-padding needs --frames A..B");
+// The frames baked: one file, or a sequence of them.
+struct BakeSequence {
+  bool sequence = false;  // --frames: --out is a pattern with {frame}
   int first = 0, last = 0, digits = 4;
-  double rate = 0.0;
-  if (frames) {
-    std::tie(first, last) = parseFrames(*frames);
-    rate = parsePositive(*fps, p + "--fps", 1e6);
-    if (padding) digits = static_cast<int>(parseInteger(*padding, p + "--frame-padding", 1, 10));
+  double rate = 0.0;  // frames per second
+
+  int count() const { return last - first + 1; }
+};
+
+BakeSequence readSequence(const BakeArguments& a) {
+  const std::string& p = kBakePrefix;
+  if (a.frames && !a.fps)
+    throw UsageError(p + "--frames needs --fps (the sequence's frames per second)");
+  if (a.fps && !a.frames) throw UsageError(p + "--fps needs --frames A..B");
+  if (a.padding && !a.frames) throw UsageError(p + "--frame-padding needs --frames A..B");
+  BakeSequence s;
+  if (a.frames) {
+    s.sequence = true;
+    std::tie(s.first, s.last) = parseFrames(*a.frames);
+    s.rate = parsePositive(*a.fps, p + "--fps", 1e6);
+    if (a.padding)
+      s.digits = static_cast<int>(parseInteger(*a.padding, p + "--frame-padding", 1, 10));
   }
-  const bool pattern = out->find("{frame}") != std::string::npos;
-  if (frames && !pattern) {
-    throw UsageError(p + "--out: '" + *out +
+  const bool pattern = a.out->find("{frame}") != std::string::npos;
+  if (a.frames && !pattern) {
+    throw UsageError(p + "--out: '" + *a.out +
                      "' has no {frame} (expected a pattern such as vel.{frame}.vdb with --frames)");
   }
-  if (!frames && pattern) {
-    throw UsageError(p + "--out: '" + *out + "' has {frame} but no --frames A..B is given");
+  if (!a.frames && pattern) {
+    throw UsageError(p + "--out: '" + *a.out + "' has {frame} but no --frames A..B is given");
   }
+  return s;
+}
 
-  // The grid's size, as an effect's bake table is judged.
-  const double h = bake.voxelSize;
-  const int count = last - first + 1;
-  const io::BakeSize size = io::measureBake(bake, count);
+// Everything `tickfx bake-field` is asked for, checked before anything is written.
+struct BakeFieldSettings {
+  std::string kind;
+  std::string out;  // a file, or with a sequence a pattern with {frame}
+  io::FieldBakeSettings bake;
+  std::string gridName;
+  BakeSequence frames;
+};
+
+BakeFieldSettings readBakeFieldSettings(Arguments& args) {
+  const BakeArguments a = readBakeArguments(args);
+  const std::size_t kind = checkKind(a);
+  if (!a.out || a.out->empty()) throw UsageError("bake-field: --out FILE.vdb is required");
+  BakeFieldSettings s;
+  s.kind = a.kind;
+  s.out = *a.out;
+  s.bake.kind = static_cast<io::FieldBakeSettings::Kind>(kind);
+  readKindOptions(a.given, s.bake);
+  const std::string& p = kBakePrefix;
+  if (a.voxelSize) s.bake.voxelSize = parsePositive(*a.voxelSize, p + "--voxel-size", kBig);
+  if (a.bounds) readBounds(*a.bounds, s.bake);
+  s.bake.staggered = a.staggered;
+  if (a.background) s.bake.background = parseVector(*a.background, p + "--background");
+  s.gridName = a.grid.value_or("vel");
+  if (s.gridName.empty()) throw UsageError(p + "--grid: the grid needs a name");
+  s.frames = readSequence(a);
+  return s;
+}
+
+// The grid's voxels a frame, judged as an effect's bake table is; UsageError when too many.
+double checkBakeSize(const BakeFieldSettings& s) {
+  const std::string& p = kBakePrefix;
+  const double h = s.bake.voxelSize;
+  const int count = s.frames.count();
+  const io::BakeSize size = io::measureBake(s.bake, count);
   switch (size.problem) {
     case io::BakeSize::Problem::None:
       break;
@@ -266,22 +318,42 @@ int bakeFieldCommand(Arguments& args) {
                        " over " + std::to_string(count) + (count == 1 ? " frame" : " frames") +
                        " (expected at most 100000000)");
   }
-  const double perFrame = size.perFrame;
-  const AnalyticField field = io::analyticField(bake);
-  const BakeSettings settings = io::bakeSettings(bake, gridName);
-  const std::filesystem::path parent = std::filesystem::path(*out).parent_path();
+  return size.perFrame;
+}
+
+// ---- baking ---------------------------------------------------------------------------------
+
+// Bakes every frame into its file, a line for each.
+void bakeFrames(const BakeFieldSettings& s, double perFrame) {
+  const BakeSequence& frames = s.frames;
+  const AnalyticField field = io::analyticField(s.bake);
+  const BakeSettings settings = io::bakeSettings(s.bake, s.gridName);
+  const std::filesystem::path parent = std::filesystem::path(s.out).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   ProgressLine progress("frames");
-  for (int f = first; f <= last; ++f) {
-    const std::string path = frames ? sequenceFramePath(*out, f, digits) : *out;
-    const double time = frames ? (f - first) / rate : 0.0;
-    progress.update(f - first, count, path);
+  for (int f = frames.first; f <= frames.last; ++f) {
+    const std::string path = frames.sequence ? sequenceFramePath(s.out, f, frames.digits) : s.out;
+    const double time = frames.sequence ? (f - frames.first) / frames.rate : 0.0;
+    progress.update(f - frames.first, frames.count(), path);
     bakeField(field, settings, path, time);
     progress.finish();  // the line below replaces it
-    std::printf("%s: %s field, grid '%s', %.0f voxels of %s m%s\n", path.c_str(), kind.c_str(),
-                gridName.c_str(), perFrame, numberText(h).c_str(),
-                frames ? (", t = " + numberText(time) + " s").c_str() : "");
+    std::printf("%s: %s field, grid '%s', %.0f voxels of %s m%s\n", path.c_str(), s.kind.c_str(),
+                s.gridName.c_str(), perFrame, numberText(s.bake.voxelSize).c_str(),
+                frames.sequence ? (", t = " + numberText(time) + " s").c_str() : "");
   }
+}
+
+}  // namespace
+
+int bakeFieldCommand(Arguments& args) {
+  if (args.flag("--help")) {
+    std::fputs(kBakeFieldHelp, stdout);
+    return kExitOk;
+  }
+  // Everything is checked before anything is written.
+  const BakeFieldSettings settings = readBakeFieldSettings(args);
+  const double perFrame = checkBakeSize(settings);
+  bakeFrames(settings, perFrame);
   return kExitOk;
 }
 

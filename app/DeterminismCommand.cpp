@@ -3,22 +3,27 @@
 // log, or compared with a log recorded on another machine.
 #include <algorithm>
 #include <cinttypes>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "app/Commands.h"
 #include "app/DeterminismCheck.h"
 #include "app/DifferenceImage.h"
+#include "app/FrameTimes.h"
 #include "app/HashLogRun.h"
 #include "app/LoadEffect.h"
 #include "app/ProgressLine.h"
-#include "io/util/AtomicFile.h"
-#include "app/FrameTimes.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectParser.h"
+#include "io/util/AtomicFile.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {
@@ -141,6 +146,33 @@ int recordCommand(const io::EffectSettings& effect, const std::string& effectPat
   return kExitOk;
 }
 
+// Where the run parts from the log: the tick, the columns and, from the log's snapshot of that
+// tick, the first particle and column that differ.
+void reportParting(const LogComparison& c, const io::HashLog& log) {
+  std::printf("the runs part at tick %" PRId64 " (t = %.9g s): state-hash %s here, %s in the log\n",
+              c.partTick,
+              static_cast<double>(c.partTick) / static_cast<double>(log.header.stepRateHz),
+              hashToHex(c.runHash).c_str(), hashToHex(c.logHash).c_str());
+  std::string columns;
+  for (const std::string& name : c.columns) columns += " " + name;
+  std::printf("columns that differ:%s\n", columns.empty() ? " -" : columns.c_str());
+  if (c.row && c.row->column == "counters") {
+    std::printf("first difference: particle id %" PRIu64 ": %" PRIu64 " particles here, %" PRIu64
+                " in the log\n",
+                c.row->id, c.row->runBits, c.row->logBits);
+  } else if (c.row) {
+    std::printf("first difference: particle id %" PRIu64 ", %s: %s here, %s in the log\n",
+                c.row->id, c.row->column.c_str(),
+                describeBits(c.row->column, c.row->runBits).c_str(),
+                describeBits(c.row->column, c.row->logBits).c_str());
+  } else if (!c.logHasState) {
+    std::printf("the log holds no state of tick %" PRId64
+                ": record it again with --snapshot-at %" PRId64
+                " to name the particle and both values\n",
+                c.partTick, c.partTick);
+  }
+}
+
 int compareCommand(const io::EffectSettings& effect, std::uint64_t fingerprint,
                    const std::string& logPath) {
   LogComparison c;
@@ -158,28 +190,7 @@ int compareCommand(const io::EffectSettings& effect, std::uint64_t fingerprint,
   std::printf("log:       %s\n", describeBuild(log.header).c_str());
   std::printf("this run:  %s\n", describeBuild(describeThisBuild()).c_str());
   if (c.partTick >= 0) {
-    std::printf(
-        "the runs part at tick %" PRId64 " (t = %.9g s): state-hash %s here, %s in the log\n",
-        c.partTick, static_cast<double>(c.partTick) / static_cast<double>(log.header.stepRateHz),
-        hashToHex(c.runHash).c_str(), hashToHex(c.logHash).c_str());
-    std::string columns;
-    for (const std::string& name : c.columns) columns += " " + name;
-    std::printf("columns that differ:%s\n", columns.empty() ? " -" : columns.c_str());
-    if (c.row && c.row->column == "counters") {
-      std::printf("first difference: particle id %" PRIu64 ": %" PRIu64 " particles here, %" PRIu64
-                  " in the log\n",
-                  c.row->id, c.row->runBits, c.row->logBits);
-    } else if (c.row) {
-      std::printf("first difference: particle id %" PRIu64 ", %s: %s here, %s in the log\n",
-                  c.row->id, c.row->column.c_str(),
-                  describeBits(c.row->column, c.row->runBits).c_str(),
-                  describeBits(c.row->column, c.row->logBits).c_str());
-    } else if (!c.logHasState) {
-      std::printf("the log holds no state of tick %" PRId64
-                  ": record it again with --snapshot-at %" PRId64
-                  " to name the particle and both values\n",
-                  c.partTick, c.partTick);
-    }
+    reportParting(c, log);
     return kExitFailure;
   }
   if (c.partFrame >= 0) {
@@ -248,89 +259,138 @@ std::string hashAt(const DriveTrace& t, std::int64_t tick) {
   return "-";
 }
 
-}  // namespace
+// ---- the table: every frame schedule and thread count ------------------------------------------
 
-int determinismCommand(Arguments& args) {
-  if (args.flag("--help")) {
-    std::fputs(kDeterminismHelp, stdout);
-    return kExitOk;
-  }
-  const std::vector<std::string> overrides = args.values("--set");
-  const auto record = args.value("--record");
-  const auto compare = args.value("--compare");
-  if (record || compare) return logCommand(args, overrides, record, compare);
-  const double seconds =
+// What the table of runs was asked for (after --set, --record and --compare).
+struct TableSettings {
+  std::vector<std::string> overrides;
+  double seconds = 5.0;
+  std::vector<int> threads;
+  std::optional<std::string> frameTimes;
+  std::optional<std::filesystem::path> diffImage;
+  std::string effectPath;
+};
+
+TableSettings readTableSettings(Arguments& args, std::vector<std::string> overrides) {
+  TableSettings s;
+  s.overrides = std::move(overrides);
+  s.seconds =
       parseNumber(args.value("--seconds").value_or("5"), "determinism: --seconds", 0.001, 3600.0);
-  const std::vector<int> threads = parseThreadList(args.value("--threads").value_or("1,2,3,8"));
-  const auto frameTimes = args.value("--frame-times");
-  const std::optional<std::filesystem::path> diffImage = args.value("--diff-image");
-  const std::string path =
-      args.positionals(1, "one effect file: tickfx determinism EFFECT.toml")[0];
-  if (diffImage) {
+  s.threads = parseThreadList(args.value("--threads").value_or("1,2,3,8"));
+  s.frameTimes = args.value("--frame-times");
+  s.diffImage = args.value("--diff-image");
+  s.effectPath = args.positionals(1, "one effect file: tickfx determinism EFFECT.toml")[0];
+  return s;
+}
+
+// The table's runs, ready: the effect loaded and its drives made.
+struct PreparedTable {
+  io::LoadResult load;
+  std::int64_t rate = 0;      // the effect's step rate (Hz)
+  std::int64_t lastTick = 0;  // the tick the runs end at
+  std::vector<DriveCase> drives;
+
+  const io::EffectSettings& effect() const { return *load.effect; }
+};
+
+// Nothing after printing why not (bad input: exit 2).
+std::optional<PreparedTable> prepareTable(const TableSettings& s) {
+  if (s.diffImage) {
     try {
-      io::requireWritable(*diffImage);
+      io::requireWritable(*s.diffImage);
     } catch (const io::WriteError& e) {
       std::fprintf(stderr, "%s\n", e.what());
-      return kExitUsage;
+      return std::nullopt;
     }
   }
-
-  const io::LoadResult load = loadEffectReporting(path, overrides);
-  if (!load.ok()) return kExitUsage;
-  const io::EffectSettings& effect = *load.effect;
-  const Flicks total = flicksFromSeconds(seconds);
+  PreparedTable t;
+  t.load = loadEffectReporting(s.effectPath, s.overrides);
+  if (!t.load.ok()) return std::nullopt;
+  const Flicks total = flicksFromSeconds(s.seconds);
   std::optional<std::vector<Flicks>> recorded;
-  if (frameTimes) {
+  if (s.frameTimes) {
     try {
-      recorded = readFrameTimes(*frameTimes);
+      recorded = readFrameTimes(*s.frameTimes);
     } catch (const std::runtime_error& e) {
       std::fprintf(stderr, "%s\n", e.what());
-      return kExitUsage;
+      return std::nullopt;
     }
   }
+  t.rate = t.effect().simulation.stepRateHz;
+  t.lastTick =
+      static_cast<std::int64_t>((static_cast<__int128>(total) * t.rate) / kFlicksPerSecond);
+  t.drives = standardDriveCases(total, s.threads, recorded);
+  return t;
+}
 
-  const std::int64_t rate = effect.simulation.stepRateHz;
-  const std::int64_t lastTick =
-      static_cast<std::int64_t>((static_cast<__int128>(total) * rate) / kFlicksPerSecond);
+// Runs every drive, printing its row of the table as it ends; nothing after printing why a
+// drive could not run (bad input: exit 2).
+std::optional<std::vector<DriveTrace>> runDrives(const TableSettings& s, const PreparedTable& t) {
   std::printf("determinism: %s for %.6g s: %" PRId64 " ticks at %" PRId64 " Hz (%s)\n\n",
-              path.c_str(), seconds, lastTick, rate, effect.simulation.integrator.c_str());
+              s.effectPath.c_str(), s.seconds, t.lastTick, t.rate,
+              t.effect().simulation.integrator.c_str());
   std::printf("%-18s %7s %7s  %-16s  %-16s  %-16s %8s\n", "frames", "threads", "ticks",
               "hash at 1 s", "hash at 2 s", "hash at the end", "wall s");
-
   std::vector<DriveTrace> traces;
-  const std::vector<DriveCase> drives = standardDriveCases(total, threads, recorded);
   ProgressLine progress("schedules");
-  for (const DriveCase& drive : drives) {
+  for (const DriveCase& drive : t.drives) {
     const auto done = static_cast<std::int64_t>(traces.size());
-    progress.update(done, static_cast<std::int64_t>(drives.size()), drive.label);
+    progress.update(done, static_cast<std::int64_t>(t.drives.size()), drive.label);
     try {
-      traces.push_back(traceDrive(effect, drive));
+      traces.push_back(traceDrive(t.effect(), drive));
     } catch (const io::BuildError& e) {  // a vector field's file that does not load: bad input
       std::fprintf(stderr, "%s\n", e.what());
-      return kExitUsage;
+      return std::nullopt;
     }
-    const DriveTrace& t = traces.back();
+    const DriveTrace& r = traces.back();
     progress.finish();  // the row below replaces the line
-    std::printf("%-18s %7d %7zu  %-16s  %-16s  %-16s %8.3f%s\n", t.label.c_str(), t.threads,
-                t.ticks.size(), hashAt(t, rate).c_str(), hashAt(t, 2 * rate).c_str(),
-                hashAt(t, lastTick).c_str(), t.wallSeconds,
-                t.ticksDropped > 0 ? "  (ticks dropped!)" : "");
+    std::printf("%-18s %7d %7zu  %-16s  %-16s  %-16s %8.3f%s\n", r.label.c_str(), r.threads,
+                r.ticks.size(), hashAt(r, t.rate).c_str(), hashAt(r, 2 * t.rate).c_str(),
+                hashAt(r, t.lastTick).c_str(), r.wallSeconds,
+                r.ticksDropped > 0 ? "  (ticks dropped!)" : "");
     std::fflush(stdout);
   }
+  return traces;
+}
 
+// --diff-image: the state after tick d.tick of the first run, coloured by how far each particle
+// is from where the first run that differs has it.
+void writeDifferenceImage(const PreparedTable& t, const Divergence& d,
+                          const std::filesystem::path& path) {
+  const std::vector<DriveCase>& drives = t.drives;
+  const std::size_t other = d.runs.front();
+  // Named without quotes: the image's pixel font has none.
+  const auto name = [&](std::size_t r) {
+    return drives[r].label + " on " + std::to_string(drives[r].threads) +
+           (drives[r].threads == 1 ? " thread" : " threads");
+  };
+  const io::FrameData a = stateAfterTick(t.effect(), drives.front(), d.tick);
+  const io::FrameData b = stateAfterTick(t.effect(), drives[other], d.tick);
+  DifferenceSummary summary;
+  renderDifference(a, b, name(0), name(other), d.tick, 1280, 720, &summary).writePng(path);
+  std::printf("difference image: %s (tick %" PRId64
+              ", %s against %s: %zu particles differ, by "
+              "up to %.6g m)\n",
+              path.c_str(), d.tick, name(0).c_str(), name(other).c_str(), summary.differing,
+              summary.largest);
+}
+
+// The verdict under the table, and its exit code: 0 when every run agrees at every tick.
+int reportVerdict(const TableSettings& s, const PreparedTable& t,
+                  const std::vector<DriveTrace>& traces) {
   const Divergence d = firstDivergence(traces);
   std::printf("\n");
   if (d.tick < 0) {
     std::printf(
         "verdict: all %zu runs agree bit for bit after every one of %" PRId64
         " ticks (state-hash %s)\n",
-        traces.size(), lastTick,
+        traces.size(), t.lastTick,
         traces.front().hashes.empty() ? "-" : hashToHex(traces.front().hashes.back()).c_str());
-    if (diffImage) std::printf("no difference image: the runs agree\n");
+    if (s.diffImage) std::printf("no difference image: the runs agree\n");
     return kExitOk;
   }
   std::printf("verdict: runs part at tick %" PRId64 " (t = %.6g s):", d.tick,
-              static_cast<double>(d.tick) / static_cast<double>(rate));
+              static_cast<double>(d.tick) / static_cast<double>(t.rate));
   for (std::size_t r : d.runs)
     std::printf(" '%s, %d thread(s)'", traces[r].label.c_str(), traces[r].threads);
   std::printf(" differ from '%s, %d thread(s)'\n", traces.front().label.c_str(),
@@ -338,24 +398,27 @@ int determinismCommand(Arguments& args) {
   std::printf(
       "rerun two of them with `tickfx run ... --trace FILE` and compare the files to see the state "
       "there\n");
-  if (diffImage) {
-    const std::size_t other = d.runs.front();
-    // Named without quotes: the image's pixel font has none.
-    const auto name = [&](std::size_t r) {
-      return drives[r].label + " on " + std::to_string(drives[r].threads) +
-             (drives[r].threads == 1 ? " thread" : " threads");
-    };
-    const io::FrameData a = stateAfterTick(effect, drives.front(), d.tick);
-    const io::FrameData b = stateAfterTick(effect, drives[other], d.tick);
-    DifferenceSummary summary;
-    renderDifference(a, b, name(0), name(other), d.tick, 1280, 720, &summary).writePng(*diffImage);
-    std::printf("difference image: %s (tick %" PRId64
-                ", %s against %s: %zu particles differ, by "
-                "up to %.6g m)\n",
-                diffImage->c_str(), d.tick, name(0).c_str(), name(other).c_str(), summary.differing,
-                summary.largest);
-  }
+  if (s.diffImage) writeDifferenceImage(t, d, *s.diffImage);
   return kExitFailure;
+}
+
+}  // namespace
+
+int determinismCommand(Arguments& args) {
+  if (args.flag("--help")) {
+    std::fputs(kDeterminismHelp, stdout);
+    return kExitOk;
+  }
+  std::vector<std::string> overrides = args.values("--set");
+  const auto record = args.value("--record");
+  const auto compare = args.value("--compare");
+  if (record || compare) return logCommand(args, overrides, record, compare);
+  const TableSettings settings = readTableSettings(args, std::move(overrides));
+  const std::optional<PreparedTable> table = prepareTable(settings);
+  if (!table) return kExitUsage;
+  const std::optional<std::vector<DriveTrace>> traces = runDrives(settings, *table);
+  if (!traces) return kExitUsage;
+  return reportVerdict(settings, *table, *traces);
 }
 
 }  // namespace tickfx::app

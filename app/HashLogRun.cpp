@@ -4,10 +4,14 @@
 
 #include <algorithm>
 #include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "app/FrameTimes.h"
 #include "io/cache/FrameData.h"
 #include "io/effect/EffectBuilder.h"
+#include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {
@@ -53,6 +57,45 @@ void driveAsLogged(ParticleSystem& system, const io::HashLogHeader& h, OnFrame o
   }
 }
 
+// Refuses a log of another step rate, seed or effect, checked in that order (so that a --set of
+// the seed or the step rate is named as such).
+void checkLogIsOfEffect(const io::EffectSettings& effect, std::uint64_t fingerprint,
+                        const std::string& logName, const io::HashLogHeader& h) {
+  const std::string refused = logName + ": error: the log is of another ";
+  if (h.stepRateHz != effect.simulation.stepRateHz) {
+    throw HashLogRefused(refused + "step rate (" + std::to_string(h.stepRateHz) + " Hz, this run " +
+                         std::to_string(effect.simulation.stepRateHz) + " Hz)");
+  }
+  if (h.seed != effect.simulation.seed) {
+    throw HashLogRefused(refused + "seed (" + std::to_string(h.seed) + ", this run " +
+                         std::to_string(effect.simulation.seed) + ")");
+  }
+  if (h.fingerprint != fingerprint) {
+    throw HashLogRefused(refused + "effect (fingerprint " + hashToHex(h.fingerprint) +
+                         ", this run " + hashToHex(fingerprint) + ")");
+  }
+}
+
+// The first value of `pool` that differs from `snapshot` (the log's state after the same tick),
+// or else the first particle one of them lacks; nothing when they agree.
+std::optional<RowDifference> firstRowDifference(const ParticlePool& pool,
+                                                const io::HashLogSnapshot& snapshot,
+                                                const std::vector<std::string>& columns) {
+  const std::size_t common = std::min(pool.size(), snapshot.rows.size());
+  for (std::size_t row = 0; row < common; ++row) {
+    const std::vector<std::uint64_t> bits = stateRowBits(pool, row);
+    for (std::size_t k = 0; k < bits.size(); ++k) {
+      if (bits[k] != snapshot.rows[row][k])
+        return RowDifference{pool.id()[row], columns[k + 1], bits[k], snapshot.rows[row][k]};
+    }
+  }
+  if (pool.size() == snapshot.rows.size()) return std::nullopt;
+  // Every common row agrees: one run has particles the other has not.
+  const std::size_t first = common;
+  const std::uint64_t id = first < pool.size() ? pool.id()[first] : snapshot.rows[first][0];
+  return RowDifference{id, "counters", pool.size(), snapshot.rows.size()};
+}
+
 }  // namespace
 
 io::HashLogHeader describeThisBuild() {
@@ -95,19 +138,7 @@ io::HashLog recordHashLog(const io::EffectSettings& effect, io::HashLogHeader he
 LogComparison compareWithHashLog(const io::EffectSettings& effect, std::uint64_t fingerprint,
                                  const std::string& logName, const io::HashLog& log) {
   const io::HashLogHeader& h = log.header;
-  const std::string refused = logName + ": error: the log is of another ";
-  if (h.stepRateHz != effect.simulation.stepRateHz) {
-    throw HashLogRefused(refused + "step rate (" + std::to_string(h.stepRateHz) + " Hz, this run " +
-                         std::to_string(effect.simulation.stepRateHz) + " Hz)");
-  }
-  if (h.seed != effect.simulation.seed) {
-    throw HashLogRefused(refused + "seed (" + std::to_string(h.seed) + ", this run " +
-                         std::to_string(effect.simulation.seed) + ")");
-  }
-  if (h.fingerprint != fingerprint) {
-    throw HashLogRefused(refused + "effect (fingerprint " + hashToHex(h.fingerprint) +
-                         ", this run " + hashToHex(fingerprint) + ")");
-  }
+  checkLogIsOfEffect(effect, fingerprint, logName, h);
   const auto system = io::buildOfflineSystem(effect, std::nullopt);
   const std::vector<std::string> columns = stateColumnNames(system->pool());
   if (columns != h.columns) {
@@ -145,22 +176,7 @@ LogComparison compareWithHashLog(const io::EffectSettings& effect, std::uint64_t
                      [&](const io::HashLogSnapshot& snap) { return snap.tick == tick; });
     if (snapshot == log.snapshots.end()) return;
     c.logHasState = true;
-    const std::size_t common = std::min(pool.size(), snapshot->rows.size());
-    for (std::size_t row = 0; row < common && !c.row; ++row) {
-      const std::vector<std::uint64_t> bits = stateRowBits(pool, row);
-      for (std::size_t k = 0; k < bits.size(); ++k) {
-        if (bits[k] != snapshot->rows[row][k]) {
-          c.row = RowDifference{pool.id()[row], columns[k + 1], bits[k], snapshot->rows[row][k]};
-          break;
-        }
-      }
-    }
-    if (!c.row && pool.size() != snapshot->rows.size()) {
-      // Every common row agrees: one run has particles the other has not.
-      const std::size_t first = common;
-      const std::uint64_t id = first < pool.size() ? pool.id()[first] : snapshot->rows[first][0];
-      c.row = RowDifference{id, "counters", pool.size(), snapshot->rows.size()};
-    }
+    c.row = firstRowDifference(pool, *snapshot, columns);
   });
   driveAsLogged(*system, h, [&](std::int64_t frame, const io::FrameData& data) {
     c.frames = frame;

@@ -396,52 +396,70 @@ std::string windCsv(const StudyResults& results) {
   return text;
 }
 
+namespace {
+
+double secondsAtTick(std::int64_t tick, std::int64_t rate) {
+  return static_cast<double>(tick) / static_cast<double>(rate);
+}
+
+// Rows of series_constant_acceleration.csv: `integrator` at `rate`, every tick from t = 0.
+void appendConstantAccelerationSeries(std::string& csv, const std::string& integrator,
+                                      std::int64_t rate) {
+  ForceSet forces = constantAccelerationForces();
+  const auto row = [&](std::int64_t tick, float p) {
+    const double t = secondsAtTick(tick, rate), exact = exactConstantAccelerationPosition(t);
+    csv += csvRow({integrator, csvInteger(rate), csvNumber(t), csvNumber(p), csvNumber(exact),
+                   csvNumber(p - exact)});
+  };
+  row(0, 0.0f);
+  simulate(integrator, forces, rate, wholeTicks(kSeriesConstantAccelerationSeconds, rate), 0.0f,
+           0.0f, [&](std::int64_t tick, float p, float) { row(tick, p); });
+}
+
+// Rows of series_oscillator.csv: `integrator` at `rate` for `duration` seconds.
+void appendOscillatorSeries(std::string& csv, const std::string& integrator, std::int64_t rate,
+                            double duration) {
+  ForceSet forces = oscillatorForces();
+  const auto row = [&](std::int64_t tick, float p, float v) {
+    csv += csvRow({integrator, csvInteger(rate), csvNumber(secondsAtTick(tick, rate)), csvNumber(p),
+                   csvNumber(v), csvNumber(energyOf(p, v))});
+  };
+  const auto start = static_cast<float>(kStudyOscillatorStart);
+  row(0, start, 0.0f);
+  simulate(integrator, forces, rate, wholeTicks(duration, rate), start, 0.0f, row);
+}
+
+// Rows of series_wind.csv: semi-implicit Euler at `rate` in a wind of `frequency` Hz.
+void appendWindSeries(std::string& csv, std::int64_t rate, double frequency, double duration) {
+  ForceSet forces = windForces(frequency);
+  const std::string integrator = "semi_implicit_euler";
+  const auto row = [&](std::int64_t tick, float p) {
+    const double t = secondsAtTick(tick, rate);
+    csv += csvRow({integrator, csvInteger(rate), csvNumber(frequency), csvNumber(t), csvNumber(p),
+                   csvNumber(exactWindPosition(frequency, t))});
+  };
+  row(0, 0.0f);
+  simulate(integrator, forces, rate, wholeTicks(duration, rate), 0.0f, 0.0f,
+           [&](std::int64_t tick, float p, float) { row(tick, p); });
+}
+
+}  // namespace
+
 std::vector<std::filesystem::path> writeStudySeriesCsv(const StudyPlan& plan,
                                                        const std::filesystem::path& dir) {
   std::string gravity = "integrator,step_rate_hz,t,position,exact,error\n";
   std::string oscillator = "integrator,step_rate_hz,t,position,velocity,energy\n";
   std::string wind = "integrator,step_rate_hz,frequency_hz,t,position,exact\n";
-  const auto seconds = [](std::int64_t tick, std::int64_t rate) {
-    return static_cast<double>(tick) / static_cast<double>(rate);
-  };
   for (const std::string& integrator :
        plan.integrators.empty() ? integratorNames() : plan.integrators) {
-    for (const std::int64_t rate : plan.stepRatesHz) {
-      ForceSet forces = constantAccelerationForces();
-      const auto row = [&](std::int64_t tick, float p) {
-        const double t = seconds(tick, rate), exact = exactConstantAccelerationPosition(t);
-        gravity += csvRow({integrator, csvInteger(rate), csvNumber(t), csvNumber(p),
-                           csvNumber(exact), csvNumber(p - exact)});
-      };
-      row(0, 0.0f);
-      simulate(integrator, forces, rate, wholeTicks(kSeriesConstantAccelerationSeconds, rate), 0.0f,
-               0.0f, [&](std::int64_t tick, float p, float) { row(tick, p); });
-    }
-    for (const std::int64_t rate : plan.oscillatorStepRatesHz) {
-      ForceSet forces = oscillatorForces();
-      const auto row = [&](std::int64_t tick, float p, float v) {
-        oscillator += csvRow({integrator, csvInteger(rate), csvNumber(seconds(tick, rate)),
-                              csvNumber(p), csvNumber(v), csvNumber(energyOf(p, v))});
-      };
-      const auto start = static_cast<float>(kStudyOscillatorStart);
-      row(0, start, 0.0f);
-      simulate(integrator, forces, rate, wholeTicks(plan.oscillatorDuration, rate), start, 0.0f,
-               row);
-    }
+    for (const std::int64_t rate : plan.stepRatesHz)
+      appendConstantAccelerationSeries(gravity, integrator, rate);
+    for (const std::int64_t rate : plan.oscillatorStepRatesHz)
+      appendOscillatorSeries(oscillator, integrator, rate, plan.oscillatorDuration);
   }
   const double frequency = plan.windFrequenciesHz.empty() ? 16.0 : plan.windFrequenciesHz.back();
-  for (const std::int64_t rate : kSeriesWindStepRatesHz) {
-    ForceSet forces = windForces(frequency);
-    const std::string integrator = "semi_implicit_euler";
-    const auto row = [&](std::int64_t tick, float p) {
-      const double t = seconds(tick, rate);
-      wind += csvRow({integrator, csvInteger(rate), csvNumber(frequency), csvNumber(t),
-                      csvNumber(p), csvNumber(exactWindPosition(frequency, t))});
-    };
-    row(0, 0.0f);
-    simulate(integrator, forces, rate, wholeTicks(plan.windDuration, rate), 0.0f, 0.0f,
-             [&](std::int64_t tick, float p, float) { row(tick, p); });
-  }
+  for (const std::int64_t rate : kSeriesWindStepRatesHz)
+    appendWindSeries(wind, rate, frequency, plan.windDuration);
   return writeFiles(dir, {{"series_constant_acceleration.csv", gravity},
                           {"series_oscillator.csv", oscillator},
                           {"series_wind.csv", wind}});

@@ -1,4 +1,7 @@
 // tickfx preview: an effect's frames, or a folder of caches, rendered to PNG without a DCC.
+// The command runs in stages: its settings (app/PreviewSettings.h), the prepared preview (the
+// input opened, the output folder made, the framing pass walked, cameras and flipbooks made),
+// the frames rendered, then the report.
 #include <algorithm>
 #include <cinttypes>
 #include <cmath>
@@ -7,22 +10,26 @@
 #include <functional>
 #include <future>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "app/Commands.h"
+#include "app/PreviewSettings.h"
 #include "app/PreviewSource.h"
 #include "app/ProgressLine.h"
-#include "io/util/AtomicFile.h"
-#include "io/cache/FrameCaches.h"
 #include "app/preview/ColourBy.h"
 #include "app/preview/FfmpegMovie.h"
 #include "app/preview/FrameRenderer.h"
 #include "app/preview/GifFlipbook.h"
 #include "app/preview/PinholeCamera.h"
 #include "app/preview/SceneGuides.h"
+#include "io/cache/FrameCaches.h"
+#include "io/util/AtomicFile.h"
 
 namespace tickfx::app {
 namespace {
@@ -76,42 +83,6 @@ constexpr preview::Rgb kBackground{24, 24, 28};
 constexpr std::int64_t kSheetCells = 64;
 constexpr double kFramingMargin = 0.1;
 
-struct Size {
-  int width = 1280;
-  int height = 720;
-};
-
-Size parseSize(const std::string& text) {
-  const UsageError refused("preview: --size: '" + text +
-                           "' is not WxH with whole numbers from 1 to " +
-                           std::to_string(preview::SplatImage::kMaxSide));
-  const std::size_t x = text.find('x');
-  if (x == std::string::npos) throw refused;
-  try {
-    return {
-        static_cast<int>(parseInteger(text.substr(0, x), "--size", 1, preview::SplatImage::kMaxSide)),
-        static_cast<int>(parseInteger(text.substr(x + 1), "--size", 1, preview::SplatImage::kMaxSide))};
-  } catch (const UsageError&) {
-    throw refused;
-  }
-}
-
-preview::UpAxis parseUp(const std::string& text) {
-  if (text == "y") return preview::UpAxis::Y;
-  if (text == "z") return preview::UpAxis::Z;
-  throw UsageError("preview: --up: '" + text + "' (expected y or z)");
-}
-
-Eigen::Vector3d parsePoint(const std::string& option, const std::optional<std::string>& text) {
-  try {
-    const std::vector<double> v = parseNumberList(*text, option, 3, "x,y,z", -1e9, 1e9);
-    return {v[0], v[1], v[2]};
-  } catch (const UsageError&) {
-    throw UsageError("preview: " + option + ": '" + *text +
-                     "' is not a point X,Y,Z (metres, three numbers from -1e9 to 1e9)");
-  }
-}
-
 // The particles' bounds and the colouring value's range over the whole run.
 struct RunExtent {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
@@ -155,88 +126,11 @@ class OutputFolder {
   bool made_ = false;
 };
 
-// Everything the command line asks for, read and checked before anything runs.
-struct PreviewOptions {
-  std::string input;
-  std::vector<std::string> overrides;
-  std::filesystem::path out;
-  Size size;
-  std::string colour;
-  std::optional<std::string> frames;
-  long long every = 1;
-  preview::SplatSize splatSize;
-  std::optional<Eigen::Vector3d> eye, target;
-  double fov = 40.0;
-  preview::UpAxis up = preview::UpAxis::Y;
-  bool guides = true;
-  bool sheet = false;
-  bool gif = false;
-  std::optional<std::filesystem::path> ffmpeg;  // --mp4
-  std::size_t keepBytes = std::size_t{1} << 30;
-
-  // The camera at --camera looking at `look`; a camera that sees nothing is a usage error.
-  preview::PinholeCamera cameraAt(const Eigen::Vector3d& look, int width, int height) const {
-    try {
-      return preview::PinholeCamera(*eye, look, preview::upVector(up), fov, width, height);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("preview: --camera: ") + e.what());
-    }
-  }
-};
-
-PreviewOptions readOptions(Arguments& args) {
-  PreviewOptions o;
-  o.overrides = args.values("--set");
-  o.out = args.value("--out").value_or("out/preview");
-  o.size = parseSize(args.value("--size").value_or("1280x720"));
-  o.colour = args.value("--color").value_or("");  // empty: Cd when the frames have it, else speed
-  o.frames = args.value("--frames");
-  o.every = parseInteger(args.value("--every").value_or("1"), "preview: --every", 1, 1'000'000);
-  const auto pointSize = args.value("--point-size");
-  const auto radius = args.value("--radius");
-  const auto eye = args.value("--camera");
-  const auto lookat = args.value("--lookat");
-  o.fov = parseNumber(args.value("--fov").value_or("40"), "preview: --fov", 1.0, 170.0);
-  o.up = parseUp(args.value("--up").value_or("y"));
-  o.guides = !args.flag("--no-guides");
-  o.sheet = args.flag("--sheet");
-  o.gif = args.flag("--gif");
-  o.keepBytes = static_cast<std::size_t>(parseInteger(args.value("--keep-mb").value_or("1024"),
-                                                      "preview: --keep-mb", 0, 1 << 20))
-                << 20;
-  const bool mp4 = args.flag("--mp4");
-  o.input = args.positionals(1, "one effect file or cache folder: tickfx preview EFFECT.toml")[0];
-
-  if (pointSize && radius) {
-    throw UsageError("preview: --point-size and --radius each set the splat size: give one");
-  }
-  if (pointSize) {
-    o.splatSize.diameterPixels =
-        static_cast<double>(parseInteger(*pointSize, "preview: --point-size", 1, 100));
-  }
-  if (radius) o.splatSize.radiusMetres = parseNumber(*radius, "preview: --radius", 1e-6, 1e6);
-  if (lookat && !eye) {
-    throw UsageError("preview: --lookat needs --camera (without it the camera frames the run)");
-  }
-  if (eye) o.eye = parsePoint("--camera", eye);
-  if (lookat) o.target = parsePoint("--lookat", lookat);
-  if (o.eye && o.target) o.cameraAt(*o.target, o.size.width, o.size.height);
-  if (mp4) {
-    o.ffmpeg = preview::findFfmpeg();
-    if (!o.ffmpeg) {
-      throw UsageError(
-          "preview: --mp4 needs ffmpeg, which is not installed (Debian: apt-get install ffmpeg; "
-          "--gif needs nothing more)");
-    }
-  }
-  return o;
-}
-
 // The contact sheet: every rendered frame (every stride-th past 64) in cells a quarter the size,
 // four a row.
 class ContactSheet {
  public:
-  ContactSheet(std::int64_t rendered, Size size) {
+  ContactSheet(std::int64_t rendered, ImageSize size) {
     rendered = std::max<std::int64_t>(rendered, 1);
     stride_ = (rendered + kSheetCells - 1) / kSheetCells;
     cells_ = (rendered + stride_ - 1) / stride_;
@@ -341,6 +235,239 @@ std::string captionOf(const PreviewSource& source, const io::FrameData& frame,
   return caption;
 }
 
+// ---- the prepared preview -----------------------------------------------------------------------
+
+// The frames to render: A..B, every Nth from A.
+struct FrameRange {
+  std::int64_t first = 0, last = 0;
+  long long every = 1;
+
+  bool wants(std::int64_t f) const { return f >= first && f <= last && (f - first) % every == 0; }
+};
+
+// The input to render, how to colour it and which of its frames, ready to render: the output
+// folder made, the framing pass walked, the cameras, guides and flipbooks made.
+struct PreparedPreview {
+  PreparedPreview(std::unique_ptr<PreviewSource> from, preview::ColourBy by, std::size_t keepBytes)
+      : source(std::move(from)), colour(std::move(by)), kept(keepBytes) {}
+
+  std::unique_ptr<PreviewSource> source;
+  preview::ColourBy colour;
+  FrameRange range;
+  std::optional<OutputFolder> out;
+  // The framing pass: the whole run's extent and the frames to render, counted and kept.
+  RunExtent extent;
+  std::int64_t rendered = 0;
+  KeptFrames kept;
+  std::optional<preview::PinholeCamera> camera, cellCamera;
+  std::optional<ContactSheet> sheet;
+  preview::RenderSettings render;
+  bool legend = false;
+  int textScale = 1;
+  std::optional<preview::GifFlipbook> gif;
+  std::optional<preview::FfmpegMovie> movie;
+
+  const std::filesystem::path& outDir() const { return out->path(); }
+};
+
+// --color, or by default Cd when the frames have it, else speed.
+preview::ColourBy chooseColour(const std::string& name, const PreviewSource& source) {
+  try {
+    const io::FrameData sample = source.sample();
+    if (!name.empty()) return preview::ColourBy::parse(name, sample);
+    const std::vector<std::string> choices = preview::ColourBy::choices(sample);
+    const bool hasCd = std::find(choices.begin(), choices.end(), "Cd") != choices.end();
+    return preview::ColourBy::parse(hasCd ? "Cd" : "speed", sample);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("preview: --color: ") + e.what());
+  }
+}
+
+// --frames and --every, within the source's frames.
+FrameRange chooseFrames(const PreviewSettings& o, const PreviewSource& source, bool folder) {
+  FrameRange range{source.frames().front(), source.frames().back(), o.every};
+  if (o.frames) {
+    const UsageError refused("preview: --frames: '" + *o.frames + "' is not a range A..B of this " +
+                             (folder ? "folder's" : "effect's") + " frames (" +
+                             std::to_string(range.first) + ".." + std::to_string(range.last) + ")");
+    std::tie(range.first, range.last) = parseRange(*o.frames, range.first, range.last, refused);
+  }
+  return range;
+}
+
+// The input opened and checked, and the output folder made; nothing after printing why not (bad
+// input: exit 2).
+std::unique_ptr<PreparedPreview> openPreview(const PreviewSettings& o) {
+  std::unique_ptr<PreviewSource> source = openPreviewSource(o.input, o.overrides);
+  if (!source) return nullptr;
+  const bool folder = std::filesystem::is_directory(o.input);
+  if (folder && !o.overrides.empty()) {
+    throw UsageError("preview: --set changes an effect file; " + o.input + " is a cache folder");
+  }
+  preview::ColourBy colour = chooseColour(o.colour, *source);
+  auto p = std::make_unique<PreparedPreview>(std::move(source), std::move(colour), o.keepBytes);
+  p->range = chooseFrames(o, *p->source, folder);
+  try {
+    p->out.emplace(o.out);
+    io::requireWritable(io::cacheFilePath(o.out, p->range.first, "png"));
+  } catch (const std::runtime_error& e) {  // WriteError too
+    std::fprintf(stderr, "%s\n", e.what());
+    if (p->out) p->out->abandon();
+    return nullptr;
+  }
+  return p;
+}
+
+// The framing pass, then the cameras that see what it found (and the contact sheet's).
+void frameRun(PreparedPreview& p, const PreviewSettings& o) {
+  const FrameRange range = p.range;
+  p.extent = scanRun(
+      *p.source, p.colour, [range](std::int64_t f) { return range.wants(f); }, p.rendered, p.kept);
+  const Eigen::Vector3d centre = 0.5 * (p.extent.lo + p.extent.hi);
+  const auto cameraFor = [&](int width, int height) {
+    return o.eye
+               ? o.cameraAt(o.target.value_or(centre), width, height)
+               : preview::PinholeCamera::framing(p.extent.lo, p.extent.hi, preview::upVector(o.up),
+                                                 o.fov, width, height, kFramingMargin);
+  };
+  try {
+    p.camera.emplace(cameraFor(o.size.width, o.size.height));
+    if (o.sheet) {
+      p.sheet.emplace(p.rendered, o.size);
+      p.cellCamera.emplace(cameraFor(p.sheet->cellWidth(), p.sheet->cellHeight()));
+    }
+  } catch (const UsageError&) {
+    p.out->abandon();
+    throw;
+  }
+}
+
+// The guides, the legend and the flipbooks.
+void setUpRendering(PreparedPreview& p, const PreviewSettings& o) {
+  p.render.background = kBackground;
+  p.render.size = o.splatSize;
+  if (o.guides) {
+    p.render.grid = preview::GroundGrid::under(p.extent.lo, p.extent.hi, o.up);
+    if (p.render.grid) p.render.axisLength = p.render.grid->spacing;
+  }
+  p.legend = o.guides && !p.colour.ownColours();
+  p.textScale = o.size.width >= 640 ? 2 : 1;
+  if (o.gif) {
+    p.gif.emplace(o.size.width, o.size.height, preview::GifFlipbook::delayFor(p.source->fps()),
+                  p.render.background);
+  }
+  if (o.ffmpeg) {
+    p.movie.emplace(*o.ffmpeg, p.outDir() / "flipbook.mp4", o.size.width, o.size.height,
+                    p.source->fps());
+  }
+}
+
+// Everything before the first frame is rendered; nothing after printing why not (exit 2).
+std::unique_ptr<PreparedPreview> preparePreview(const PreviewSettings& o) {
+  std::unique_ptr<PreparedPreview> p = openPreview(o);
+  if (!p) return nullptr;
+  frameRun(*p, o);
+  setUpRendering(*p, o);
+  return p;
+}
+
+// ---- the frames ---------------------------------------------------------------------------------
+
+// The second walk: each frame asked for rendered, captioned and written as PNG (and added to the
+// flipbooks and the contact sheet). The previous frame's PNG (and flipbook frame) is encoded on a
+// thread of its own while this one simulates and renders: one frame in flight, so files and
+// flipbook frames keep their order.
+class FrameRendering {
+ public:
+  explicit FrameRendering(PreparedPreview& p) : p_(p) {}
+
+  // Renders every frame of the range; returns how many.
+  std::int64_t run() {
+    if (p_.kept.whole()) {
+      for (const auto& [frame, lines] : p_.kept.frames()) renderOne(frame, lines);
+    } else {
+      const FrameRange range = p_.range;
+      p_.source->walk(
+          range.last, [range](std::int64_t f) { return range.wants(f); },
+          [this](const io::FrameData& frame, const IdPairs& lines) { renderOne(frame, lines); });
+    }
+    if (encoding_.valid()) encoding_.get();
+    progress_.finish();
+    return written_;
+  }
+
+ private:
+  preview::SplatImage render(const preview::PinholeCamera& view, const io::FrameData& frame,
+                             const IdPairs& lines) const {
+    return preview::renderFrame(view, frame,
+                                p_.colour.colours(frame, p_.extent.valueLo, p_.extent.valueHi),
+                                lines, p_.render);
+  }
+
+  void renderOne(const io::FrameData& frame, const IdPairs& lines) {
+    const std::int64_t f = frame.frame;
+    preview::SplatImage image = render(*p_.camera, frame, lines);
+    preview::drawCaption(image, captionOf(*p_.source, frame, p_.render), p_.textScale);
+    if (p_.legend) {
+      preview::drawLegend(image, p_.colour.title(), p_.extent.valueLo, p_.extent.valueHi,
+                          p_.textScale);
+    }
+    if (encoding_.valid()) encoding_.get();
+    encoding_ = std::async(std::launch::async, [this, f, done = std::move(image)] {
+      done.writePng(io::cacheFilePath(p_.outDir(), f, "png"));
+      if (p_.gif) p_.gif->add(done);
+      if (p_.movie) p_.movie->add(done);
+    });
+    if (p_.sheet && p_.sheet->takes(written_)) {
+      preview::SplatImage cell = render(*p_.cellCamera, frame, lines);
+      preview::drawCaption(cell, "frame " + std::to_string(f), 1);
+      p_.sheet->place(written_, cell);
+    }
+    ++written_;
+    progress_.update(written_, p_.rendered, io::cacheFilePath(p_.outDir(), f, "png").string());
+  }
+
+  PreparedPreview& p_;
+  ProgressLine progress_{"frames"};
+  std::int64_t written_ = 0;
+  std::future<void> encoding_;
+};
+
+// ---- the report ---------------------------------------------------------------------------------
+
+// The contact sheet and the flipbooks, written once every frame is. The exit code when the movie
+// fails (reported), else nothing.
+std::optional<int> finishFlipbooks(PreparedPreview& p) {
+  if (p.sheet) p.sheet->image().writePng(p.outDir() / "sheet.png");
+  if (p.gif) p.gif->write(p.outDir() / "flipbook.gif");
+  if (p.movie) {
+    try {
+      p.movie->finish();
+    } catch (const std::runtime_error& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      return kExitFailure;
+    }
+  }
+  return std::nullopt;
+}
+
+void printPreviewSummary(const PreparedPreview& p, const PreviewSettings& o, std::int64_t written) {
+  const std::filesystem::path& outDir = p.outDir();
+  std::printf("%s: %" PRId64 " frames rendered to %s (%dx%d), frames %" PRId64 "..%" PRId64
+              " every %lld\n",
+              o.input.c_str(), written, outDir.string().c_str(), o.size.width, o.size.height,
+              p.range.first, p.range.last, p.range.every);
+  if (p.sheet) {
+    std::printf("sheet: %s (%" PRId64 " frames, %dx%d cells)\n", (outDir / "sheet.png").c_str(),
+                p.sheet->cells(), p.sheet->cellWidth(), p.sheet->cellHeight());
+  }
+  if (p.gif) {
+    std::printf("flipbook: %s (%zu frames, %d/100 s each)\n", (outDir / "flipbook.gif").c_str(),
+                p.gif->frameCount(), preview::GifFlipbook::delayFor(p.source->fps()));
+  }
+  if (p.movie) std::printf("movie: %s\n", (outDir / "flipbook.mp4").c_str());
+}
+
 }  // namespace
 
 int previewCommand(Arguments& args) {
@@ -348,152 +475,12 @@ int previewCommand(Arguments& args) {
     std::fputs(kPreviewHelp, stdout);
     return kExitOk;
   }
-  const PreviewOptions options = readOptions(args);
-  const std::unique_ptr<PreviewSource> source = openPreviewSource(options.input, options.overrides);
-  if (!source) return kExitUsage;
-  const bool folder = std::filesystem::is_directory(options.input);
-  if (folder && !options.overrides.empty()) {
-    throw UsageError("preview: --set changes an effect file; " + options.input +
-                     " is a cache folder");
-  }
-  const preview::ColourBy colour = [&] {
-    try {
-      const io::FrameData sample = source->sample();
-      if (!options.colour.empty()) return preview::ColourBy::parse(options.colour, sample);
-      const std::vector<std::string> choices = preview::ColourBy::choices(sample);
-      const bool hasCd = std::find(choices.begin(), choices.end(), "Cd") != choices.end();
-      return preview::ColourBy::parse(hasCd ? "Cd" : "speed", sample);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("preview: --color: ") + e.what());
-    }
-  }();
-  std::int64_t first = source->frames().front(), last = source->frames().back();
-  if (options.frames) {
-    const UsageError refused("preview: --frames: '" + *options.frames +
-                             "' is not a range A..B of this " + (folder ? "folder's" : "effect's") +
-                             " frames (" + std::to_string(first) + ".." + std::to_string(last) +
-                             ")");
-    std::tie(first, last) = parseRange(*options.frames, first, last, refused);
-  }
-  const long long every = options.every;
-  const auto wanted = [&](std::int64_t f) {
-    return f >= first && f <= last && (f - first) % every == 0;
-  };
-  const std::filesystem::path& outDir = options.out;
-  const Size size = options.size;
-
-  std::optional<OutputFolder> out;
-  try {
-    out.emplace(outDir);
-    io::requireWritable(io::cacheFilePath(outDir, first, "png"));
-  } catch (const std::runtime_error& e) {  // WriteError too
-    std::fprintf(stderr, "%s\n", e.what());
-    if (out) out->abandon();
-    return kExitUsage;
-  }
-
-  std::int64_t rendered = 0;
-  KeptFrames kept(options.keepBytes);
-  const RunExtent extent = scanRun(*source, colour, wanted, rendered, kept);
-  const Eigen::Vector3d centre = 0.5 * (extent.lo + extent.hi);
-  const auto cameraFor = [&](int width, int height) {
-    return options.eye ? options.cameraAt(options.target.value_or(centre), width, height)
-                       : preview::PinholeCamera::framing(extent.lo, extent.hi, preview::upVector(options.up),
-                                                    options.fov, width, height, kFramingMargin);
-  };
-  std::optional<preview::PinholeCamera> camera, cellCamera;
-  std::optional<ContactSheet> sheet;
-  try {
-    camera.emplace(cameraFor(size.width, size.height));
-    if (options.sheet) {
-      sheet.emplace(rendered, size);
-      cellCamera.emplace(cameraFor(sheet->cellWidth(), sheet->cellHeight()));
-    }
-  } catch (const UsageError&) {
-    out->abandon();
-    throw;
-  }
-
-  preview::RenderSettings settings;
-  settings.background = kBackground;
-  settings.size = options.splatSize;
-  if (options.guides) {
-    settings.grid = preview::GroundGrid::under(extent.lo, extent.hi, options.up);
-    if (settings.grid) settings.axisLength = settings.grid->spacing;
-  }
-  const bool legend = options.guides && !colour.ownColours();
-  const int textScale = size.width >= 640 ? 2 : 1;
-  const auto render = [&](const preview::PinholeCamera& view, const io::FrameData& frame,
-                          const IdPairs& lines) {
-    return preview::renderFrame(view, frame, colour.colours(frame, extent.valueLo, extent.valueHi),
-                           lines, settings);
-  };
-  std::optional<preview::GifFlipbook> gif;
-  if (options.gif) {
-    gif.emplace(size.width, size.height, preview::GifFlipbook::delayFor(source->fps()),
-                settings.background);
-  }
-  std::optional<preview::FfmpegMovie> movie;
-  if (options.ffmpeg) {
-    movie.emplace(*options.ffmpeg, outDir / "flipbook.mp4", size.width, size.height, source->fps());
-  }
-
-  // Second walk: the frames asked for.
-  ProgressLine progress("frames");
-  std::int64_t written = 0;
-  std::future<void> encoding;
-  const auto renderOne = [&](const io::FrameData& frame, const IdPairs& lines) {
-    const std::int64_t f = frame.frame;
-    preview::SplatImage image = render(*camera, frame, lines);
-    preview::drawCaption(image, captionOf(*source, frame, settings), textScale);
-    if (legend) preview::drawLegend(image, colour.title(), extent.valueLo, extent.valueHi, textScale);
-    // The previous frame's PNG (and flipbook frame) is encoded on a thread of its own while this
-    // one simulates and renders: one frame in flight, so files and flipbook frames keep their
-    // order.
-    if (encoding.valid()) encoding.get();
-    encoding = std::async(std::launch::async, [&, f, done = std::move(image)] {
-      done.writePng(io::cacheFilePath(outDir, f, "png"));
-      if (gif) gif->add(done);
-      if (movie) movie->add(done);
-    });
-    if (sheet && sheet->takes(written)) {
-      preview::SplatImage cell = render(*cellCamera, frame, lines);
-      preview::drawCaption(cell, "frame " + std::to_string(f), 1);
-      sheet->place(written, cell);
-    }
-    ++written;
-    progress.update(written, rendered, io::cacheFilePath(outDir, f, "png").string());
-  };
-  if (kept.whole()) {
-    for (const auto& [frame, lines] : kept.frames()) renderOne(frame, lines);
-  } else {
-    source->walk(last, wanted, renderOne);
-  }
-  if (encoding.valid()) encoding.get();
-  progress.finish();
-  if (sheet) sheet->image().writePng(outDir / "sheet.png");
-  if (gif) gif->write(outDir / "flipbook.gif");
-  if (movie) {
-    try {
-      movie->finish();
-    } catch (const std::runtime_error& e) {
-      std::fprintf(stderr, "%s\n", e.what());
-      return kExitFailure;
-    }
-  }
-  std::printf("%s: %" PRId64 " frames rendered to %s (%dx%d), frames %" PRId64 "..%" PRId64
-              " every %lld\n",
-              options.input.c_str(), written, outDir.string().c_str(), size.width, size.height,
-              first, last, every);
-  if (sheet) {
-    std::printf("sheet: %s (%" PRId64 " frames, %dx%d cells)\n", (outDir / "sheet.png").c_str(),
-                sheet->cells(), sheet->cellWidth(), sheet->cellHeight());
-  }
-  if (gif) {
-    std::printf("flipbook: %s (%zu frames, %d/100 s each)\n", (outDir / "flipbook.gif").c_str(),
-                gif->frameCount(), preview::GifFlipbook::delayFor(source->fps()));
-  }
-  if (movie) std::printf("movie: %s\n", (outDir / "flipbook.mp4").c_str());
+  const PreviewSettings settings = readPreviewSettings(args);
+  const std::unique_ptr<PreparedPreview> prepared = preparePreview(settings);
+  if (!prepared) return kExitUsage;
+  const std::int64_t written = FrameRendering(*prepared).run();
+  if (const std::optional<int> failed = finishFlipbooks(*prepared)) return *failed;
+  printPreviewSummary(*prepared, settings, written);
   return kExitOk;
 }
 

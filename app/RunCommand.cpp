@@ -1,32 +1,34 @@
 // tickfx run: simulate an effect through the fixed-step driver and write one cache per frame.
+// The command runs in stages: its settings (app/RunSettings.h), the prepared run (the system built
+// and resumed, every output checked), the frames, then the report.
+#include <algorithm>
 #include <chrono>
-#include <cinttypes>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <memory>
 #include <optional>
-#include <sstream>
+#include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/Commands.h"
+#include "app/FrameTimes.h"
 #include "app/Interrupt.h"
 #include "app/LoadEffect.h"
 #include "app/ProgressLine.h"
-#include "io/util/AtomicFile.h"
-#include "app/FrameTimes.h"
+#include "app/RunSettings.h"
 #include "io/cache/BackgroundWriter.h"
-#include "io/state/Checkpoint.h"
-#include "io/cache/CsvCache.h"
 #include "io/cache/FrameCaches.h"
 #include "io/cache/FrameData.h"
-#include "io/cache/PlyCache.h"
-#include "io/state/StateDump.h"
-#include "io/cache/VdbPointCache.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
+#include "io/state/Checkpoint.h"
+#include "io/state/StateDump.h"
+#include "io/util/AtomicFile.h"
+#include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {
@@ -69,87 +71,106 @@ constexpr const char* kRunHelp =
     "  --threads N           worker threads (default: the effect's, 0 = all cores)\n"
     "  --quiet               no summary (errors, warnings and --hash lines still print)\n";
 
-std::vector<io::CacheFormat> parseFormats(const std::string& text) {
-  std::vector<io::CacheFormat> formats;
-  if (text == "none") return formats;
-  std::stringstream list(text);
-  std::string name;
-  while (std::getline(list, name, ',')) {
-    const std::optional<io::CacheFormat> f = io::cacheFormatFromName(name);
-    if (!f) {
-      throw UsageError("run: --format: unknown format '" + name +
-                       "' (expected csv, ply, vdb or none)");
-    }
-    formats.push_back(*f);
-  }
-  if (formats.empty())
-    throw UsageError("run: --format: empty list (expected csv, ply, vdb or none)");
-  return formats;
-}
+// ---- the prepared run -------------------------------------------------------------------------
 
-struct FramePlan {
+// A run ready for its first frame: the system built (and resumed from a checkpoint), its lint
+// printed, every output checked writable and the cache writer made. The frames advance it.
+struct PreparedRun {
+  PreparedRun(const io::EffectSettings& runEffect, std::uint64_t fingerprint, FrameSchedule frames)
+      : effect(runEffect), effectHash(fingerprint), schedule(std::move(frames)) {}
+
+  const io::EffectSettings& effect;
+  std::uint64_t effectHash;  // the effect's fingerprint, which its checkpoints carry
   FrameSchedule schedule;
-  std::string description;
+  std::unique_ptr<ParticleSystem> system;
+  std::vector<io::Diagnostic> lint;
+  std::int64_t firstFrame = 1;  // the first frame this run simulates
+  Flicks elapsed = 0;           // the run's time: where it starts, then the last frame's end
+  // --trace: the state hash after every tick.
+  std::vector<std::pair<std::int64_t, std::uint64_t>> tickHashes;
+  // Frame f's files are written while frame f + 1 simulates; the writer holds at most one frame.
+  std::optional<io::BackgroundWriter> writer;
 };
 
-// The run's length comes from the effect (or --seconds / --frames), whatever the frame rate:
-// --fps only says how that length is cut into frames.
-FramePlan planFrames(const io::OutputSettings& output, const std::optional<std::string>& seconds,
-                     const std::optional<std::string>& frames,
-                     const std::optional<std::string>& fps,
-                     const std::optional<std::string>& jitter,
-                     const std::optional<std::string>& frameTimes) {
-  if (seconds && frames) throw UsageError("run: give --seconds or --frames, not both");
-  if (jitter && frameTimes) throw UsageError("run: give --jitter or --frame-times, not both");
-  if ((jitter || frameTimes) && fps)
-    throw UsageError("run: --fps does not go with --jitter or --frame-times");
-  if (frameTimes && (seconds || frames))
-    throw UsageError("run: --frame-times sets the length; drop --seconds/--frames");
-  if (jitter && frames) throw UsageError("run: --jitter needs a length in --seconds, not --frames");
-
-  if (frameTimes) {
-    return {FrameSchedule::recorded(readFrameTimes(*frameTimes)),
-            "frame times from " + *frameTimes};
+// Reads --resume's checkpoint into the system and skips the frames it covers. False after
+// printing why it does not fit this run: verified whole before anything is written, a refusal is
+// bad input (exit 2).
+bool resumeRun(PreparedRun& run, const std::string& checkpoint) {
+  io::CheckpointInfo info;
+  try {
+    info = io::readCheckpoint(checkpoint, *run.system, run.effectHash);
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return false;
   }
-  FrameRate rate = output.fps;
-  if (fps) {
-    try {
-      rate = parseFrameRate(*fps);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("run: --fps: ") + e.what());
-    }
+  for (std::int64_t f = 0; f < info.frame; ++f) {
+    const std::optional<Flicks> d = run.schedule.next();
+    if (!d) break;
+    run.elapsed += *d;
   }
-  Flicks total = 0;
-  if (seconds) {
-    total = flicksFromSeconds(parseNumber(*seconds, "run: --seconds", 0.0, io::kMaxRunSeconds));
-  } else if (frames) {
-    const long long count = parseInteger(*frames, "run: --frames", 0, io::kMaxRunFrames);
-    total = lengthOfFrames(rate, count, "run: --frames");
-  } else {
-    total = lengthOfFrames(output.fps, output.frameCount(), "output length");
+  if (run.schedule.framesDone() != info.frame || run.elapsed != info.elapsed) {
+    std::fprintf(
+        stderr,
+        "%s: error: the checkpoint is at frame %lld (%.9g s) but this run's frame %lld ends at "
+        "%.9g s (give the frame options of the run that wrote it)\n",
+        checkpoint.c_str(), static_cast<long long>(info.frame), secondsFromFlicks(info.elapsed),
+        static_cast<long long>(info.frame), secondsFromFlicks(run.elapsed));
+    return false;
   }
-  if (jitter) {
-    const auto seed =
-        static_cast<std::uint64_t>(parseInteger(*jitter, "run: --jitter", 0, INT64_MAX));
-    return {FrameSchedule::jittered(seed, total), "jittered frames (seed " + *jitter + ")"};
-  }
-  const std::string rateText =
-      std::to_string(rate.numerator) +
-      (rate.denominator == 1 ? "" : "/" + std::to_string(rate.denominator));
-  return {FrameSchedule::fixedRate(rate, total), "at " + rateText + " fps"};
+  run.firstFrame = info.frame + 1;
+  return true;
 }
 
-// A --vdb-* option's value, by the names VdbCacheOptions gives.
-template <typename Named>
-auto parseVdbChoice(const std::string& option, const std::string& value,
-                    const std::vector<std::string>& names, Named named) {
-  const auto choice = named(value);
-  if (!choice) {
-    throw UsageError("run: " + option + ": unknown value '" + value + "' (expected " +
-                     joinWords(names, " or ") + ")");
+// Every output is checked before the first tick: an unwritable --dump must not turn up after
+// hours of caches. False after printing why.
+bool checkOutputs(const RunSettings& s, std::int64_t firstFrame) {
+  try {
+    if (s.writesCaches()) std::filesystem::create_directories(s.caches.directory);
+    if (s.checkpointEvery > 0) std::filesystem::create_directories(s.checkpointDir);
+    if (s.writesCaches())
+      io::requireWritable(io::cacheFilePath(s.caches.directory, firstFrame, "tmp"));
+    if (s.checkpointEvery > 0) io::requireWritable(s.checkpointPath(firstFrame));
+    if (s.dump) io::requireWritable(*s.dump);
+    if (s.trace) io::requireWritable(*s.trace);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return false;
   }
-  return *choice;
+  return true;
 }
+
+// The run of `effect` that `s` asks for, ready for its first frame; nothing after printing why
+// not (bad input: exit 2).
+std::unique_ptr<PreparedRun> prepareRun(const RunSettings& s, const io::EffectSettings& effect,
+                                        std::uint64_t fingerprint) {
+  auto run = std::make_unique<PreparedRun>(effect, fingerprint, s.frames.schedule);
+  // Building loads the effect's vector fields: a file that does not load is bad input, reported
+  // like an effect error, before anything is written. The lint comes after, so that such a file
+  // is reported once, as the error. An offline run has no wall clock to keep up with: every
+  // tick its frames cover runs (the effect's max_ticks_per_frame is for real-time hosts).
+  try {
+    run->system = io::buildOfflineSystem(effect, s.threads);
+  } catch (const io::BuildError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return nullptr;
+  }
+  run->lint = io::lintEffect(effect, &run->system->forces());
+  for (const io::Diagnostic& d : run->lint) std::fprintf(stderr, "%s\n", d.format().c_str());
+  if (s.resume && !resumeRun(*run, *s.resume)) return nullptr;
+  if (!checkOutputs(s, run->firstFrame)) return nullptr;
+  if (s.trace) {
+    PreparedRun* const r = run.get();
+    r->system->setTickObserver([r](const ParticleSystem& system) {
+      r->tickHashes.emplace_back(system.tickCount(), stateHash(system.pool()));
+    });
+  }
+  const io::CacheTargets* const targets = &s.caches;
+  run->writer.emplace([targets](const io::FrameData& d) { io::writeFrameCaches(d, *targets); },
+                      s.overlap && s.writesCaches());
+  return run;
+}
+
+// ---- what a stopped run reports -----------------------------------------------------------------
 
 // "DIR (frame_0001 to frame_0036)": where a run's caches are, as its messages name them.
 std::string cacheRange(const std::filesystem::path& dir, std::int64_t first, std::int64_t last) {
@@ -160,54 +181,226 @@ std::string cacheRange(const std::filesystem::path& dir, std::int64_t first, std
 }
 
 // After a stop: which cache files are there, every one whole.
-void reportWritten(std::int64_t lastWritten, std::int64_t firstFrame,
-                   const std::optional<std::filesystem::path>& out) {
-  if (out && lastWritten >= firstFrame) {
-    std::fprintf(stderr, "caches written: %s\n", cacheRange(*out, firstFrame, lastWritten).c_str());
+void reportWritten(const RunSettings& s, std::int64_t firstFrame, std::int64_t lastWritten) {
+  if (s.writesCaches() && lastWritten >= firstFrame) {
+    std::fprintf(stderr, "caches written: %s\n",
+                 cacheRange(s.caches.directory, firstFrame, lastWritten).c_str());
   }
 }
 
-void reportInterruption(const std::string& effectPath, int signal, std::int64_t lastFrame,
-                        std::int64_t firstFrame, Flicks elapsed,
-                        const std::optional<std::filesystem::path>& out,
-                        const std::optional<std::filesystem::path>& resumeFrom,
-                        bool checkpointing) {
-  if (lastFrame >= firstFrame) {
-    std::fprintf(stderr, "%s: interrupted by %s after frame %lld (%.9g s)\n", effectPath.c_str(),
+void reportInterruption(const RunSettings& s, const PreparedRun& run, int signal,
+                        std::int64_t lastFrame,
+                        const std::optional<std::filesystem::path>& resumeFrom) {
+  const char* const effectPath = s.effectPath.c_str();
+  if (lastFrame >= run.firstFrame) {
+    std::fprintf(stderr, "%s: interrupted by %s after frame %lld (%.9g s)\n", effectPath,
                  InterruptCatcher::name(signal), static_cast<long long>(lastFrame),
-                 secondsFromFlicks(elapsed));
+                 secondsFromFlicks(run.elapsed));
   } else {
-    std::fprintf(stderr, "%s: interrupted by %s before the first frame\n", effectPath.c_str(),
+    std::fprintf(stderr, "%s: interrupted by %s before the first frame\n", effectPath,
                  InterruptCatcher::name(signal));
   }
-  reportWritten(lastFrame, firstFrame, out);
+  reportWritten(s, run.firstFrame, lastFrame);
   if (resumeFrom) {
     std::fprintf(stderr,
                  "checkpoint: %s\nresume with: tickfx run %s --resume %s (and the options "
                  "of this run)\n",
-                 resumeFrom->c_str(), effectPath.c_str(), resumeFrom->c_str());
-  } else if (!checkpointing) {
+                 resumeFrom->c_str(), effectPath, resumeFrom->c_str());
+  } else if (s.checkpointEvery == 0) {
     std::fprintf(stderr, "no checkpoint: run with --checkpoint-every N to be able to resume\n");
   }
 }
 
-void reportNonfiniteStop(const std::string& effectPath, const NonfiniteEvent& event,
-                         const std::vector<io::Diagnostic>& lint, std::int64_t lastWritten,
-                         std::int64_t firstFrame, const std::optional<std::filesystem::path>& out) {
+void reportNonfiniteStop(const RunSettings& s, const PreparedRun& run, std::int64_t lastWritten) {
   std::fprintf(stderr,
                "%s: error: %s; the run stops there (simulation.nonfinite = \"stop\"; \"kill\" "
                "removes such particles instead)\n",
-               effectPath.c_str(), event.describe().c_str());
-  if (const io::Diagnostic* cause = io::instabilityWarning(lint)) {
+               s.effectPath.c_str(), run.system->nonfiniteStop()->describe().c_str());
+  if (const io::Diagnostic* cause = io::instabilityWarning(run.lint)) {
     std::fprintf(stderr, "likely cause: %s\n", cause->format().c_str());
   }
-  reportWritten(lastWritten, firstFrame, out);
+  reportWritten(s, run.firstFrame, lastWritten);
 }
 
-std::filesystem::path checkpointPath(const std::filesystem::path& dir, std::int64_t frame) {
-  char name[64];
-  std::snprintf(name, sizeof name, "checkpoint_%06" PRId64 ".tfxc", frame);
-  return dir / name;
+// ---- the frames ---------------------------------------------------------------------------------
+
+using SteadyClock = std::chrono::steady_clock;
+
+double secondsSince(SteadyClock::time_point start) {
+  return std::chrono::duration<double>(SteadyClock::now() - start).count();
+}
+
+// The frame loop: each frame simulated, captured and handed to the writer, with its checkpoint.
+// Ctrl-C (or SIGTERM) finishes the frame in hand and stops there, for as long as the loop lives.
+class FrameLoop {
+ public:
+  FrameLoop(const RunSettings& settings, PreparedRun& run)
+      : s_(settings), run_(run), resumedAt_(run.elapsed), lastFrame_(run.firstFrame - 1) {}
+
+  // Runs every frame left in the schedule. The exit code when the run stops early (reported),
+  // else nothing.
+  std::optional<int> run();
+
+  std::int64_t lastFrame() const { return lastFrame_; }
+  double simulationSeconds() const { return simulationSeconds_; }
+  double wallSeconds() const { return wallSeconds_; }
+
+ private:
+  bool simulateFrame(Flicks duration);
+  void showProgress(std::int64_t f);
+  int stopAtNonfinite();
+  int stopAtInterruption(int signal);
+  int stopAtWriteError(const io::WriteError& e);
+  // Every file of frames up to this one is whole (once the writer is idle).
+  std::int64_t writtenThrough() const {
+    return s_.writesCaches() ? run_.writer->lastWritten().value_or(run_.firstFrame - 1)
+                             : lastFrame_;
+  }
+
+  const RunSettings& s_;
+  PreparedRun& run_;
+  const SteadyClock::time_point wallStart_ = SteadyClock::now();
+  ProgressLine progress_{"frames"};
+  const Flicks resumedAt_;  // the bar and the time left count this run's part alone
+  std::int64_t lastFrame_;  // the last frame simulated
+  double simulationSeconds_ = 0.0;
+  double wallSeconds_ = 0.0;
+  const InterruptCatcher interrupts_;
+};
+
+std::optional<int> FrameLoop::run() {
+  try {
+    while (InterruptCatcher::caught() == 0) {
+      const std::optional<Flicks> duration = run_.schedule.next();
+      if (!duration) break;
+      if (!simulateFrame(*duration)) return stopAtNonfinite();
+    }
+    run_.writer->finish();
+    if (const int signal = InterruptCatcher::caught()) return stopAtInterruption(signal);
+  } catch (const io::WriteError& e) {
+    return stopAtWriteError(e);
+  }
+  progress_.finish();
+  wallSeconds_ = secondsSince(wallStart_);
+  return std::nullopt;
+}
+
+// The schedule's next frame, of `duration`. False when a tick of it went non-finite.
+bool FrameLoop::simulateFrame(Flicks duration) {
+  const std::int64_t f = run_.schedule.framesDone();
+  const auto simulationStart = SteadyClock::now();
+  run_.system->advance(duration);
+  if (run_.system->nonfiniteStop()) return false;
+  run_.elapsed += duration;
+  std::optional<io::FrameData> data;
+  if (s_.writesCaches()) data = io::captureFrame(*run_.system, f, secondsFromFlicks(run_.elapsed));
+  simulationSeconds_ += secondsSince(simulationStart);
+  if (data) run_.writer->submit(std::move(*data));
+  if (s_.checkpointEvery > 0 && f % s_.checkpointEvery == 0) {
+    // A checkpoint at frame f promises the caches through f: a run resumed from it writes
+    // from f + 1 on.
+    run_.writer->finish();
+    io::writeCheckpoint(s_.checkpointPath(f), *run_.system,
+                        io::CheckpointInfo{run_.effectHash, f, run_.elapsed});
+  }
+  lastFrame_ = f;
+  showProgress(f);
+  return true;
+}
+
+void FrameLoop::showProgress(std::int64_t f) {
+  const Flicks total = run_.schedule.total();
+  char detail[96];
+  std::snprintf(detail, sizeof detail, "t = %.3f of %.3f s, %zu particles",
+                secondsFromFlicks(run_.elapsed), secondsFromFlicks(total),
+                run_.system->pool().size());
+  progress_.update(f - run_.firstFrame + 1, -1,
+                   static_cast<double>(run_.elapsed - resumedAt_) /
+                       static_cast<double>(std::max<Flicks>(1, total - resumedAt_)),
+                   detail);
+}
+
+int FrameLoop::stopAtNonfinite() {
+  // The frame holding the tick is not written; those before it are, whole.
+  run_.writer->finish();
+  progress_.finish();
+  reportNonfiniteStop(s_, run_, writtenThrough());
+  return kExitFailure;
+}
+
+int FrameLoop::stopAtInterruption(int signal) {
+  progress_.finish();
+  // The state is that of the end of lastFrame: a checkpoint of it, unless one was just made.
+  std::optional<std::filesystem::path> resumeFrom;
+  if (s_.checkpointEvery > 0 && lastFrame_ >= run_.firstFrame) {
+    resumeFrom = s_.checkpointPath(lastFrame_);
+    if (lastFrame_ % s_.checkpointEvery != 0) {
+      io::writeCheckpoint(*resumeFrom, *run_.system,
+                          io::CheckpointInfo{run_.effectHash, lastFrame_, run_.elapsed});
+    }
+  }
+  reportInterruption(s_, run_, signal, lastFrame_, resumeFrom);
+  return 128 + signal;
+}
+
+int FrameLoop::stopAtWriteError(const io::WriteError& e) {
+  run_.writer->drain();
+  progress_.finish();
+  std::fprintf(stderr, "%s\n", e.what());
+  reportWritten(s_, run_.firstFrame, writtenThrough());
+  return kExitFailure;
+}
+
+// ---- the report ---------------------------------------------------------------------------------
+
+// The files of the run's end: --dump's last state and --trace's hash of every tick.
+void writeEndFiles(const RunSettings& s, const PreparedRun& run, std::int64_t lastFrame) {
+  // The dump shows the run's end time, as the last cache frame does.
+  if (s.dump) {
+    io::writeStateDump(io::captureFrame(*run.system, lastFrame, secondsFromFlicks(run.elapsed)),
+                       *s.dump);
+  }
+  if (s.trace) {
+    io::writeFileAtomically(*s.trace, [&](std::ostream& os) {
+      os << "tick,state_hash\n";
+      for (const auto& [tick, hash] : run.tickHashes) os << tick << ',' << hashToHex(hash) << '\n';
+    });
+  }
+}
+
+// What the run did and what it cost (not with --quiet).
+void printRunSummary(const RunSettings& s, const PreparedRun& run, const FrameLoop& frames) {
+  const ParticleSystem& system = *run.system;
+  const ParticlePool& pool = system.pool();
+  const SystemSettings& simulation = run.effect.simulation;
+  std::printf("%s: %lld frames %s, %.6g s simulated (%lld ticks at %lld Hz, %s)\n",
+              s.effectPath.c_str(), static_cast<long long>(frames.lastFrame()),
+              s.frames.description.c_str(), secondsFromFlicks(run.elapsed),
+              static_cast<long long>(system.tickCount()),
+              static_cast<long long>(simulation.stepRateHz), simulation.integrator.c_str());
+  std::printf("particles alive: %zu (emitted %llu, refused by max_particles: %llu)\n", pool.size(),
+              static_cast<unsigned long long>(pool.nextId() + pool.droppedSpawns()),
+              static_cast<unsigned long long>(pool.droppedSpawns()));
+  if (simulation.nonfinite == NonfinitePolicy::Kill) {
+    std::printf("removed for a non-finite position or velocity: %llu\n",
+                static_cast<unsigned long long>(system.nonfiniteKilled()));
+  }
+  const double wall = frames.wallSeconds();
+  if (!s.writesCaches()) {
+    std::printf("wall time: %.3f s\n", wall);
+  } else {
+    // What writing cost on top of simulating: the overlap is the time both went on at once.
+    const double simulating = frames.simulationSeconds();
+    const double writing = run.writer->writeSeconds();
+    std::printf("wall time: %.3f s (simulating %.3f s, writing caches %.3f s, %s %.3f s)\n", wall,
+                simulating, writing, s.overlap ? "overlapped" : "not overlapped (--no-overlap):",
+                std::max(0.0, simulating + writing - wall));
+  }
+  if (s.writesCaches() && frames.lastFrame() >= run.firstFrame) {
+    std::printf("caches: %s\n",
+                cacheRange(s.caches.directory, run.firstFrame, frames.lastFrame()).c_str());
+  }
+  if (s.dump) std::printf("state dump: %s\n", s.dump->c_str());
 }
 
 }  // namespace
@@ -217,258 +410,22 @@ int runCommand(Arguments& args) {
     std::fputs(kRunHelp, stdout);
     return kExitOk;
   }
-  const std::vector<std::string> overrides = args.values("--set");
-  const auto seconds = args.value("--seconds");
-  const auto frames = args.value("--frames");
-  const auto fps = args.value("--fps");
-  const auto jitter = args.value("--jitter");
-  const auto frameTimes = args.value("--frame-times");
-  const auto out = args.value("--out");
-  const auto format = args.value("--format");
-  const auto dump = args.value("--dump");
-  const auto trace = args.value("--trace");
-  const auto checkpointEvery = args.value("--checkpoint-every");
-  const auto checkpointDir = args.value("--checkpoint-dir");
-  const auto resume = args.value("--resume");
-  const auto threads = args.value("--threads");
-  const auto vdbCompression = args.value("--vdb-compression");
-  const auto vdbPositions = args.value("--vdb-positions");
-  const bool durable = args.flag("--durable");
-  const bool overlap = !args.flag("--no-overlap");
-  const bool printHash = args.flag("--hash");
-  const bool quiet = args.flag("--quiet");
-  const std::string effectPath = args.positionals(1, "one effect file: tickfx run EFFECT.toml")[0];
-
+  const RunArguments arguments = readRunArguments(args);
   // Everything that can be wrong with the request is found before anything is written.
-  const io::LoadResult load = loadEffectReporting(effectPath, overrides);
+  const io::LoadResult load = loadEffectReporting(arguments.effectPath, arguments.overrides);
   if (!load.ok()) return kExitUsage;
-  const io::EffectSettings& effect = *load.effect;
+  const std::optional<RunSettings> settings = resolveRunSettings(arguments, load);
+  if (!settings) return kExitUsage;
+  const std::unique_ptr<PreparedRun> run = prepareRun(*settings, *load.effect, load.fingerprint);
+  if (!run) return kExitUsage;
 
-  const std::vector<io::CacheFormat> formats =
-      format ? parseFormats(*format) : effect.output.formats;
-  const std::filesystem::path outDir = out ? *out : effect.output.directory;
-  std::optional<int> threadOverride;
-  if (threads) {
-    threadOverride = static_cast<int>(parseInteger(*threads, "run: --threads", 0, io::kMaxThreads));
-  }
-  std::optional<FramePlan> plan;
-  try {
-    plan.emplace(planFrames(effect.output, seconds, frames, fps, jitter, frameTimes));
-  } catch (const std::runtime_error& e) {
-    if (dynamic_cast<const UsageError*>(&e) != nullptr) throw;
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitUsage;
-  }
-  FrameSchedule& schedule = plan->schedule;
-
-  std::int64_t every = 0;
-  if (checkpointEvery)
-    every = parseInteger(*checkpointEvery, "run: --checkpoint-every", 1, 1'000'000'000);
-  if (checkpointDir && !checkpointEvery)
-    throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
-  const std::filesystem::path checkpoints =
-      checkpointDir ? std::filesystem::path(*checkpointDir) : outDir;
-  const std::uint64_t effectHash = load.fingerprint;
-  io::CacheTargets targets;
-  targets.directory = outDir;
-  targets.formats = formats;
-  // What a VDB cache records of the run, for the pipeline that reads it.
-  targets.vdbMetadata = io::VdbCacheMetadata{hashToHex(effectHash), effect.simulation.seed,
-                                             effect.simulation.stepRateHz,
-                                             effect.simulation.integrator, TICKFX_VERSION};
-  targets.vdbOptions = effect.output.vdb;
-  if (vdbCompression) {
-    targets.vdbOptions.compression = parseVdbChoice(
-        "--vdb-compression", *vdbCompression, io::vdbCompressionNames(), io::vdbCompressionNamed);
-  }
-  if (vdbPositions) {
-    targets.vdbOptions.positions = parseVdbChoice("--vdb-positions", *vdbPositions,
-                                                  io::vdbPositionsNames(), io::vdbPositionsNamed);
-  }
-  targets.durability = durable ? io::Durability::Synced : io::Durability::Renamed;
-
-  // Building loads the effect's vector fields: a file that does not load is bad input, reported
-  // like an effect error, before anything is written. The lint comes after, so that such a file
-  // is reported once, as the error. An offline run has no wall clock to keep up with: every
-  // tick its frames cover runs (the effect's max_ticks_per_frame is for real-time hosts).
-  std::unique_ptr<ParticleSystem> system;
-  try {
-    system = io::buildOfflineSystem(effect, threadOverride);
-  } catch (const io::BuildError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitUsage;
-  }
-  const std::vector<io::Diagnostic> lint = io::lintEffect(effect, &system->forces());
-  for (const io::Diagnostic& d : lint) std::fprintf(stderr, "%s\n", d.format().c_str());
-  std::int64_t firstFrame = 1;
-  Flicks elapsed = 0;
-  if (resume) {
-    // Verified whole before anything is written; a refusal is bad input (exit 2).
-    io::CheckpointInfo info;
-    try {
-      info = io::readCheckpoint(*resume, *system, effectHash);
-    } catch (const std::runtime_error& e) {
-      std::fprintf(stderr, "%s\n", e.what());
-      return kExitUsage;
-    }
-    for (std::int64_t f = 0; f < info.frame; ++f) {
-      const std::optional<Flicks> d = schedule.next();
-      if (!d) break;
-      elapsed += *d;
-    }
-    if (schedule.framesDone() != info.frame || elapsed != info.elapsed) {
-      std::fprintf(
-          stderr,
-          "%s: error: the checkpoint is at frame %lld (%.9g s) but this run's frame %lld ends at "
-          "%.9g s (give the frame options of the run that wrote it)\n",
-          resume->c_str(), static_cast<long long>(info.frame), secondsFromFlicks(info.elapsed),
-          static_cast<long long>(info.frame), secondsFromFlicks(elapsed));
-      return kExitUsage;
-    }
-    firstFrame = info.frame + 1;
-  }
-  // Every output is checked before the first tick: an unwritable --dump must not turn up after
-  // hours of caches.
-  try {
-    if (!formats.empty()) std::filesystem::create_directories(outDir);
-    if (every > 0) std::filesystem::create_directories(checkpoints);
-    if (!formats.empty()) io::requireWritable(io::cacheFilePath(outDir, firstFrame, "tmp"));
-    if (every > 0) io::requireWritable(checkpointPath(checkpoints, firstFrame));
-    if (dump) io::requireWritable(*dump);
-    if (trace) io::requireWritable(*trace);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitUsage;
-  }
-  std::vector<std::pair<std::int64_t, std::uint64_t>> tickHashes;
-  if (trace) {
-    system->setTickObserver([&](const ParticleSystem& s) {
-      tickHashes.emplace_back(s.tickCount(), stateHash(s.pool()));
-    });
-  }
-
-  const auto wallStart = std::chrono::steady_clock::now();
-  ProgressLine progress("frames");
-  const Flicks resumedAt = elapsed;         // the bar and the time left count this run's part alone
-  std::int64_t lastFrame = firstFrame - 1;  // the last frame simulated
-  const std::optional<std::filesystem::path> cacheDir =
-      formats.empty() ? std::nullopt : std::optional(outDir);
-  // Frame f's files are written while frame f + 1 simulates; the writer holds at most one frame.
-  io::BackgroundWriter writer(
-      [&targets](const io::FrameData& d) { io::writeFrameCaches(d, targets); },
-      overlap && !formats.empty());
-  // Every file of frames up to this one is whole (once the writer is idle).
-  const auto writtenThrough = [&] {
-    return formats.empty() ? lastFrame : writer.lastWritten().value_or(firstFrame - 1);
-  };
-  double simulationSeconds = 0.0;
-  const InterruptCatcher interrupts;
-  try {
-    while (InterruptCatcher::caught() == 0) {
-      const std::optional<Flicks> duration = schedule.next();
-      if (!duration) break;
-      const std::int64_t f = schedule.framesDone();
-      const auto simulationStart = std::chrono::steady_clock::now();
-      system->advance(*duration);
-      if (system->nonfiniteStop()) {
-        // The frame holding the tick is not written; those before it are, whole.
-        writer.finish();
-        progress.finish();
-        reportNonfiniteStop(effectPath, *system->nonfiniteStop(), lint, writtenThrough(),
-                            firstFrame, cacheDir);
-        return kExitFailure;
-      }
-      elapsed += *duration;
-      std::optional<io::FrameData> data;
-      if (!formats.empty()) data = io::captureFrame(*system, f, secondsFromFlicks(elapsed));
-      simulationSeconds +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - simulationStart).count();
-      if (data) writer.submit(std::move(*data));
-      if (every > 0 && f % every == 0) {
-        // A checkpoint at frame f promises the caches through f: a run resumed from it writes
-        // from f + 1 on.
-        writer.finish();
-        io::writeCheckpoint(checkpointPath(checkpoints, f), *system,
-                            io::CheckpointInfo{effectHash, f, elapsed});
-      }
-      lastFrame = f;
-      char detail[96];
-      std::snprintf(detail, sizeof detail, "t = %.3f of %.3f s, %zu particles",
-                    secondsFromFlicks(elapsed), secondsFromFlicks(schedule.total()),
-                    system->pool().size());
-      progress.update(f - firstFrame + 1, -1,
-                      static_cast<double>(elapsed - resumedAt) /
-                          static_cast<double>(std::max<Flicks>(1, schedule.total() - resumedAt)),
-                      detail);
-    }
-    writer.finish();
-    if (const int signal = InterruptCatcher::caught()) {
-      progress.finish();
-      // The state is that of the end of lastFrame: a checkpoint of it, unless one was just made.
-      std::optional<std::filesystem::path> resumeFrom;
-      if (every > 0 && lastFrame >= firstFrame) {
-        resumeFrom = checkpointPath(checkpoints, lastFrame);
-        if (lastFrame % every != 0) {
-          io::writeCheckpoint(*resumeFrom, *system,
-                              io::CheckpointInfo{effectHash, lastFrame, elapsed});
-        }
-      }
-      reportInterruption(effectPath, signal, lastFrame, firstFrame, elapsed, cacheDir, resumeFrom,
-                         every > 0);
-      return 128 + signal;
-    }
-  } catch (const io::WriteError& e) {
-    writer.drain();
-    progress.finish();
-    std::fprintf(stderr, "%s\n", e.what());
-    reportWritten(writtenThrough(), firstFrame, cacheDir);
-    return kExitFailure;
-  }
-  progress.finish();
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
-
-  // The dump shows the run's end time, as the last cache frame does.
-  if (dump)
-    io::writeStateDump(io::captureFrame(*system, lastFrame, secondsFromFlicks(elapsed)), *dump);
-  if (trace) {
-    io::writeFileAtomically(*trace, [&](std::ostream& os) {
-      os << "tick,state_hash\n";
-      for (const auto& [tick, hash] : tickHashes) os << tick << ',' << hashToHex(hash) << '\n';
-    });
-  }
-  const ParticlePool& pool = system->pool();
-  if (!quiet) {
-    std::printf("%s: %lld frames %s, %.6g s simulated (%lld ticks at %lld Hz, %s)\n",
-                effectPath.c_str(), static_cast<long long>(lastFrame), plan->description.c_str(),
-                secondsFromFlicks(elapsed), static_cast<long long>(system->tickCount()),
-                static_cast<long long>(effect.simulation.stepRateHz),
-                effect.simulation.integrator.c_str());
-    std::printf("particles alive: %zu (emitted %llu, refused by max_particles: %llu)\n",
-                pool.size(), static_cast<unsigned long long>(pool.nextId() + pool.droppedSpawns()),
-                static_cast<unsigned long long>(pool.droppedSpawns()));
-    if (effect.simulation.nonfinite == NonfinitePolicy::Kill) {
-      std::printf("removed for a non-finite position or velocity: %llu\n",
-                  static_cast<unsigned long long>(system->nonfiniteKilled()));
-    }
-    if (formats.empty()) {
-      std::printf("wall time: %.3f s\n", wall);
-    } else {
-      // What writing cost on top of simulating: the overlap is the time both went on at once.
-      const double writing = writer.writeSeconds();
-      std::printf("wall time: %.3f s (simulating %.3f s, writing caches %.3f s, %s %.3f s)\n", wall,
-                  simulationSeconds, writing,
-                  overlap ? "overlapped" : "not overlapped (--no-overlap):",
-                  std::max(0.0, simulationSeconds + writing - wall));
-    }
-    if (!formats.empty() && lastFrame >= firstFrame) {
-      std::printf("caches: %s\n", cacheRange(outDir, firstFrame, lastFrame).c_str());
-    }
-    if (dump) std::printf("state dump: %s\n", dump->c_str());
-  }
-  if (printHash) {
-    std::printf("state-hash: %s\n", hashToHex(stateHash(pool)).c_str());
-    std::printf("ticks: %lld\n", static_cast<long long>(system->tickCount()));
+  FrameLoop frames(*settings, *run);
+  if (const std::optional<int> stopped = frames.run()) return *stopped;
+  writeEndFiles(*settings, *run, frames.lastFrame());
+  if (!settings->quiet) printRunSummary(*settings, *run, frames);
+  if (settings->printHash) {
+    std::printf("state-hash: %s\n", hashToHex(stateHash(run->system->pool())).c_str());
+    std::printf("ticks: %lld\n", static_cast<long long>(run->system->tickCount()));
   }
   return kExitOk;
 }

@@ -33,17 +33,16 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
-#include <string_view>
-#include <thread>
 #include <tuple>
 #include <vector>
 
 #include "BenchHarness.h"
-#include "fields/vdb/AnalyticField.h"
 #include "fields/ForceSet.h"
+#include "fields/vdb/AnalyticField.h"
 #include "fields/vdb/VectorField.h"
 #include "fields/vdb/VectorFieldGrids.h"
 #include "integrators/Integrator.h"
@@ -106,24 +105,11 @@ void load(tickfx::ParticlePool& pool, const std::vector<openvdb::Vec3f>& points)
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::CommandLine cl;
-  std::size_t count = 1'000'000;
-  bool countGiven = false;
-  if (auto exit = bench::parseCommandLine(argc, argv, cl, usage, [&](std::string_view arg) {
-        if (auto v = bench::valueOf(arg, "--count=")) {
-          count = static_cast<std::size_t>(std::atoll(v->c_str()));
-          countGiven = true;
-          if (count == 0) {
-            std::fprintf(stderr, "bad --count: %s\n", v->c_str());
-            return bench::Arg::kBad;
-          }
-          return bench::Arg::kTaken;
-        }
-        return bench::Arg::kNotMine;
-      })) {
-    return *exit;
-  }
-  if (cl.quick && !countGiven) count = 10'000;
+  std::optional<std::size_t> countGiven;
+  bench::CommandLine cl(usage);
+  cl.count("--count", countGiven, [](std::size_t n) { return n >= 1; });
+  if (const std::optional<int> exitCode = cl.parse(argc, argv)) return *exitCode;
+  const std::size_t count = countGiven ? *countGiven : cl.quick ? 10'000 : 1'000'000;
 
   openvdb::initialize();
   const AnalyticField noise = AnalyticField::curlNoise(3, 2.0, 1.0, 4);
@@ -156,8 +142,7 @@ int main(int argc, char** argv) {
       "dt = 1/%lld s\n",
       count, bake.voxelSize, static_cast<unsigned long long>(grid->activeVoxelCount()),
       static_cast<long long>(kStepRateHz));
-  std::printf("machine: %s, %u hardware threads\n", bench::cpuModel().c_str(),
-              std::thread::hardware_concurrency());
+  bench::printMachine();
   bench::printBuild();
 
   // State kept per case so that the timed loop allocates nothing.
@@ -237,13 +222,14 @@ int main(int argc, char** argv) {
 
   std::printf("\n%-6s %-8s %-22s %16s %12s %8s\n", "order", "threads", "case", "particle-steps/s",
               "ms/step", "ratio");
+  // Each tickfx case against its baseline, the PointAdvect case after it.
   for (std::size_t i = 0; i < cases.size(); i += 2) {
-    const double oursT = bench::median(cases[i].secondsPerTick);
-    const double theirsT = bench::median(cases[i + 1].secondsPerTick);
-    for (const AdvectCase* c : {&cases[i], &cases[i + 1]}) {
-      const double t = c->ours ? oursT : theirsT;
+    const AdvectCase& tickfxCase = cases[i];
+    const AdvectCase& pointAdvect = cases[i + 1];
+    for (const AdvectCase* c : {&tickfxCase, &pointAdvect}) {
+      const double t = c->seconds();
       std::printf("%-6d %-8d %-22s %16.3e %12.3f %8.2f\n", c->order, c->threads, c->name.c_str(),
-                  static_cast<double>(count) / t, 1e3 * t, theirsT / t);
+                  static_cast<double>(count) / t, 1e3 * t, bench::speedup(*c, pointAdvect));
     }
   }
   std::printf(
@@ -254,16 +240,15 @@ int main(int argc, char** argv) {
   std::printf("\n");
   for (std::size_t i = 0; i < cases.size(); i += 2) {
     const AdvectCase& c = cases[i];
-    const double oursT = bench::median(c.secondsPerTick);
-    const double theirsT = bench::median(cases[i + 1].secondsPerTick);
+    const AdvectCase& pointAdvect = cases[i + 1];
     std::printf(
-        "advect order %d %d thread%s %s %s: %.2fx PointAdvect (target >= 2x), %s particle-steps/s "
+        "advect order %d %s %s %s: %.2fx PointAdvect (target >= 2x), %s particle-steps/s "
         "(PointAdvect %s",
-        c.order, c.threads, c.threads == 1 ? "" : "s", c.name.substr(0, c.name.find(' ')).c_str(),
-        bench::sizeLabel(count).c_str(), theirsT / oursT,
-        bench::g3(static_cast<double>(count) / oursT).c_str(),
-        bench::g3(static_cast<double>(count) / theirsT).c_str());
-    if (c.threads > 1) std::printf("; %.2f of %d cores busy", c.cpu / c.timed, c.threads);
+        c.order, bench::threadsLabel(c.threads).c_str(), c.name.substr(0, c.name.find(' ')).c_str(),
+        bench::sizeLabel(count).c_str(), bench::speedup(c, pointAdvect),
+        bench::g3(static_cast<double>(count) / c.seconds()).c_str(),
+        bench::g3(static_cast<double>(count) / pointAdvect.seconds()).c_str());
+    if (c.threads > 1) std::printf("; %.2f of %d cores busy", c.cores(), c.threads);
     std::printf(")\n");
   }
   return 0;

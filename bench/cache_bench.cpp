@@ -33,14 +33,14 @@
 // whatever the writer; the bench prints the memory so the reader can tell which case holds.
 // In a VM whose balloon reports free pages to the host (virtio-balloon free page reporting),
 // memory left free for a couple of seconds goes back to the host and the next write into it
-// faults it in again: 800 MB took 0.16 s right after a delete and 0.7 s after 5 s idle on the
-// 2-core guest. Files of 10⁷ particles take seconds, so their rows, dd's too, vary the most.
+// faults it in again, so a write is slower the longer the memory it fills stayed free. Files of
+// 10⁷ particles take seconds, so their rows, dd's too, vary the most.
 //
 // Timing: the cases of one format take turns batch by batch, a tick being one file, and a case's
 // figure is the median over its batches of the time per file (BenchHarness.h). Each file has a
-// name of its own and the files are deleted between batches, outside the timed part: deleting
-// costs 0.03 s per GB while its pages are dirty and 0.2 s per GB once written back (ext4), as
-// much as dd's whole write, so timing it would pull every ratio towards 1.
+// name of its own and the files are deleted between batches (each case's `after`), outside the
+// timed part: deleting a file can cost as much as dd's whole write of it, more once its pages are
+// written back, so timing it would pull every ratio towards 1.
 //
 // Output: the tables, then one line a figure, `name: value unit (ratios, targets)`.
 #include <fcntl.h>
@@ -54,6 +54,7 @@
 #include <cerrno>
 #include <charconv>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -68,12 +69,10 @@
 #include <string>
 #include <string_view>
 #include <system_error>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "BenchHarness.h"
-#include "io/util/AtomicFile.h"
 #include "io/cache/BackgroundWriter.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameCaches.h"
@@ -83,6 +82,7 @@
 #include "io/cache/VdbPointCache.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectParser.h"
+#include "io/util/AtomicFile.h"
 #include "particles/Clock.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Random.h"
@@ -91,6 +91,7 @@
 namespace {
 
 namespace bench = tickfx::bench;
+using bench::threadsLabel;
 namespace fs = std::filesystem;
 namespace io = tickfx::io;
 
@@ -250,28 +251,6 @@ void ddWrite(const fs::path& path, std::size_t bytes, io::Durability durability,
 
 // ---- part 1: writers against dd ---------------------------------------------------------------
 
-// timeCases (BenchHarness.h) with `clean` run between batches, outside the timed part (see the
-// top of the file for why deleting cannot sit inside a batch).
-void timeCasesCleaning(std::vector<bench::Case>& cases, const bench::Timing& timing,
-                       const std::function<void()>& clean) {
-  const double target = timing.minTime / timing.reps;
-  for (bench::Case& c : cases) {
-    bench::calibrate(c, target);
-    clean();
-  }
-  const auto finished = [&](const bench::Case& c) {
-    return static_cast<int>(c.secondsPerTick.size()) >= timing.reps && c.timed >= timing.minTime;
-  };
-  while (!std::all_of(cases.begin(), cases.end(), finished)) {
-    for (bench::Case& c : cases) {
-      const double s = bench::timeBatch(c, &c.cpu);
-      c.secondsPerTick.push_back(s / static_cast<double>(c.batch));
-      c.timed += s;
-      clean();
-    }
-  }
-}
-
 struct ResultRow {
   std::string format;
   double target;
@@ -287,10 +266,6 @@ struct Part1 {
   std::vector<ResultRow> rows;
   bool sizesAgree = true;
 };
-
-std::string threadsLabel(int threads) {
-  return std::to_string(threads) + (threads == 1 ? " thread" : " threads");
-}
 
 // One format at one size: the writer with all threads, and at the reference size also on 1
 // thread (and PLY synced), each against its dd, all taking turns.
@@ -351,23 +326,26 @@ void runFormat(const FormatInfo& f, const io::FrameData& frame, bool reference, 
       fs::remove(e.path());
     }
   };
-  timeCasesCleaning(cases, timing, clean);
+  for (bench::Case& c : cases) {
+    c.after = [&clean] {
+      clean();
+      return true;
+    };
+  }
+  bench::timeCases(cases, timing);
 
   for (const bench::Case& c : cases) {
-    const double s = bench::median(c.secondsPerTick);
-    const auto [lo, hi] = std::minmax_element(c.secondsPerTick.begin(), c.secondsPerTick.end());
     std::printf(
         "  %-28s %10.4f ms/file  (median of %zu batches of %lld; %.4f to %.4f; %.2f cores)\n",
-        c.name.c_str(), 1e3 * s, c.secondsPerTick.size(), static_cast<long long>(c.batch),
-        1e3 * *lo, 1e3 * *hi, c.timed > 0.0 ? c.cpu / c.timed : 0.0);
+        c.name.c_str(), 1e3 * c.seconds(), c.secondsPerTick.size(), static_cast<long long>(c.batch),
+        1e3 * c.fastest(), 1e3 * c.slowest(), c.cores());
   }
   std::fflush(stdout);
   for (const Writer& w : writers) {
     const bool sync = w.durability == io::Durability::Synced;
     const bench::Case& dd = cases[ddIndex + (sync ? 1 : 0)];
     out.rows.push_back({f.name, f.target, n, w.threads, sync, static_cast<double>(bytes),
-                        bench::median(cases[w.index].secondsPerTick),
-                        bench::median(dd.secondsPerTick)});
+                        cases[w.index].seconds(), dd.seconds()});
   }
 }
 
@@ -665,35 +643,15 @@ double memoryBytes() {
 
 int run(int argc, char** argv) {
   std::optional<std::vector<std::size_t>> sizes;
-  std::optional<std::size_t> overlap;
-  std::optional<int> rounds;
-  fs::path parent = fs::temp_directory_path();
-  bench::CommandLine cl;
-  const auto own = [&](std::string_view arg) {
-    if (auto v = bench::valueOf(arg, "--sizes=")) {
-      sizes = bench::parseSizes(*v);
-      if (!sizes) std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
-      return sizes ? bench::Arg::kTaken : bench::Arg::kBad;
-    }
-    if (auto v = bench::valueOf(arg, "--overlap=")) {
-      overlap = bench::parseCount(*v, 0.0);
-      if (!overlap) std::fprintf(stderr, "bad --overlap: %s\n", v->c_str());
-      return overlap ? bench::Arg::kTaken : bench::Arg::kBad;
-    }
-    if (auto v = bench::valueOf(arg, "--rounds=")) {
-      rounds = std::atoi(v->c_str());
-      if (*rounds < 1) std::fprintf(stderr, "bad --rounds: %s\n", v->c_str());
-      return *rounds >= 1 ? bench::Arg::kTaken : bench::Arg::kBad;
-    }
-    if (auto v = bench::valueOf(arg, "--dir=")) {
-      parent = *v;
-      return bench::Arg::kTaken;
-    }
-    return bench::Arg::kNotMine;
-  };
-  if (const std::optional<int> exitCode = bench::parseCommandLine(argc, argv, cl, usage, own)) {
-    return *exitCode;
-  }
+  std::optional<std::size_t> overlap, rounds;
+  std::optional<std::string> dirGiven;
+  bench::CommandLine cl(usage);
+  cl.sizes("--sizes", sizes)
+      .count("--overlap", overlap)
+      .count("--rounds", rounds, [](std::size_t r) { return r >= 1 && r <= INT_MAX; })
+      .text("--dir", dirGiven);
+  if (const std::optional<int> exitCode = cl.parse(argc, argv)) return *exitCode;
+  const fs::path parent = dirGiven ? fs::path(*dirGiven) : fs::temp_directory_path();
   std::vector<std::size_t> writerSizes{10'000, 1'000'000, 10'000'000};
   std::size_t overlapSize = 1'000'000;
   int overlapRounds = 3;
@@ -704,13 +662,14 @@ int run(int argc, char** argv) {
   }
   if (sizes) writerSizes = *sizes;
   if (overlap) overlapSize = *overlap;
-  if (rounds) overlapRounds = *rounds;
+  if (rounds) overlapRounds = static_cast<int>(*rounds);
 
   const int allThreads = tbb::info::default_concurrency();
   std::printf("cache_bench: cache writers against dd, and writing overlapped with simulating\n");
-  std::printf("machine: %s, %u hardware threads (TBB uses %d), %.1f GB of memory\n",
-              bench::cpuModel().c_str(), std::thread::hardware_concurrency(), allThreads,
-              memoryBytes() / 1e9);
+  char machine[64];
+  std::snprintf(machine, sizeof machine, " (TBB uses %d), %.1f GB of memory", allThreads,
+                memoryBytes() / 1e9);
+  bench::printMachine(machine);
   bench::printBuild();
 
   std::error_code ec;

@@ -37,6 +37,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -49,7 +50,6 @@
 #include <random>
 #include <string>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #ifdef __GLIBC__
@@ -67,6 +67,7 @@
 namespace {
 
 namespace bench = tickfx::bench;
+using bench::threadsLabel;
 
 // ---- the emitters ---------------------------------------------------------------------------
 
@@ -168,53 +169,14 @@ long minorFaults() {
   return u.ru_minflt;
 }
 
-// One burst measurement: prepare (untimed), run (timed), finish (untimed: checks the count and
-// adds to the checksum; false on a wrong count).
-struct BurstCase {
-  std::string name;
-  std::function<void()> prepare;
-  std::function<void()> run;
-  std::function<bool()> finish;
-  std::vector<double> seconds;
-  std::vector<double> faults;
-  double timed = 0.0;
-  double cpu = 0.0;     // process CPU seconds over the timed repetitions, all threads
-  bool warmUp = false;  // one untimed repetition first (the first to write reused storage)
-};
-
-bool timeOnce(BurstCase& c, bool record) {
-  c.prepare();
-  // The fault count and the CPU clock are read outside the wall-clock interval.
-  const long f0 = minorFaults();
-  const double cpu0 = bench::processCpuSeconds();
-  const bench::Clock::time_point start = bench::Clock::now();
-  c.run();
-  const double s = std::chrono::duration<double>(bench::Clock::now() - start).count();
-  const double cpu = bench::processCpuSeconds() - cpu0;
-  const long f1 = minorFaults();
-  if (!c.finish()) return false;
-  if (record) {
-    c.seconds.push_back(s);
-    c.faults.push_back(static_cast<double>(f1 - f0));
-    c.timed += s;
-    c.cpu += cpu;
-  }
-  return true;
-}
-
-bool timeBursts(std::vector<BurstCase>& cases, const bench::Timing& timing) {
-  for (BurstCase& c : cases) {
-    if (c.warmUp && !timeOnce(c, /*record=*/false)) return false;
-  }
-  const auto finished = [&](const BurstCase& c) {
-    return static_cast<int>(c.seconds.size()) >= timing.reps && c.timed >= timing.minTime;
-  };
-  while (!std::all_of(cases.begin(), cases.end(), finished)) {
-    for (BurstCase& c : cases) {
-      if (!timeOnce(c, /*record=*/true)) return false;
-    }
-  }
-  return true;
+// One burst measurement, a case of a single repetition a batch (BenchHarness.h): `before`
+// prepares it (untimed), `run` is timed, `after` checks the count and adds to the checksum
+// (untimed; false on a wrong count). The page faults of each repetition are counted.
+bench::Case burstCase(std::string name, std::function<void()> run) {
+  bench::Case c(std::move(name), [run = std::move(run)](std::int64_t) { run(); });
+  c.calibrated = false;
+  c.counter = [] { return static_cast<double>(minorFaults()); };
+  return c;
 }
 
 // At most 3 significant digits, as 3.14e7 or 5e7: short, and read back by any float parser.
@@ -231,10 +193,6 @@ std::string sci(double v) {
   exponent.erase(0, exponent.find_first_not_of("+-0"));
   if (exponent.empty()) return mantissa;
   return mantissa + "e" + (negative ? "-" : "") + exponent;
-}
-
-std::string threadsLabel(int threads) {
-  return std::to_string(threads) + (threads == 1 ? " thread" : " threads");
 }
 
 struct Figure {
@@ -268,8 +226,7 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
   std::printf("\nburst of N = %zu\n", n);
   std::fflush(stdout);
   const std::string label = bench::sizeLabel(n);
-  std::vector<int> threadCounts{1};
-  if (arenas.allThreads > 1) threadCounts.push_back(arenas.allThreads);
+  const std::vector<int> threadCounts = bench::oneAndAll(arenas.allThreads);
 
   const auto countError = [n](const std::string& name, std::size_t size, std::uint64_t dropped) {
     std::fprintf(stderr, "error: %s: %zu particles after the burst (%llu dropped), expected %zu\n",
@@ -288,15 +245,16 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
   const std::vector<Shape> shapes = burstShapes();
   for (const Shape& s : shapes) emitters.push_back(burstEmitter(s.shape, n));
 
-  std::vector<BurstCase> cases;
+  std::vector<bench::Case> cases;
   for (const bool reuse : {false, true}) {
     const std::string mode = reuse ? ", reused pool" : "";
     {
-      BurstCase c;
-      c.name = "hand mt19937 box loop " + label + " 1 thread" + (reuse ? ", reused vector" : "");
-      c.warmUp = reuse;
       std::vector<HandParticle>* out = reuse ? &reusedHand : &freshHand;
-      c.prepare = [out, reuse, n] {
+      bench::Case c = burstCase(
+          "hand mt19937 box loop " + label + " 1 thread" + (reuse ? ", reused vector" : ""),
+          [out, n] { handFill(*out, n); });
+      c.warmUp = reuse;
+      c.before = [out, reuse, n] {
         if (reuse) {
           out->clear();
         } else {
@@ -305,8 +263,7 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
           out->reserve(n);
         }
       };
-      c.run = [out, n] { handFill(*out, n); };
-      c.finish = [out, reuse, n, &checksum, name = c.name, countError] {
+      c.after = [out, reuse, n, &checksum, name = c.name, countError] {
         if (out->size() != n) return countError(name, out->size(), 0);
         checksum += positionSum(*out);
         if (!reuse) std::vector<HandParticle>().swap(*out);
@@ -316,61 +273,61 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
     }
     for (std::size_t s = 0; s < shapes.size(); ++s) {
       for (const int threads : threadCounts) {
-        BurstCase c;
-        c.name = std::string("emit ") + shapes[s].name + " " + label + " " + threadsLabel(threads) +
-                 mode;
         tbb::task_arena* arena = &arenas.of(threads);
-        // The first reused case writes the shared pool's pages before the others are timed.
-        c.warmUp = reuse && s == 0 && threads == 1;
         const tickfx::Emitter* emitter = &emitters[s];
+        const std::string name = std::string("emit ") + shapes[s].name + " " + label + " " +
+                                 threadsLabel(threads) + mode;
         if (reuse) {
-          c.prepare = [&reusedPool] { reusedPool.resizeForRestore(0, 0, 0); };
-          c.run = [&reusedPool, arena, emitter] {
+          bench::Case c = burstCase(name, [&reusedPool, arena, emitter] {
             arena->execute([&] { emitter->emit(reusedPool, kSeed, 0); });
             bench::escape(reusedPool.position().x.data());
-          };
-          c.finish = [&reusedPool, n, &checksum, name = c.name, countError] {
+          });
+          // The first reused case writes the shared pool's pages before the others are timed.
+          c.warmUp = s == 0 && threads == 1;
+          c.before = [&reusedPool] { reusedPool.resizeForRestore(0, 0, 0); };
+          c.after = [&reusedPool, n, &checksum, name, countError] {
             if (reusedPool.size() != n || reusedPool.droppedSpawns() != 0)
               return countError(name, reusedPool.size(), reusedPool.droppedSpawns());
             checksum += bench::positionSum(reusedPool);
             return true;
           };
+          cases.push_back(std::move(c));
         } else {
-          c.prepare = [&freshPool, n] {
+          bench::Case c = burstCase(name, [&freshPool, arena, emitter] {
+            arena->execute([&] { emitter->emit(*freshPool, kSeed, 0); });
+            bench::escape(freshPool->position().x.data());
+          });
+          c.before = [&freshPool, n] {
             freshPool.reset();
             freshPool = std::make_unique<tickfx::ParticlePool>(n);
             freshPool->reserve(n);  // the allocation, untimed; the pages are touched by emit()
           };
-          c.run = [&freshPool, arena, emitter] {
-            arena->execute([&] { emitter->emit(*freshPool, kSeed, 0); });
-            bench::escape(freshPool->position().x.data());
-          };
-          c.finish = [&freshPool, n, &checksum, name = c.name, countError] {
+          c.after = [&freshPool, n, &checksum, name, countError] {
             if (freshPool->size() != n || freshPool->droppedSpawns() != 0)
               return countError(name, freshPool->size(), freshPool->droppedSpawns());
             checksum += bench::positionSum(*freshPool);
             freshPool.reset();  // unmapping the storage, untimed
             return true;
           };
+          cases.push_back(std::move(c));
         }
-        cases.push_back(std::move(c));
       }
     }
   }
 
-  if (!timeBursts(cases, timing)) return false;
+  if (!bench::timeCases(cases, timing)) return false;
 
-  const auto spawnsPerSecond = [n](const BurstCase& c) {
-    return static_cast<double>(n) / bench::median(c.seconds);
+  const auto spawnsPerSecond = [n](const bench::Case& c) {
+    return static_cast<double>(n) / c.seconds();
   };
   std::printf("  %-52s %9s  %-30s %7s %s\n", "case", "median ms", "(repetitions; fastest, slowest)",
               "cores", "page faults/1000 spawns");
-  for (const BurstCase& c : cases) {
-    const auto [lo, hi] = std::minmax_element(c.seconds.begin(), c.seconds.end());
+  for (const bench::Case& c : cases) {
     char reps[64];
-    std::snprintf(reps, sizeof reps, "(%zu; %.3f, %.3f)", c.seconds.size(), 1e3 * *lo, 1e3 * *hi);
-    std::printf("  %-52s %9.3f  %-30s %7.2f %.3f\n", c.name.c_str(), 1e3 * bench::median(c.seconds),
-                reps, c.cpu / c.timed, 1e3 * bench::median(c.faults) / static_cast<double>(n));
+    std::snprintf(reps, sizeof reps, "(%zu; %.3f, %.3f)", c.secondsPerTick.size(),
+                  1e3 * c.fastest(), 1e3 * c.slowest());
+    std::printf("  %-52s %9.3f  %-30s %7.2f %.3f\n", c.name.c_str(), 1e3 * c.seconds(), reps,
+                c.cores(), 1e3 * bench::median(c.counts) / static_cast<double>(n));
   }
   std::fflush(stdout);
 
@@ -378,7 +335,7 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
   const std::size_t perMode = 1 + shapes.size() * threadCounts.size();
   char buf[512];
   for (std::size_t m = 0; m < 2; ++m) {
-    const BurstCase& hand = cases[m * perMode];
+    const bench::Case& hand = cases[m * perMode];
     const double handRate = spawnsPerSecond(hand);
     std::snprintf(buf, sizeof buf, "%s: %s spawns/s (%.2fx target %s)", hand.name.c_str(),
                   sci(handRate).c_str(), handRate / kTargetSpawnsPerSecond,
@@ -388,7 +345,7 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
       const std::size_t first = m * perMode + 1 + s * threadCounts.size();
       const double oneRate = spawnsPerSecond(cases[first]);
       for (std::size_t t = 0; t < threadCounts.size(); ++t) {
-        const BurstCase& c = cases[first + t];
+        const bench::Case& c = cases[first + t];
         const double rate = spawnsPerSecond(c);
         if (t == 0) {
           std::snprintf(buf, sizeof buf, "%s: %s spawns/s (%.2fx target %s; %.2fx hand %s)",
@@ -400,7 +357,7 @@ bool runBursts(std::size_t n, const bench::Timing& timing, Arenas& arenas,
           std::snprintf(buf, sizeof buf,
                         "%s: %s spawns/s (%.2fx 1 thread; %.2fx hand %s; %.2f of %d cores busy)",
                         c.name.c_str(), sci(rate).c_str(), rate / oneRate, rate / handRate,
-                        "mt19937 loop", c.cpu / c.timed, threadCounts[t]);
+                        "mt19937 loop", c.cores(), threadCounts[t]);
         }
         figures.push_back({buf});
       }
@@ -553,15 +510,14 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
   }
 
   for (const bench::Case& c : cases) {
-    const auto [lo, hi] = std::minmax_element(c.secondsPerTick.begin(), c.secondsPerTick.end());
     std::printf(
         "  %-44s %9.4f ms/tick  (median of %zu batches of %lld ticks; %.4f to %.4f; %.2f cores)\n",
-        c.name.c_str(), 1e3 * bench::median(c.secondsPerTick), c.secondsPerTick.size(),
-        static_cast<long long>(c.batch), 1e3 * *lo, 1e3 * *hi, c.cpu / c.timed);
+        c.name.c_str(), 1e3 * c.seconds(), c.secondsPerTick.size(), static_cast<long long>(c.batch),
+        1e3 * c.fastest(), 1e3 * c.slowest(), c.cores());
   }
-  const double with = bench::median(cases[0].secondsPerTick);
-  const double without = bench::median(cases[1].secondsPerTick);
-  const double copy = bench::median(cases[2].secondsPerTick);
+  const double with = cases[0].seconds();
+  const double without = cases[1].seconds();
+  const double copy = cases[2].seconds();
   const double emitAlone = bench::median(emitSeconds);
   const double perTick = static_cast<double>(spawned) / static_cast<double>(emitSeconds.size());
   std::printf("  %-44s %9.4f ms/tick  (median of %zu ticks of %.0f births)\n",
@@ -586,8 +542,8 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
                 pop.c_str(), 100.0 * emitAlone / with, 1e3 * emitAlone,
                 sci(perTick / emitAlone).c_str(), 1e3 * (with - without - emitAlone));
   figures.push_back({buf});
-  const double withFused = bench::median(cases[3].secondsPerTick);
-  const double withoutFused = bench::median(cases[4].secondsPerTick);
+  const double withFused = cases[3].seconds();
+  const double withoutFused = cases[4].seconds();
   std::snprintf(buf, sizeof buf,
                 "steady %s emission cost, frames of %lld ticks: %.1f %% of the tick (%.4g ms a "
                 "tick, %.4g ms without emission; fused frames remove the dead once a frame)",
@@ -629,29 +585,12 @@ void usage(const char* argv0) {
 int main(int argc, char** argv) {
   std::optional<std::vector<std::size_t>> sizes;
   std::optional<std::size_t> steady;
-  bench::CommandLine cl;
-  const auto own = [&](std::string_view arg) {
-    if (const std::optional<std::string> v = bench::valueOf(arg, "--sizes=")) {
-      sizes = bench::parseSizes(*v);
-      if (!sizes) {
-        std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
-        return bench::Arg::kBad;
-      }
-      return bench::Arg::kTaken;
-    }
-    if (const std::optional<std::string> v = bench::valueOf(arg, "--steady=")) {
-      steady = bench::parseCount(*v, 0.0);
-      if (!steady || (*steady > 0 && *steady < 60)) {
-        std::fprintf(stderr, "bad --steady: %s (0, or at least 60 particles)\n", v->c_str());
-        return bench::Arg::kBad;
-      }
-      return bench::Arg::kTaken;
-    }
-    return bench::Arg::kNotMine;
-  };
-  if (const std::optional<int> exitCode = bench::parseCommandLine(argc, argv, cl, usage, own)) {
-    return *exitCode;
-  }
+  bench::CommandLine cl(usage);
+  cl.sizes("--sizes", sizes)
+      .count(
+          "--steady", steady, [](std::size_t n) { return n == 0 || n >= 60; },
+          " (0, or at least 60 particles)");
+  if (const std::optional<int> exitCode = cl.parse(argc, argv)) return *exitCode;
   std::vector<std::size_t> burstSizes{1'000'000, 10'000'000};
   std::size_t population = 1'000'000;
   if (cl.quick) {
@@ -675,9 +614,8 @@ int main(int argc, char** argv) {
       "emit_bench: bursts (box, sphere volume, disc; %g° spread, speed and lifetime jitter) "
       "and a steady rate emitter\n",
       kSpreadDegrees);
-  std::printf("machine: %s, %u hardware threads (TBB uses %d), transparent huge pages: %s\n",
-              bench::cpuModel().c_str(), std::thread::hardware_concurrency(), allThreads,
-              transparentHugePages().c_str());
+  bench::printMachine(" (TBB uses " + std::to_string(allThreads) +
+                      "), transparent huge pages: " + transparentHugePages());
   bench::printBuild();
 
   std::vector<Figure> figures;

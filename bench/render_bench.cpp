@@ -1,11 +1,12 @@
 // Preview render speed (issue 14, item 5): 10⁶ particles to a 1280×720 PNG through the
 // preview's own path: colour each particle by speed (preview::ColourBy), render the frame
-// (preview::renderFrame: ground grid and axis marks, every particle projected through the camera, the
-// splats sorted far to near and drawn in parallel bands of rows), encode the PNG. One and all
+// (preview::renderFrame: ground grid and axis marks, every particle projected through the camera,
+// the splats sorted far to near and drawn in parallel bands of rows), encode the PNG. One and all
 // threads; the median of the repeats.
 //
 //   render_bench              10⁶ particles, 7 repeats
 //   render_bench --quick      10⁵ particles, 3 repeats
+//   render_bench --reps=9     repeats a thread count
 //
 // Output: a table, then `render ...: value unit` lines (BenchHarness.h's summary form).
 #include <tbb/info.h>
@@ -14,20 +15,23 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
+#include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "io/cache/FrameData.h"
+#include "BenchHarness.h"
 #include "app/preview/ColourBy.h"
 #include "app/preview/FrameRenderer.h"
 #include "app/preview/PinholeCamera.h"
 #include "app/preview/SplatImage.h"
+#include "io/cache/FrameData.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+namespace bench = tickfx::bench;
+using bench::Clock;
 
 struct Timing {
   double colour = 0.0, render = 0.0, png = 0.0;
@@ -56,12 +60,24 @@ Timing renderOnce(const tickfx::io::FrameData& frame, const tickfx::preview::Pin
   return t;
 }
 
+void usage(const char* argv0) {
+  std::printf(
+      "usage: %s [--quick] [--reps=COUNT]\n"
+      "  --quick            smoke run: 1e5 particles, 3 repeats\n"
+      "  --reps=7           repeats on each thread count (the median is reported)\n",
+      argv0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
-  const std::size_t n = quick ? 100'000 : 1'000'000;
-  const int repeats = quick ? 3 : 7;
+  bench::CommandLine cl(usage);
+  cl.timing.reps = 7;
+  cl.quickTiming.reps = 3;
+  cl.withoutMinTime();
+  if (const std::optional<int> exitCode = cl.parse(argc, argv)) return *exitCode;
+  const std::size_t n = cl.quick ? 100'000 : 1'000'000;
+  const int repeats = cl.timing.reps;
   std::printf("render_bench: %zu particles in a 6 x 2 x 2 m box to a 1280x720 PNG (%s build)\n", n,
               TICKFX_BENCH_CONFIG);
   // Particles in a 6 x 2 x 2 m box, each with a velocity of up to about 1.7 m/s.
@@ -79,16 +95,16 @@ int main(int argc, char** argv) {
     frame.velocity.y[r] = u(random);
     frame.velocity.z[r] = u(random);
   }
-  const auto camera = tickfx::preview::PinholeCamera::framing({-3, 0, -1}, {3, 2, 1},
-                                                         Eigen::Vector3d::UnitY(), 40.0, 1280, 720);
+  const auto camera = tickfx::preview::PinholeCamera::framing(
+      {-3, 0, -1}, {3, 2, 1}, Eigen::Vector3d::UnitY(), 40.0, 1280, 720);
   tickfx::preview::RenderSettings settings;
-  settings.grid = tickfx::preview::GroundGrid::under({-3, 0, -1}, {3, 2, 1}, tickfx::preview::UpAxis::Y);
+  settings.grid =
+      tickfx::preview::GroundGrid::under({-3, 0, -1}, {3, 2, 1}, tickfx::preview::UpAxis::Y);
   settings.axisLength = 1.0;
   const int all = tbb::info::default_concurrency();
   std::vector<std::pair<int, Timing>> results;
   std::size_t bytes = 0;
-  for (const int threads : {1, all}) {
-    if (threads == all && all == 1 && !results.empty()) break;
+  for (const int threads : bench::oneAndAll(all)) {
     tbb::task_arena arena(threads);
     std::vector<Timing> runs;
     arena.execute([&] {
@@ -104,12 +120,12 @@ int main(int argc, char** argv) {
     std::printf("%8d %12.4f %12.4f %12.4f %12.4f\n", threads, t.colour, t.render, t.png, t.total());
   }
   std::printf("\n");
-  const std::string size = n == 1'000'000 ? "1e6" : "1e5";
+  const std::string size = bench::sizeLabel(n);
   for (const auto& [threads, t] : results) {
     std::printf(
-        "render %s 1280x720 %d thread%s: %.3f s a frame (colour %.3f, render %.3f, png %.3f; "
+        "render %s 1280x720 %s: %.3f s a frame (colour %.3f, render %.3f, png %.3f; "
         "%.2fx 1 thread; target < 1 s at 1e6; %zu bytes)\n",
-        size.c_str(), threads, threads == 1 ? "" : "s", t.total(), t.colour, t.render, t.png,
+        size.c_str(), bench::threadsLabel(threads).c_str(), t.total(), t.colour, t.render, t.png,
         results.front().second.total() / t.total(), bytes);
   }
   return 0;

@@ -32,7 +32,6 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
-#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -41,7 +40,6 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -140,32 +138,21 @@ void usage(const char* argv0) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::optional<int> side;
-  bench::CommandLine cl;
-  const auto own = [&](std::string_view arg) {
-    const std::optional<std::string> s = bench::valueOf(arg, "--side=");
-    if (!s) return bench::Arg::kNotMine;
-    side = std::atoi(s->c_str());
-    if (*side < 2 || *side > 1000) {
-      std::fprintf(stderr, "bad --side: %s (2 to 1000)\n", s->c_str());
-      return bench::Arg::kBad;
-    }
-    return bench::Arg::kTaken;
-  };
-  if (const std::optional<int> exitCode = bench::parseCommandLine(argc, argv, cl, usage, own)) {
-    return *exitCode;
-  }
+  std::optional<std::size_t> side;
+  bench::CommandLine cl(usage);
+  cl.count(
+      "--side", side, [](std::size_t s) { return s >= 2 && s <= 1000; }, " (2 to 1000)");
+  if (const std::optional<int> exitCode = cl.parse(argc, argv)) return *exitCode;
   Options o;
   o.timing = cl.timing;
   if (cl.quick) o.side = 64;
-  if (side) o.side = *side;
+  if (side) o.side = static_cast<int>(*side);
 
   std::printf(
       "spring_bench: a %d x %d cloth (structural + shear + bend springs), gravity,\n"
       "semi-implicit Euler at %lld Hz\n",
       o.side, o.side, static_cast<long long>(kStepRateHz));
-  std::printf("machine: %s, %u hardware threads (TBB default %d)\n", bench::cpuModel().c_str(),
-              std::thread::hardware_concurrency(), tbb::info::default_concurrency());
+  bench::printMachine(" (TBB default " + std::to_string(tbb::info::default_concurrency()) + ")");
   bench::printBuild();
 
   // One system per case, so that no case's ticks move another's state.
@@ -233,19 +220,20 @@ int main(int argc, char** argv) {
   std::printf("\n%-22s %11s %11s %15s %13s %9s %6s  %s\n", "case", "ms/tick", "ticks/s",
               "spring evals/s", "springs/s", "2t / 1t", "cores", "batches (min to max ms)");
   std::vector<double> seconds;
-  for (const Case& c : cases) seconds.push_back(bench::median(c.secondsPerTick));
+  for (const Case& c : cases) seconds.push_back(c.seconds());
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
     const double s = seconds[i];
-    const auto [lo, hi] = std::minmax_element(c.secondsPerTick.begin(), c.secondsPerTick.end());
     const double perSpring = static_cast<double>(springs) / s;  // each spring once
     char evals[32] = "-", ratio[16] = "";
     if (c.evaluations > 0.0)
       std::snprintf(evals, sizeof evals, "%.4g", 2.0 * c.evaluations * perSpring);
-    if (c.threads == 2) std::snprintf(ratio, sizeof ratio, "%.2f", seconds[i - 1] / s);
+    // The 2-thread case against its 1-thread baseline, the case before it.
+    if (c.threads == 2) std::snprintf(ratio, sizeof ratio, "%.2f", bench::speedup(c, cases[i - 1]));
     std::printf("%-22s %11.4f %11.1f %15s %13.4g %9s %6.2f  %zu x %lld (%.3f to %.3f)\n",
-                c.name.c_str(), 1e3 * s, 1.0 / s, evals, perSpring, ratio, c.cpu / c.timed,
-                c.secondsPerTick.size(), static_cast<long long>(c.batch), 1e3 * *lo, 1e3 * *hi);
+                c.name.c_str(), 1e3 * s, 1.0 / s, evals, perSpring, ratio, c.cores(),
+                c.secondsPerTick.size(), static_cast<long long>(c.batch), 1e3 * c.fastest(),
+                1e3 * c.slowest());
   }
 
   const bool finite =
@@ -274,14 +262,14 @@ int main(int argc, char** argv) {
       "evaluations/s, %s ms a tick; %.2f of 2 cores busy)\n",
       z, seconds[0] / seconds[1], bench::g3(n / seconds[1]).c_str(),
       bench::g3(evaluations / seconds[1]).c_str(), bench::g3(1e3 * seconds[1]).c_str(),
-      cases[1].cpu / cases[1].timed);
+      cases[1].cores());
   std::printf("springs evaluate 1 thread %s: %s spring evaluations/s (%s ms a tick)\n", z,
               bench::g3(evaluations / seconds[2]).c_str(), bench::g3(1e3 * seconds[2]).c_str());
   std::printf(
       "springs evaluate 2 threads %s: %.2fx 1 thread, %s spring evaluations/s (%s ms a tick; "
       "%.2f of 2 cores busy)\n",
       z, seconds[2] / seconds[3], bench::g3(evaluations / seconds[3]).c_str(),
-      bench::g3(1e3 * seconds[3]).c_str(), cases[3].cpu / cases[3].timed);
+      bench::g3(1e3 * seconds[3]).c_str(), cases[3].cores());
   std::printf("springs beginTick %s: %s ms (tables kept; %.0f %% of a 1-thread step())\n", z,
               bench::g3(1e3 * seconds[4]).c_str(), 100.0 * seconds[4] / seconds[0]);
   return same && finite ? 0 : 1;

@@ -44,7 +44,6 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #include "BenchHarness.h"
@@ -61,6 +60,7 @@
 namespace {
 
 namespace bench = tickfx::bench;
+using bench::threadsLabel;
 
 // ---- the scene, shared by both sides ----------------------------------------------------------
 
@@ -330,10 +330,6 @@ struct Row {
   double cores;  // CPU over wall time while the case ran
 };
 
-std::string threadsLabel(int threads) {
-  return std::to_string(threads) + (threads == 1 ? " thread" : " threads");
-}
-
 // Ticks a frame in the fused cases (issue 13's target: 4).
 constexpr std::int64_t kFusedTicks = 4;
 
@@ -436,14 +432,14 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 
   bench::timeCases(cases, o.timing);
 
-  const double aosSeconds = bench::median(cases.front().secondsPerTick);
+  // The AoS loop is the baseline every ratio of the table is to.
+  const bench::Case& aosCase = cases.front();
   for (const bench::Case& c : cases) {
-    const double s = bench::median(c.secondsPerTick);
-    const auto [lo, hi] = std::minmax_element(c.secondsPerTick.begin(), c.secondsPerTick.end());
+    const double s = c.seconds();
     std::printf("  %-30s %10.4f ms/tick  (median of %zu batches of %lld ticks; %.4f to %.4f)\n",
                 c.name.c_str(), 1e3 * s, c.secondsPerTick.size(), static_cast<long long>(c.batch),
-                1e3 * *lo, 1e3 * *hi);
-    rows.push_back({n, c.name, static_cast<double>(n) / s, aosSeconds / s, c.cpu / c.timed});
+                1e3 * c.fastest(), 1e3 * c.slowest());
+    rows.push_back({n, c.name, static_cast<double>(n) / s, bench::speedup(c, aosCase), c.cores()});
   }
   std::fflush(stdout);
 
@@ -617,24 +613,9 @@ void usage(const char* argv0) {
 int main(int argc, char** argv) {
   std::optional<std::vector<std::size_t>> sizes;
   bool checkCost = false;
-  bench::CommandLine cl;
-  const auto own = [&](std::string_view arg) {
-    if (arg == "--check-cost") {
-      checkCost = true;
-      return bench::Arg::kTaken;
-    }
-    const std::optional<std::string> v = bench::valueOf(arg, "--sizes=");
-    if (!v) return bench::Arg::kNotMine;
-    sizes = bench::parseSizes(*v);
-    if (!sizes) {
-      std::fprintf(stderr, "bad --sizes: %s\n", v->c_str());
-      return bench::Arg::kBad;
-    }
-    return bench::Arg::kTaken;
-  };
-  if (const std::optional<int> exitCode = bench::parseCommandLine(argc, argv, cl, usage, own)) {
-    return *exitCode;
-  }
+  bench::CommandLine cl(usage);
+  cl.flag("--check-cost", checkCost).sizes("--sizes", sizes);
+  if (const std::optional<int> exitCode = cl.parse(argc, argv)) return *exitCode;
   Options o;
   o.timing = cl.timing;
   if (cl.quick) o.sizes = {10'000, 100'000};
@@ -647,8 +628,7 @@ int main(int argc, char** argv) {
   const int allThreads = tbb::info::default_concurrency();
   std::printf("tick_bench: one tick of gravity + wind + drag, semi-implicit Euler, %lld Hz\n",
               static_cast<long long>(kStepRateHz));
-  std::printf("machine: %s, %u hardware threads (TBB uses %d)\n", bench::cpuModel().c_str(),
-              std::thread::hardware_concurrency(), allThreads);
+  bench::printMachine(" (TBB uses " + std::to_string(allThreads) + ")");
   bench::printBuild();
 
   std::vector<Row> rows;
