@@ -1,20 +1,17 @@
 #include "fields/vdb/VdbFileCheck.h"
 
-#include <blosc.h>
+#include <openvdb/io/DelayedLoadMetadata.h>
 #include <openvdb/io/GridDescriptor.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/AttributeArray.h>
 #include <openvdb/points/AttributeSet.h>
 #include <openvdb/points/PointDataGrid.h>
-#include <openvdb/points/StreamCompression.h>
 
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cctype>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <map>
 #include <memory>
@@ -23,109 +20,17 @@
 #include <utility>
 #include <vector>
 
-namespace tickfx {
-namespace {
+#include "fields/vdb/VdbCheckReader.h"
+#include "fields/vdb/VdbTreeCheck.h"
 
-using Kind = VdbFileError::Kind;
+namespace tickfx::vdbcheck {
+namespace {
 
 // File formats (OPENVDB_FILE_VERSION_*): per-grid compression and mask-compressed node values
 // from 222, multi-pass PointDataGrids from 224, which OpenVDB 10 writes.
 constexpr std::uint32_t kOldestFormat = 222;
 constexpr std::uint32_t kPointsFormat = 224;
 constexpr std::uint32_t kNewestFormat = 224;
-// Compression flags of a grid (io::COMPRESS_*).
-constexpr std::uint32_t kZip = 0x1, kActiveMask = 0x2, kBlosc = 0x4;
-// A PointDataGrid leaf's voxel values: 512 uint32 offsets.
-constexpr std::uint64_t kLeafOffsetBytes = 512 * 4;
-constexpr std::size_t kLeafMaskBytes = 64;
-
-[[noreturn]] void unreadable(const std::string& what) {
-  throw VdbFileError(Kind::Unreadable, what);
-}
-
-/// Reads little-endian values (x86-64, as OpenVDB writes them) from [pos, end) of the file. A read
-/// past `end` is "the file is truncated" in the file's header and descriptors, and corruption in a
-/// grid (its descriptor says where it ends, so a size read inside it that runs further is wrong).
-class Cursor {
- public:
-  Cursor(const std::string& file, std::size_t pos, std::size_t end, bool inGrid)
-      : file_(file), pos_(pos), end_(end), inGrid_(inGrid) {}
-
-  std::size_t pos() const { return pos_; }
-  std::uint64_t left() const { return end_ - pos_; }
-
-  [[noreturn]] void corrupt(std::size_t at, const std::string& what) const {
-    unreadable("the file is corrupt at byte " + std::to_string(at) + ": " + what);
-  }
-  const char* take(std::uint64_t n) {
-    if (n > left()) {
-      if (!inGrid_) unreadable("the file is truncated");
-      corrupt(pos_, "a size that runs past the grid's end at byte " + std::to_string(end_));
-    }
-    const char* p = file_.data() + pos_;
-    pos_ += static_cast<std::size_t>(n);
-    return p;
-  }
-  template <class T>
-  T get() {
-    T v;
-    std::memcpy(&v, take(sizeof v), sizeof v);
-    return v;
-  }
-  /// io::readString: a uint32 length and the bytes.
-  std::string string() {
-    const auto n = get<std::uint32_t>();
-    return std::string(take(n), n);
-  }
-
- private:
-  const std::string& file_;
-  std::size_t pos_;
-  std::size_t end_;
-  bool inGrid_;
-};
-
-std::uint64_t bitsOn(const char* mask, std::size_t bytes) {
-  std::uint64_t n = 0;
-  for (std::size_t i = 0; i < bytes; ++i) n += std::popcount(static_cast<unsigned char>(mask[i]));
-  return n;
-}
-
-bool bitOn(const char* mask, std::size_t i) {
-  return (static_cast<unsigned char>(mask[i / 8]) >> (i % 8)) & 1u;
-}
-
-/// A blosc block OpenVDB decompresses with blosc_decompress_ctx, which takes the block's length
-/// from its own header: safe only when blosc validates that header against the block's real length
-/// (`bytes`). Then the block must decompress to `expected` bytes, or (`padded`) to the 128 bytes
-/// OpenVDB pads smaller point arrays to.
-///
-/// The block is decompressed here once, as OpenVDB will: a header can be sound over a damaged body,
-/// and OpenVDB throwing from the middle of a paged attribute read leaks the page handles its
-/// AttributeArray keeps in a union (no destructor runs for them).
-void checkBlosc(const Cursor& in, std::size_t at, const char* block, std::uint64_t bytes,
-                std::uint64_t expected, bool padded) {
-  std::size_t nbytes = 0;
-  if (bytes < BLOSC_MIN_HEADER_LENGTH || blosc_cbuffer_validate(block, bytes, &nbytes) != 0) {
-    in.corrupt(at, "a blosc block of " + std::to_string(bytes) + " bytes that blosc refuses");
-  }
-  const auto pad = static_cast<std::uint64_t>(openvdb::compression::BLOSC_PAD_BYTES);
-  if (nbytes != expected && !(padded && expected <= pad && nbytes == pad)) {
-    in.corrupt(at, "a blosc block holding " + std::to_string(nbytes) + " bytes where " +
-                       std::to_string(expected) + " are expected");
-  }
-  // nbytes is now bounded by the structure the file declares, which the cursor has checked.
-  std::vector<char> out(nbytes);
-  const int got = blosc_decompress_ctx(block, out.data(), out.size(), /*numinternalthreads=*/1);
-  if (got < 0 || static_cast<std::size_t>(got) != nbytes) {
-    in.corrupt(at, "a blosc block of " + std::to_string(bytes) + " bytes that does not decompress");
-  }
-}
-
-/// What a grid's metadata says about how its values are stored.
-struct MetadataFound {
-  bool halfFloat = false;  // is_saved_as_half_float: real values are stored as half floats
-};
 
 /// io::DelayedLoadMetadata::readValue (the "file_delayed_load" OpenVDB 6.2 and later write).
 void checkDelayedLoad(Cursor& in, std::uint32_t numBytes, std::uint64_t leafBound) {
@@ -157,10 +62,8 @@ void checkDelayedLoad(Cursor& in, std::uint32_t numBytes, std::uint64_t leafBoun
   in.take(numBytes - total);
 }
 
-/// MetaMap::readMeta: a count, then per entry a name, a type name, a byte count and the value.
-/// Registered types are read as OpenVDB reads them (a fixed size whatever the count says, so the
-/// count must be that size; strings and io::DelayedLoadMetadata by their own layout); unknown types
-/// as raw bytes. `leafBound` bounds the leaf count a DelayedLoadMetadata may claim.
+}  // namespace
+
 MetadataFound checkMetadata(Cursor& in, std::uint64_t leafBound) {
   MetadataFound found;
   const auto count = in.get<std::uint32_t>();
@@ -200,6 +103,8 @@ MetadataFound checkMetadata(Cursor& in, std::uint64_t leafBound) {
   return found;
 }
 
+namespace {
+
 /// math::Transform::read: a map type and its values (every one a finite double).
 void checkTransform(Cursor& in) {
   static const std::map<std::string, std::size_t> kLinearMapDoubles = {
@@ -232,196 +137,54 @@ void checkTransform(Cursor& in) {
   doubles(it->second, at);
 }
 
-/// What a grid's values are: their size in bytes, and the size of the half floats OpenVDB stores
-/// real values as in a grid saved as half (io::RealToHalf).
-struct ValueLayout {
-  std::size_t size;
-  std::size_t halfSize;
+/// The grids tickfx reads: OpenVDB's numeric and vector trees, and PointDataGrid.
+struct GridKind {
+  ValueLayout value;
+  bool points;
 };
 
-/// Checks one grid from its start (the compression flags) to its end: metadata, transform, tree
-/// topology (RootNode, InternalNode 5 and 4, LeafNode 3) and buffers, regular or PointDataGrid.
-class GridCheck {
+const std::map<std::string, GridKind>& gridKinds() {
+  static const std::map<std::string, GridKind> kinds = {
+      {openvdb::FloatGrid::gridType(), {{4, 2}, false}},
+      {openvdb::DoubleGrid::gridType(), {{8, 2}, false}},
+      {openvdb::Int32Grid::gridType(), {{4, 0}, false}},
+      {openvdb::Int64Grid::gridType(), {{8, 0}, false}},
+      {openvdb::Vec3IGrid::gridType(), {{12, 0}, false}},
+      {openvdb::Vec3SGrid::gridType(), {{12, 6}, false}},
+      {openvdb::Vec3DGrid::gridType(), {{24, 6}, false}},
+      {openvdb::points::PointDataGrid::gridType(), {{4, 0}, true}},
+  };
+  return kinds;
+}
+
+/// One GridDescriptor (GridDescriptor::read): names, type, and where the grid lies.
+struct Descriptor {
+  std::string uniqueName;
+  std::string type;  // as in the file, "_HalfFloat" included
+  std::string parent;
+  std::int64_t gridPos = 0, blockPos = 0, endPos = 0;
+  std::string gridName() const { return openvdb::io::GridDescriptor::stripSuffix(uniqueName); }
+};
+
+// A PointDataGrid leaf's voxel values: 512 uint32 offsets.
+constexpr std::uint64_t kLeafOffsetBytes = 512 * 4;
+
+/// The buffers of one PointDataGrid's leaves (points::PointDataLeafNode::readBuffers).
+class PointBufferCheck {
  public:
-  GridCheck(Cursor& in, ValueLayout value, bool points, std::uint64_t gridBytes)
-      : in_(in), value_(value), points_(points), gridBytes_(gridBytes) {}
+  PointBufferCheck(Cursor& in, const std::vector<LeafMask>& leaves) : in_(in), leaves_(leaves) {}
 
-  /// Checks up to the buffers and returns where they begin.
-  std::size_t topology() {
-    const std::size_t at = in_.pos();
-    compression_ = in_.get<std::uint32_t>();  // Archive::readGridCompression
-    if (compression_ & ~(kZip | kActiveMask | kBlosc)) {
-      in_.corrupt(at, "unknown compression flags " + std::to_string(compression_));
-    }
-    half_ = checkMetadata(in_, gridBytes_ / kLeafMaskBytes).halfFloat && value_.halfSize != 0;
-    checkTransform(in_);
-    root();
-    return in_.pos();
-  }
-
-  void buffers() {
-    if (points_) {
-      pointBuffers();
-      return;
-    }
-    for (const std::array<char, kLeafMaskBytes>& mask : leafMasks_) {
-      leafMask(mask);
-      values(512, mask.data(), kLeafMaskBytes);
-    }
-  }
-
- private:
-  // ---- topology ------------------------------------------------------------------------------
-
-  void root() {
-    const std::size_t at = in_.pos();
-    if (in_.get<std::int32_t>() != 1) in_.corrupt(at, "a tree with other than one buffer");
-    in_.take(value_.size);  // the background value
-    const auto tiles = in_.get<std::uint32_t>();
-    const auto children = in_.get<std::uint32_t>();
-    // The root's table is a std::map: OpenVDB writes tiles, then children, each in the map's
-    // order, and reads buffers in that order. Keys in order, unique and node-aligned keep the
-    // file's order the reading order and every lookup finding its node.
-    std::vector<openvdb::Coord> tileKeys;
-    for (std::uint32_t i = 0; i < tiles; ++i) {
-      const openvdb::Coord key = rootKey(tileKeys);
-      in_.take(value_.size);
-      const std::size_t active = in_.pos();
-      if (in_.get<std::uint8_t>() > 1) in_.corrupt(active, "a tile that is neither on nor off");
-      tileKeys.push_back(key);
-    }
-    std::vector<openvdb::Coord> childKeys;
-    for (std::uint32_t i = 0; i < children; ++i) {
-      const std::size_t keyAt = in_.pos();
-      const openvdb::Coord key = rootKey(childKeys);
-      if (std::binary_search(tileKeys.begin(), tileKeys.end(), key)) {
-        in_.corrupt(keyAt, "a child of the root where it has a tile");
-      }
-      childKeys.push_back(key);
-      internal(5);
-    }
-  }
-
-  openvdb::Coord rootKey(const std::vector<openvdb::Coord>& before) {
-    const std::size_t at = in_.pos();
-    openvdb::Coord key;
-    for (int c = 0; c < 3; ++c) key[c] = in_.get<std::int32_t>();
-    constexpr std::int32_t kAlign = (1 << 12) - 1;  // a root child spans 2^(5+4+3) voxels
-    if ((key[0] & kAlign) || (key[1] & kAlign) || (key[2] & kAlign) ||
-        (!before.empty() && !(before.back() < key))) {
-      in_.corrupt(at, "a root node entry out of order or not aligned to its node");
-    }
-    return key;
-  }
-
-  void internal(int log2) {
-    const std::size_t bytes = (std::size_t{1} << (3 * log2)) / 8;
-    const std::size_t at = in_.pos();
-    const char* childMask = in_.take(bytes);
-    const char* valueMask = in_.take(bytes);
-    for (std::size_t i = 0; i < bytes; ++i) {
-      if (childMask[i] & valueMask[i]) in_.corrupt(at, "a node value that is both child and tile");
-    }
-    values(std::uint64_t{1} << (3 * log2), valueMask, bytes);
-    for (std::size_t i = 0; i < bytes * 8; ++i) {
-      if (!bitOn(childMask, i)) continue;
-      if (log2 == 5) {
-        internal(4);
-      } else {
-        std::array<char, kLeafMaskBytes> mask;
-        std::memcpy(mask.data(), in_.take(kLeafMaskBytes), kLeafMaskBytes);
-        leafMasks_.push_back(mask);
-      }
-    }
-  }
-
-  // ---- values (io::readCompressedValues, io::readData) ------------------------------------------
-
-  void values(std::uint64_t count, const char* valueMask, std::size_t maskBytes) {
-    const std::size_t at = in_.pos();
-    const auto layout = in_.get<std::int8_t>();
-    if (layout < 0 || layout > 6) in_.corrupt(at, "unknown node value compression");
-    if (layout == 2 || layout == 4 || layout == 5) in_.take(value_.size);  // an inactive value
-    if (layout == 5) in_.take(value_.size);                                // a second one
-    if (layout >= 3 && layout <= 5) in_.take(maskBytes);                   // which is which
-    // With mask compression, only the active values are stored.
-    const std::uint64_t stored =
-        (compression_ & kActiveMask) && layout != 6 ? bitsOn(valueMask, maskBytes) : count;
-    if (half_ && stored == 0) return;  // io::HalfReader reads nothing then
-    data(stored * (half_ ? value_.halfSize : value_.size));
-  }
-
-  void data(std::uint64_t bytes) {
-    if (!(compression_ & (kBlosc | kZip))) {
-      in_.take(bytes);
-      return;
-    }
-    const std::size_t at = in_.pos();
-    const auto n = in_.get<std::int64_t>();
-    if (n <= 0) {
-      // Stored raw: OpenVDB reads -n bytes into its buffer of `bytes` before comparing the two.
-      if (n == std::numeric_limits<std::int64_t>::min() ||
-          static_cast<std::uint64_t>(-n) != bytes) {
-        in_.corrupt(at, "a block of " + std::to_string(n) + " bytes where " +
-                            std::to_string(bytes) + " are expected");
-      }
-      in_.take(bytes);
-      return;
-    }
-    const char* block = in_.take(static_cast<std::uint64_t>(n));
-    // zlib is given the block's length and the buffer's size, and OpenVDB compares what it gets:
-    // a zip block needs no more. Blosc trusts the block's header.
-    if (compression_ & kBlosc) {
-      checkBlosc(in_, at + 8, block, static_cast<std::uint64_t>(n), bytes, /*padded=*/false);
-    }
-  }
-
-  void leafMask(const std::array<char, kLeafMaskBytes>& topology) {
-    // LeafNode::readBuffers reads the value mask again from a stream; OpenVDB writes it twice the
-    // same, and values() counts the one in the topology.
-    const std::size_t at = in_.pos();
-    if (std::memcmp(in_.take(kLeafMaskBytes), topology.data(), kLeafMaskBytes) != 0) {
-      in_.corrupt(at, "a leaf's value mask unlike the one in the tree's topology");
-    }
-  }
-
-  // ---- PointDataGrid buffers (points::PointDataLeafNode::readBuffers) ---------------------------
-
-  /// An attribute array as TypedAttributeArray::readMetadata leaves it.
-  struct Array {
-    bool uniform = false;
-    bool paged = false;
-    std::uint64_t stored = 0;    // its bytes in the file (compressed or not)
-    std::uint64_t expected = 0;  // the bytes of its data: (uniform ? 1 : dataSize()) * storage size
-    std::size_t page = 0;        // paged: its page in its attribute's stream
-  };
-  struct Page {
-    std::int32_t compressed;  // > 0: a blosc block of that many bytes; < 0: raw, -that many
-    std::int32_t uncompressed;
-    bool loaded = false;
-  };
-  /// compression::PagedInputStream: the pages of one attribute index across the leaves.
-  struct PagedStream {
-    std::int64_t byteIndex = 0;
-    std::int64_t uncompressed = 0;
-    std::vector<Page> pages;
-  };
-  struct PointLeaf {
-    std::shared_ptr<const std::vector<std::size_t>> storage;  // per attribute, from the descriptor
-    std::vector<Array> arrays;
-  };
-
-  void pointBuffers() {
+  void check() {
     // Grid::readBuffers: a pass count, then every leaf once per pass.
     const std::size_t at = in_.pos();
     const auto passes = in_.get<std::uint16_t>();
     // OpenVDB writes 2n + 4 passes for leaves of at most n attributes, and none for no leaves.
-    if (passes == 0 ? !leafMasks_.empty() : passes < 4 || passes % 2 != 0) {
-      in_.corrupt(at, std::to_string(passes) + " passes over " + std::to_string(leafMasks_.size()) +
+    if (passes == 0 ? !leaves_.empty() : passes < 4 || passes % 2 != 0) {
+      in_.corrupt(at, std::to_string(passes) + " passes over " + std::to_string(leaves_.size()) +
                           " leaves");
     }
     const std::uint32_t attributes = passes == 0 ? 0 : (passes - 4u) / 2u;
-    std::vector<PointLeaf> leaves(leafMasks_.size());
+    std::vector<PointLeaf> leaves(leaves_.size());
     std::map<std::uint32_t, PagedStream> streams;
     for (std::uint32_t pass = 0; pass < passes; ++pass) {
       bool matching = false;  // the shared descriptor (the "hasMatchingDescriptor" aux data)
@@ -453,7 +216,7 @@ class GridCheck {
         } else if (pass < attributes + 2) {
           if (pass - 2 < count) sizes(streams[pass - 2], leaf.arrays[pass - 2]);
         } else if (pass == attributes + 2) {
-          voxels(leafMasks_[l]);
+          voxels(leaves_[l]);
         } else if (pass < 2 * attributes + 3) {
           const std::uint32_t a = pass - attributes - 3;
           if (a < count) contents(streams[a], leaf.arrays[a]);
@@ -464,6 +227,31 @@ class GridCheck {
       }
     }
   }
+
+ private:
+  /// An attribute array as TypedAttributeArray::readMetadata leaves it.
+  struct Array {
+    bool uniform = false;
+    bool paged = false;
+    std::uint64_t stored = 0;    // its bytes in the file (compressed or not)
+    std::uint64_t expected = 0;  // the bytes of its data: (uniform ? 1 : dataSize()) * storage size
+    std::size_t page = 0;        // paged: its page in its attribute's stream
+  };
+  struct Page {
+    std::int32_t compressed;  // > 0: a blosc block of that many bytes; < 0: raw, -that many
+    std::int32_t uncompressed;
+    bool loaded = false;
+  };
+  /// compression::PagedInputStream: the pages of one attribute index across the leaves.
+  struct PagedStream {
+    std::int64_t byteIndex = 0;
+    std::int64_t uncompressed = 0;
+    std::vector<Page> pages;
+  };
+  struct PointLeaf {
+    std::shared_ptr<const std::vector<std::size_t>> storage;  // per attribute, from the descriptor
+    std::vector<Array> arrays;
+  };
 
   /// AttributeSet::Descriptor::read: types (name and codec), the names and positions of the
   /// attributes, groups, and default-value metadata. Returns each attribute's storage size.
@@ -630,8 +418,8 @@ class GridCheck {
 
   /// The voxel pass: the value mask again, then the offsets (the readCompressedValues of
   /// PointDataIndex32: a 16-bit size, 0xFFFF for raw, else a blosc block).
-  void voxels(const std::array<char, kLeafMaskBytes>& mask) {
-    leafMask(mask);
+  void voxels(const LeafMask& mask) {
+    checkLeafMask(in_, mask);
     const std::size_t at = in_.pos();
     const auto bytes = in_.get<std::uint16_t>();
     if (bytes == std::numeric_limits<std::uint16_t>::max()) {
@@ -643,46 +431,20 @@ class GridCheck {
   }
 
   Cursor& in_;
-  ValueLayout value_;
-  bool points_;
-  std::uint64_t gridBytes_;
-  std::uint32_t compression_ = 0;
-  bool half_ = false;
-  std::vector<std::array<char, kLeafMaskBytes>> leafMasks_;  // in reading order
+  const std::vector<LeafMask>& leaves_;  // the leaves' value masks, in reading order
   std::map<openvdb::NamePair, std::size_t> storageSizes_;
 };
 
-/// The grids GridCheck knows: OpenVDB's numeric and vector trees, and PointDataGrid.
-struct GridKind {
-  ValueLayout value;
-  bool points;
-};
-
-const std::map<std::string, GridKind>& gridKinds() {
-  static const std::map<std::string, GridKind> kinds = {
-      {openvdb::FloatGrid::gridType(), {{4, 2}, false}},
-      {openvdb::DoubleGrid::gridType(), {{8, 2}, false}},
-      {openvdb::Int32Grid::gridType(), {{4, 0}, false}},
-      {openvdb::Int64Grid::gridType(), {{8, 0}, false}},
-      {openvdb::Vec3IGrid::gridType(), {{12, 0}, false}},
-      {openvdb::Vec3SGrid::gridType(), {{12, 6}, false}},
-      {openvdb::Vec3DGrid::gridType(), {{24, 6}, false}},
-      {openvdb::points::PointDataGrid::gridType(), {{4, 0}, true}},
-  };
-  return kinds;
+/// Grid::readBuffers of a PointDataGrid: a pass count, then every leaf once per pass. `leaves` are
+/// the leaves' value masks as the tree's topology gave them.
+void checkPointBuffers(Cursor& in, const std::vector<LeafMask>& leaves) {
+  PointBufferCheck(in, leaves).check();
 }
 
-/// One GridDescriptor (GridDescriptor::read): names, type, and where the grid lies.
-struct Descriptor {
-  std::string uniqueName;
-  std::string type;  // as in the file, "_HalfFloat" included
-  std::string parent;
-  std::int64_t gridPos = 0, blockPos = 0, endPos = 0;
-  std::string gridName() const { return openvdb::io::GridDescriptor::stripSuffix(uniqueName); }
-};
-
-/// Checks the grid described by `d`, beginning at `begin` and ending by `end`; returns where its
-/// buffers begin and where it ends.
+/// Checks the grid described by `d`, beginning at `begin` and ending by `end`, as
+/// io::Archive::readGrid reads it: its compression flags, metadata and transform, its tree's
+/// topology, then its buffers, a regular tree's or a PointDataGrid's. Returns where its buffers
+/// begin and where it ends.
 std::pair<std::size_t, std::size_t> checkGrid(const std::string& file, std::uint32_t format,
                                               const Descriptor& d, std::size_t begin,
                                               std::size_t end) {
@@ -704,15 +466,36 @@ std::pair<std::size_t, std::size_t> checkGrid(const std::string& file, std::uint
                std::to_string(kPointsFormat) + ")");
   }
   Cursor in(file, begin, end, /*inGrid=*/true);
-  GridCheck grid(in, kind->second.value, kind->second.points, end - begin);
-  const std::size_t block = grid.topology();
-  grid.buffers();
+  const std::size_t at = in.pos();
+  const auto compression = in.get<std::uint32_t>();  // Archive::readGridCompression
+  if (compression & ~(kZip | kActiveMask | kBlosc)) {
+    in.corrupt(at, "unknown compression flags " + std::to_string(compression));
+  }
+  const ValueLayout value = kind->second.value;
+  const bool halfFloat =
+      checkMetadata(in, (end - begin) / kLeafMaskBytes).halfFloat && value.halfSize != 0;
+  checkTransform(in);
+  const TreeStorage storage{value, compression, halfFloat};
+  const std::vector<LeafMask> leaves = checkTreeTopology(in, storage);
+  const std::size_t block = in.pos();
+  if (kind->second.points) {
+    checkPointBuffers(in, leaves);
+  } else {
+    checkTreeBuffers(in, storage, leaves);
+  }
   return {block, in.pos()};
 }
 
 }  // namespace
+}  // namespace tickfx::vdbcheck
+
+namespace tickfx {
 
 std::string extractCheckedVdbGrid(const std::string& file, const std::string& name) {
+  using vdbcheck::checkGrid, vdbcheck::checkMetadata, vdbcheck::Cursor, vdbcheck::Descriptor;
+  using vdbcheck::kLeafMaskBytes, vdbcheck::kNewestFormat, vdbcheck::kOldestFormat;
+  using vdbcheck::unreadable;
+  using Kind = VdbFileError::Kind;
   Cursor in(file, 0, file.size(), /*inGrid=*/false);
   // ---- header (io::Archive::readHeader) ----
   if (file.size() < 8 || in.get<std::int64_t>() != openvdb::OPENVDB_MAGIC) {
