@@ -1,7 +1,8 @@
 // What the checks of an untrusted .vdb file share: the reader of its bytes, and the metadata maps
 // every level of the file holds (the file's, a grid's, a point attribute set's defaults), for
-// VdbFileCheck.cpp and VdbTreeCheck.cpp (the tree's nodes and compressed values). Internal to
-// tickfx_vdb; it includes none of OpenVDB's headers.
+// VdbFileCheck.cpp, VdbTreeCheck.cpp (the tree's nodes and compressed values) and
+// VdbPointsCheck.cpp (points::PointDataLeafNode and its attribute arrays). Internal to tickfx_vdb;
+// it includes none of OpenVDB's headers.
 #pragma once
 
 #include <cstddef>
