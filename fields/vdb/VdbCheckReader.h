@@ -1,6 +1,7 @@
 // What the checks of an untrusted .vdb file share: the reader of its bytes, and the metadata maps
-// every level of the file holds (the file's, a grid's, a point attribute set's defaults), for
-// VdbFileCheck.cpp, VdbTreeCheck.cpp (the tree's nodes and compressed values) and
+// every level of the file holds (the file's, a grid's, a point attribute set's defaults). The
+// checks are split as OpenVDB 10 splits its readers: VdbArchiveCheck.cpp (io::Archive, io::File,
+// MetaMap, math::Transform), VdbTreeCheck.cpp (the tree's nodes and compressed values),
 // VdbPointsCheck.cpp (points::PointDataLeafNode and its attribute arrays). Internal to tickfx_vdb;
 // it includes none of OpenVDB's headers.
 #pragma once
@@ -69,7 +70,7 @@ struct MetadataFound {
 /// Registered types are read as OpenVDB reads them (a fixed size whatever the count says, so the
 /// count must be that size; strings and io::DelayedLoadMetadata by their own layout); unknown types
 /// as raw bytes. `leafBound` bounds the leaf count a DelayedLoadMetadata may claim. Defined in
-/// VdbFileCheck.cpp.
+/// VdbArchiveCheck.cpp.
 MetadataFound checkMetadata(Cursor& in, std::uint64_t leafBound);
 
 }  // namespace tickfx::vdbcheck

@@ -1,7 +1,7 @@
 // Checking a PointDataGrid's buffers the way OpenVDB 10 reads them: points::PointDataLeafNode's
 // passes over the leaves, each leaf's AttributeSet::Descriptor and points::TypedAttributeArray
 // metadata, the attribute pages of compression::PagedInputStream, and the voxel offsets. Internal
-// to tickfx_vdb (VdbFileCheck.cpp uses it).
+// to tickfx_vdb (VdbArchiveCheck.cpp uses it).
 #pragma once
 
 #include <vector>

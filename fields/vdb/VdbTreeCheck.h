@@ -1,7 +1,7 @@
 // Checking a grid's tree the way OpenVDB 10 reads it: the topology (RootNode, InternalNode 5 and 4,
 // LeafNode 3 readTopology), the leaves' values (LeafNode::readBuffers), node values as
 // io::readCompressedValues stores them, and the blosc blocks every part of a grid may hold.
-// Internal to tickfx_vdb (VdbFileCheck.cpp and VdbPointsCheck.cpp use it).
+// Internal to tickfx_vdb (VdbArchiveCheck.cpp and VdbPointsCheck.cpp use it).
 #pragma once
 
 #include <array>
