@@ -2,6 +2,11 @@
 // flags it reads: a corrupted one makes it abort on an assertion, read or write past a buffer, or
 // allocate gigabytes. This walks one grid's bytes the way OpenVDB reads them and refuses anything
 // OpenVDB would trust wrongly. Internal to tickfx_vdb: VdbGridFile.cpp is its one user.
+//
+// The checks are split as OpenVDB's readers are: VdbArchiveCheck.cpp (the file's header, metadata,
+// transforms and grid descriptors; extractCheckedVdbGrid), VdbTreeCheck.h (a grid's tree and its
+// compressed values), VdbPointsCheck.h (a PointDataGrid's leaves and attribute arrays), sharing
+// the byte reader of VdbCheckReader.h.
 #pragma once
 
 #include <stdexcept>
