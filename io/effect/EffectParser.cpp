@@ -16,24 +16,23 @@
 #include <toml++/toml.h>
 
 #include "integrators/Integrator.h"
-#include "io/util/Fingerprint.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/VdbPointCache.h"
 #include "io/effect/EditDistance.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/SettingOverrides.h"
+#include "io/effect/TableReader.h"
 #include "io/effect/VectorFieldSource.h"
+#include "io/util/Fingerprint.h"
 
 #if !TOML_EXCEPTIONS
 #error "tickfx_io reads parse errors from toml::parse_error: build toml++ with exceptions"
 #endif
 
 namespace tickfx::io {
+namespace detail {
 namespace {
 
-// The bound on every unbounded quantity (positions, speeds, accelerations, times): far beyond any
-// effect, and far inside the float range the simulation rounds to.
-constexpr double kBig = 1e9;
 constexpr std::int64_t kMaxStepRate = 1'000'000;
 constexpr std::int64_t kMaxParticles = 1'000'000'000;
 constexpr std::int64_t kMaxTicksPerFrame = 100'000;
@@ -114,350 +113,6 @@ const std::vector<std::string>& particleEmitterKeys() {
   return keys;
 }
 
-std::string childPath(std::string_view parent, std::string_view key) {
-  return parent.empty() ? std::string(key) : std::string(parent) + "." + std::string(key);
-}
-
-std::string childPath(std::string_view parent, std::size_t index) {
-  return childPath(parent, std::to_string(index));
-}
-
-std::string joinWords(const std::vector<std::string>& words) {
-  std::string out;
-  for (const std::string& w : words) out += (out.empty() ? "" : ", ") + w;
-  return out;
-}
-
-std::string quote(std::string_view s) {
-  constexpr std::size_t kLimit = 40;
-  if (s.size() > kLimit) return "\"" + std::string(s.substr(0, kLimit)) + "...\"";
-  return "\"" + std::string(s) + "\"";
-}
-
-// A float as written in TOML: with a fraction, so that 60.0 does not read as the integer 60.
-std::string floatText(double v) {
-  std::string s = formatNumber(v);
-  if (s.find_first_of(".eni") == std::string::npos) s += ".0";
-  return s;
-}
-
-// What a value is, for "got …" messages.
-std::string describe(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string:
-      return "got a string " + quote(*node.value<std::string_view>());
-    case toml::node_type::integer:
-      return "got the integer " + std::to_string(*node.value<std::int64_t>());
-    case toml::node_type::floating_point:
-      return "got the number " + floatText(*node.value<double>());
-    case toml::node_type::boolean:
-      return std::string("got ") + (*node.value<bool>() ? "true" : "false");
-    case toml::node_type::array:
-      return "got an array";
-    case toml::node_type::table:
-      return "got a table";
-    default:
-      return "got a date or time";
-  }
-}
-
-// A closed or half-open interval; messages spell the bounds out in the "expected" text.
-struct Range {
-  double min = -kBig;
-  double max = kBig;
-  bool minOpen = false;
-  bool maxOpen = false;
-
-  bool contains(double v) const {
-    return (minOpen ? v > min : v >= min) && (maxOpen ? v < max : v <= max);
-  }
-};
-
-// Where findings go while one document is read.
-class Context {
- public:
-  Context(std::string file, const OverrideOrigins& origins)
-      : file_(std::move(file)), origins_(origins) {}
-
-  SourceLocation at(const toml::node& node) const {
-    if (const std::string* label = origins_.labelOf(node)) return {*label, 0, 0};
-    const toml::source_position& begin = node.source().begin;
-    return {file_, static_cast<int>(begin.line), static_cast<int>(begin.column)};
-  }
-
-  // An unknown key is shown where its name is written.
-  SourceLocation atKey(const toml::key& key, const toml::node& value) const {
-    if (const std::string* label = origins_.labelOf(value)) return {*label, 0, 0};
-    const toml::source_position& begin = key.source().begin;
-    if (begin.line == 0) return at(value);
-    return {file_, static_cast<int>(begin.line), static_cast<int>(begin.column)};
-  }
-
-  void error(const SourceLocation& where, std::string keyPath, std::string message) {
-    diagnostics_.push_back(Diagnostic{Severity::Error, where.file, where.line, where.column,
-                                      std::move(keyPath), std::move(message)});
-  }
-
-  void record(std::string keyPath, const toml::node& node) {
-    sources_.set(std::move(keyPath), at(node));
-  }
-
-  const std::string& file() const { return file_; }
-  const OverrideOrigins& origins() const { return origins_; }
-  // The effect file's directory: files an effect names are relative to it.
-  std::filesystem::path directory() const { return std::filesystem::path(file_).parent_path(); }
-  std::vector<Diagnostic>& diagnostics() { return diagnostics_; }
-  SourceMap& sources() { return sources_; }
-
- private:
-  std::string file_;
-  const OverrideOrigins& origins_;
-  std::vector<Diagnostic> diagnostics_;
-  SourceMap sources_;
-};
-
-// What the core type that owns an entry's settings refuses in them (its validate()), shown where
-// each key was written, or at the entry's header for a default. Only for an entry read without
-// errors: every value is then the file's or a documented default, never a default standing in
-// for a value already refused, and no condition the reader words itself is reported twice.
-void reportProblems(Context& cx, const std::string& entryPath, const SettingProblems& problems) {
-  for (const SettingProblem& p : problems) {
-    const std::string path = entryPath + "." + p.key;
-    cx.error(cx.sources().find(path), path, p.message + " (expected " + p.expected + ")");
-  }
-}
-
-// ---- single values -------------------------------------------------------------------------
-// Each check reports what is wrong with `node` (at `path`) and returns nothing, or returns the
-// value. `expected` is the "(expected …)" text: the unit and the range.
-
-std::optional<double> checkNumber(Context& cx, const toml::node& node, const std::string& path,
-                                  const std::string& expected, const Range& range) {
-  std::optional<double> v;
-  if (const auto i = node.value_exact<std::int64_t>()) v = static_cast<double>(*i);
-  if (const auto f = node.value_exact<double>()) v = *f;
-  if (!v) {
-    cx.error(cx.at(node), path, describe(node) + " (expected " + expected + ")");
-    return std::nullopt;
-  }
-  if (!std::isfinite(*v)) {
-    cx.error(cx.at(node), path,
-             formatNumber(*v) + " is not a finite number (expected " + expected + ")");
-    return std::nullopt;
-  }
-  if (!range.contains(*v)) {
-    cx.error(cx.at(node), path, formatNumber(*v) + " is out of range (expected " + expected + ")");
-    return std::nullopt;
-  }
-  cx.record(path, node);
-  return v;
-}
-
-std::optional<std::int64_t> checkInteger(Context& cx, const toml::node& node,
-                                         const std::string& path, const std::string& expected,
-                                         std::int64_t min, std::int64_t max) {
-  if (const auto f = node.value_exact<double>()) {
-    cx.error(cx.at(node), path, floatText(*f) + " is not an integer (expected " + expected + ")");
-    return std::nullopt;
-  }
-  const auto v = node.value_exact<std::int64_t>();
-  if (!v) {
-    cx.error(cx.at(node), path, describe(node) + " (expected " + expected + ")");
-    return std::nullopt;
-  }
-  if (*v < min || *v > max) {
-    cx.error(cx.at(node), path,
-             std::to_string(*v) + " is out of range (expected " + expected + ")");
-    return std::nullopt;
-  }
-  cx.record(path, node);
-  return v;
-}
-
-// One of `names`, with a suggestion when the word is close to one.
-std::optional<std::string> checkChoice(Context& cx, const toml::node& node, const std::string& path,
-                                       const std::vector<std::string>& names,
-                                       std::string_view what) {
-  const auto v = node.value_exact<std::string>();
-  if (!v) {
-    cx.error(
-        cx.at(node), path,
-        describe(node) + " (expected " + std::string(what) + ", one of: " + joinWords(names) + ")");
-    return std::nullopt;
-  }
-  for (const std::string& name : names) {
-    if (*v == name) {
-      cx.record(path, node);
-      return v;
-    }
-  }
-  const std::optional<std::string> guess = closestMatch(*v, names);
-  cx.error(cx.at(node), path,
-           "unknown " + std::string(what) + " " + quote(*v) +
-               (guess ? " (did you mean " + quote(*guess) + "?)"
-                      : " (expected one of: " + joinWords(names) + ")"));
-  return std::nullopt;
-}
-
-// ---- tables ----------------------------------------------------------------------------------
-
-// Reads the keys of one table. Every key a reader asks for is known; finish() reports the rest.
-class TableReader {
- public:
-  TableReader(Context& cx, const toml::table& table, std::string path)
-      : cx_(cx), table_(table), path_(std::move(path)) {
-    cx_.record(path_, table_);
-  }
-
-  const std::string& path() const { return path_; }
-  std::string pathOf(std::string_view key) const { return childPath(path_, key); }
-  const toml::table& table() const { return table_; }
-
-  // The value of `key`, or nullptr; the key becomes known either way.
-  const toml::node* take(std::string_view key) {
-    if (known_.insert(std::string(key)).second) knownOrder_.emplace_back(key);
-    return table_.get(key);
-  }
-
-  // A required key is missing: the error points at the table's header.
-  void missing(std::string_view key, const std::string& expected) {
-    cx_.error(cx_.at(table_), pathOf(key), "missing (expected " + expected + ")");
-  }
-
-  template <typename T>
-  bool number(std::string_view key, T& out, const std::string& expected, const Range& range,
-              bool required = false) {
-    const toml::node* node = take(key);
-    if (node == nullptr) {
-      if (required) missing(key, expected);
-      return false;
-    }
-    const std::optional<double> v = checkNumber(cx_, *node, pathOf(key), expected, range);
-    if (v) out = static_cast<T>(*v);
-    return v.has_value();
-  }
-
-  template <typename T>
-  bool integer(std::string_view key, T& out, const std::string& expected, std::int64_t min,
-               std::int64_t max, bool required = false) {
-    const toml::node* node = take(key);
-    if (node == nullptr) {
-      if (required) missing(key, expected);
-      return false;
-    }
-    const std::optional<std::int64_t> v = checkInteger(cx_, *node, pathOf(key), expected, min, max);
-    if (v) out = static_cast<T>(*v);
-    return v.has_value();
-  }
-
-  bool boolean(std::string_view key, bool& out) {
-    const toml::node* node = take(key);
-    if (node == nullptr) return false;
-    const auto v = node->value_exact<bool>();
-    if (!v) {
-      cx_.error(cx_.at(*node), pathOf(key), describe(*node) + " (expected true or false)");
-      return false;
-    }
-    cx_.record(pathOf(key), *node);
-    out = *v;
-    return true;
-  }
-
-  // A non-empty string.
-  bool string(std::string_view key, std::string& out, const std::string& expected) {
-    const toml::node* node = take(key);
-    if (node == nullptr) return false;
-    const auto v = node->value_exact<std::string>();
-    if (!v || v->empty()) {
-      cx_.error(cx_.at(*node), pathOf(key),
-                (v ? std::string("got an empty string") : describe(*node)) + " (expected " +
-                    expected + ")");
-      return false;
-    }
-    cx_.record(pathOf(key), *node);
-    out = *v;
-    return true;
-  }
-
-  bool choice(std::string_view key, std::string& out, const std::vector<std::string>& names,
-              std::string_view what, bool required = false) {
-    const toml::node* node = take(key);
-    if (node == nullptr) {
-      if (required) missing(key, std::string(what) + ", one of: " + joinWords(names));
-      return false;
-    }
-    const std::optional<std::string> v = checkChoice(cx_, *node, pathOf(key), names, what);
-    if (v) out = *v;
-    return v.has_value();
-  }
-
-  // [x, y, z], each component in `range`; `nonZero` for directions.
-  bool vec3(std::string_view key, Eigen::Vector3d& out, const std::string& expected,
-            const Range& range, bool nonZero = false) {
-    const toml::node* node = take(key);
-    if (node == nullptr) return false;
-    const std::string path = pathOf(key);
-    const toml::array* array = node->as_array();
-    if (array == nullptr) {
-      cx_.error(cx_.at(*node), path, describe(*node) + " (expected " + expected + ")");
-      return false;
-    }
-    if (array->size() != 3) {
-      cx_.error(cx_.at(*node), path,
-                "got " + std::to_string(array->size()) +
-                    (array->size() == 1 ? " entry" : " entries") + " (expected " + expected + ")");
-      return false;
-    }
-    Eigen::Vector3d v;
-    bool ok = true;
-    for (std::size_t i = 0; i < 3; ++i) {
-      const std::optional<double> c =
-          checkNumber(cx_, *array->get(i), childPath(path, i), expected, range);
-      if (c) v[static_cast<Eigen::Index>(i)] = *c;
-      ok = ok && c.has_value();
-    }
-    if (!ok) return false;
-    if (nonZero && v.isZero(0.0)) {
-      cx_.error(cx_.at(*node), path, "got [0, 0, 0] (expected " + expected + ")");
-      return false;
-    }
-    cx_.record(path, *node);
-    out = v;
-    return true;
-  }
-
-  // Marks keys as known without reading them (parameters of a variant that could not be told).
-  void allow(const std::vector<std::string>& keys) {
-    for (const std::string& k : keys) take(k);
-  }
-
-  // Reports every key nobody asked for. `notHere` holds keys that belong to another variant
-  // (another shape, another force type) and why they do not apply to this one.
-  void finish(const std::map<std::string, std::string>& notHere = {}) {
-    for (const auto& [key, value] : table_) {
-      const std::string name(key.str());
-      if (known_.count(name) != 0) continue;
-      const std::string path = pathOf(name);
-      if (const auto it = notHere.find(name); it != notHere.end()) {
-        cx_.error(cx_.atKey(key, value), path, it->second);
-        continue;
-      }
-      const std::optional<std::string> guess = closestMatch(name, knownOrder_);
-      cx_.error(cx_.atKey(key, value), path,
-                "unknown key " + quote(name) +
-                    (guess ? " (did you mean " + quote(*guess) + "?)"
-                           : " (expected one of: " + joinWords(knownOrder_) + ")"));
-    }
-  }
-
- private:
-  Context& cx_;
-  const toml::table& table_;
-  std::string path_;
-  std::set<std::string> known_;
-  std::vector<std::string> knownOrder_;
-};
-
 // ---- the sections of a version-1 document ----------------------------------------------------
 
 void readSimulation(Context& cx, const toml::table& table, SystemSettings& s) {
@@ -482,10 +137,6 @@ void readSimulation(Context& cx, const toml::table& table, SystemSettings& s) {
   }
   r.finish();
 }
-
-const std::string kPositionText = "[x, y, z] in metres, each from -1e9 to 1e9";
-const std::string kDirectionText = "a direction [x, y, z], each from -1e9 to 1e9, not all zero";
-const std::string kSecondsText = "seconds, a number from 0 to 1e9";
 
 void readBursts(Context& cx, TableReader& r, EmitterSettings& e, std::int64_t maxParticles) {
   const toml::node* node = r.take("bursts");
@@ -1640,6 +1291,7 @@ bool migrateToCurrent(Context& cx, toml::table& document) {
 }
 
 }  // namespace
+}  // namespace detail
 
 LoadResult parseEffect(std::string_view text, std::string_view fileName,
                        const std::vector<std::string>& overrides) {
@@ -1658,11 +1310,11 @@ LoadResult parseEffect(std::string_view text, std::string_view fileName,
   }
 
   OverrideOrigins origins;
-  Context cx(file, origins);
-  if (migrateToCurrent(cx, document)) {
+  detail::Context cx(file, origins);
+  if (detail::migrateToCurrent(cx, document)) {
     const std::vector<Diagnostic> overrideErrors = applyOverrides(document, overrides, origins);
     cx.diagnostics().insert(cx.diagnostics().end(), overrideErrors.begin(), overrideErrors.end());
-    EffectSettings effect = readCurrentVersion(cx, document);
+    EffectSettings effect = detail::readCurrentVersion(cx, document);
     if (!hasErrors(cx.diagnostics())) {
       effect.sources = std::move(cx.sources());
       result.effect = std::move(effect);
