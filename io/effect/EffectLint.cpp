@@ -60,6 +60,8 @@ std::optional<std::int64_t> smallestStepRate(std::int64_t from,
   return lo;
 }
 
+// Warns at forces.N.frequency about a wind at or above the Nyquist limit: docs/effects.md,
+// "Lint warnings", "Wind above the Nyquist limit".
 void lintWind(const EffectSettings& effect, const WindSettings& wind, const std::string& path,
               std::vector<Diagnostic>& out) {
   const double rate = static_cast<double>(effect.simulation.stepRateHz);
@@ -76,8 +78,8 @@ void lintWind(const EffectSettings& effect, const WindSettings& wind, const std:
                   " Hz wind (use a step_rate of at least " + std::to_string(needed) + " Hz)"));
 }
 
-// A real-time host that advances the effect at its output fps runs up to ⌈H / fps⌉ ticks a frame;
-// past max_ticks_per_frame it drops ticks (`tickfx run` never does: it lifts the cap).
+// Warns at simulation.max_ticks_per_frame when a real-time host advancing at the output's fps
+// would drop ticks: docs/effects.md, "[simulation]" (max_ticks_per_frame and overrun).
 void lintTickCap(const EffectSettings& effect, std::vector<Diagnostic>& out) {
   const SystemSettings& sim = effect.simulation;
   const FrameRate fps = effect.output.fps;
@@ -99,10 +101,10 @@ void lintTickCap(const EffectSettings& effect, std::vector<Diagnostic>& out) {
           " Hz)"));
 }
 
-// A vector field, loaded (or baked) as the builder will: a file that will not load, and a field
-// that carries particles across more than a voxel a step (drag and advect modes: the particles
-// follow the field's velocity, so a step longer than a voxel skips its structure, the CFL
-// condition of advection).
+// Warns at `path` about the vector field `field`, loaded (or baked) as the builder will, or
+// `built` when the builder made it: a file that will not load, and a field that carries particles
+// more than a voxel a step. docs/effects.md, "Lint warnings", "A vector field that does not load"
+// and "A field that carries particles more than a voxel a step".
 void lintVectorField(const EffectSettings& effect, const VectorFieldSettings& field,
                      const std::string& path, const VectorField* built,
                      std::vector<Diagnostic>& out) {
@@ -121,8 +123,7 @@ void lintVectorField(const EffectSettings& effect, const VectorFieldSettings& fi
     return;
   }
   if (field.mode == VectorField::Mode::Force) return;
-  // Drag pulls particles toward the field's velocity itself (scale is a rate there); advection
-  // moves them at scale times it.
+  // S of docs/effects.md ("A field that carries particles more than a voxel a step").
   const double speed = loaded->maxMagnitude() *
                        (field.mode == VectorField::Mode::Advect ? std::abs(field.scale) : 1.0);
   const double voxel = loaded->voxelSize();
@@ -166,10 +167,11 @@ std::string listOf(const std::vector<std::string>& paths) {
   return out;
 }
 
-// Every anchor spring pulls on every particle, so the springs of an effect act as one spring of
-// their stiffnesses and dampings added up: two springs each under the stability limit can be past
-// it together. They are checked as that one spring (with ω = √(k/m), m the lightest mass), and a
-// warning is shown at the first spring's stiffness, naming the others.
+// Checks the effect's anchor springs as one spring of their stiffnesses and dampings added up:
+// against the integrator's stability limit and, within it, for energy drift under explicit_euler
+// and midpoint. docs/effects.md, "Lint warnings", "Anchor spring past the integrator's stability
+// limit" and "Anchor spring whose energy drifts every step". At most one warning, at the first
+// spring's stiffness.
 void lintAnchorSprings(const EffectSettings& effect, std::vector<Diagnostic>& out) {
   std::vector<std::string> paths;
   double k = 0.0, c = 0.0;
@@ -296,8 +298,10 @@ StructureStiffness structureStiffness(const StructureSettings& structure) {
 
 namespace {
 
-// The stiffest structure (largest ω of its fastest vibration, anchor springs included) against
-// the integrator: past the stability limit, or, under explicit Euler, gaining energy each step.
+// Checks the stiffest structure (largest ω, anchor springs included) against the integrator's
+// stability limit and, under explicit_euler, for energy gain: docs/effects.md, "Lint warnings",
+// "A structure past the integrator's stability limit" and "A structure under explicit Euler". At
+// most one warning, at that structure's stiffness.
 void lintStructures(const EffectSettings& effect, std::vector<Diagnostic>& out) {
   double anchorK = 0.0, anchorC = 0.0;
   for (const ForceSettings& f : effect.forces) {
@@ -351,12 +355,13 @@ void lintStructures(const EffectSettings& effect, std::vector<Diagnostic>& out) 
     return;
   }
   if (integrator != "explicit_euler" || cTotal >= kTotal / rate) return;
-  // The fastest vibration as one damped oscillator: energy × 1 + (k_eff·dt − c_eff)·dt/m a step.
+  // Energy factor a step of the fastest vibration (docs/effects.md, "A structure under explicit
+  // Euler").
   const auto perStep = [=](double h) { return 1.0 + (kTotal / h - cTotal) / (m * h); };
   const double duration = effect.output.durationSeconds();
   const double budget = std::log(1.0 + kTolerableDrift);
   const double total = std::exp(rate * duration * std::log(perStep(rate)));
-  // Each spring's damping counts springFactor times, like its stiffness.
+  // The damping per spring that makes c_eff = k_eff·dt.
   const double neededDamping = (kTotal / rate - anchorC) / stiffness.springFactor;
   const std::string dampingWhy = anchorK > 0.0 ? "k·dt with the anchor springs" : "k·dt";
   std::string fix =
