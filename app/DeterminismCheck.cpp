@@ -34,8 +34,7 @@ std::vector<DriveCase> standardDriveCases(Flicks total, const std::vector<int>& 
       {"24 fps", {24, 1}}, {"25 fps", {25, 1}},
       {"30 fps", {30, 1}}, {"30000/1001 fps", {30000, 1001}},
       {"60 fps", {60, 1}}, {"144 fps", {144, 1}}};
-  for (const auto& [label, rate] : rates)
-    cases.push_back({label, fixedRateFrames(rate, total), 1});
+  for (const auto& [label, rate] : rates) cases.push_back({label, fixedRateFrames(rate, total), 1});
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     cases.push_back({"jitter " + std::to_string(seed), jitteredFrames(seed, total), 1});
   }

@@ -15,9 +15,9 @@
 namespace tickfx::app {
 
 preview::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
-                                const std::string& labelA, const std::string& labelB,
-                                std::int64_t tick, int width, int height,
-                                DifferenceSummary* summary) {
+                                     const std::string& labelA, const std::string& labelB,
+                                     std::int64_t tick, int width, int height,
+                                     DifferenceSummary* summary) {
   // Each particle of a against its id in b (rows are in id order in both).
   constexpr double kMissing = std::numeric_limits<double>::infinity();
   std::vector<double> distance(a.size(), kMissing);
@@ -25,9 +25,9 @@ preview::SplatImage renderDifference(const io::FrameData& a, const io::FrameData
   for (std::size_t i = 0; i < a.size(); ++i) {
     const auto it = std::lower_bound(b.id.begin(), b.id.end(), a.id[i]);
     if (it != b.id.end() && *it == a.id[i]) {
-      const double d =
-          (preview::positionOf(a, i) - preview::positionOf(b, static_cast<std::size_t>(it - b.id.begin())))
-              .norm();
+      const double d = (preview::positionOf(a, i) -
+                        preview::positionOf(b, static_cast<std::size_t>(it - b.id.begin())))
+                           .norm();
       distance[i] = std::isnan(d) ? kMissing : d;
       if (std::isfinite(distance[i])) found.largest = std::max(found.largest, d);
     }
@@ -40,16 +40,16 @@ preview::SplatImage renderDifference(const io::FrameData& a, const io::FrameData
   std::vector<preview::Rgb> colours(a.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     colours[i] = preview::viridis(!std::isfinite(distance[i]) ? 1.0
-                             : found.largest > 0.0       ? distance[i] / found.largest
-                                                         : 0.0);
+                                  : found.largest > 0.0       ? distance[i] / found.largest
+                                                              : 0.0);
   }
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   preview::growBounds(a, lo, hi);
   preview::growBounds(b, lo, hi);
   if (!(lo.x() <= hi.x())) lo = hi = Eigen::Vector3d::Zero();
-  const preview::PinholeCamera camera =
-      preview::PinholeCamera::framing(lo, hi, preview::upVector(preview::UpAxis::Y), 40.0, width, height, 0.1);
+  const preview::PinholeCamera camera = preview::PinholeCamera::framing(
+      lo, hi, preview::upVector(preview::UpAxis::Y), 40.0, width, height, 0.1);
   preview::RenderSettings settings;
   settings.grid = preview::GroundGrid::under(lo, hi, preview::UpAxis::Y);
   if (settings.grid) settings.axisLength = settings.grid->spacing;

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <string>
 
-#include "io/cache/FrameData.h"
 #include "app/preview/SplatImage.h"
+#include "io/cache/FrameData.h"
 
 namespace tickfx::app {
 
@@ -21,8 +21,8 @@ struct DifferenceSummary {
 /// states. The caption names the tick and the runs (`labelA`, `labelB`); the legend gives the
 /// range in metres. Fills `summary` when given.
 preview::SplatImage renderDifference(const io::FrameData& a, const io::FrameData& b,
-                                const std::string& labelA, const std::string& labelB,
-                                std::int64_t tick, int width, int height,
-                                DifferenceSummary* summary = nullptr);
+                                     const std::string& labelA, const std::string& labelB,
+                                     std::int64_t tick, int width, int height,
+                                     DifferenceSummary* summary = nullptr);
 
 }  // namespace tickfx::app

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "io/state/HashLog.h"
 #include "io/effect/EffectSettings.h"
+#include "io/state/HashLog.h"
 
 namespace tickfx::app {
 

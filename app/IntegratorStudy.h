@@ -9,12 +9,12 @@
 #pragma once
 
 #include <cstdint>
-#include "fields/ForceSet.h"
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
+#include "fields/ForceSet.h"
 
 namespace tickfx {
 

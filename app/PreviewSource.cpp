@@ -6,14 +6,14 @@
 #include <optional>
 #include <stdexcept>
 
-#include "app/LoadEffect.h"
 #include "app/FrameTimes.h"
+#include "app/LoadEffect.h"
+#include "fields/SpringNetwork.h"
 #include "io/cache/CacheFolder.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLoader.h"
 #include "io/effect/EffectParser.h"
 #include "particles/ParticleSystem.h"
-#include "fields/SpringNetwork.h"
 
 namespace tickfx::app {
 namespace {

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "app/Commands.h"
-#include "io/util/AtomicFile.h"
 #include "io/effect/EffectSettings.h"
+#include "io/util/AtomicFile.h"
 
 namespace {
 

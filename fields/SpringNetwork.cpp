@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "particles/ParallelFor.h"
 #include "particles/Assert.h"
+#include "particles/ParallelFor.h"
 
 namespace tickfx {
 namespace {

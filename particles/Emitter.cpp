@@ -4,11 +4,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "particles/Assert.h"
 #include "particles/DetMath.h"
 #include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
 #include "particles/Random.h"
-#include "particles/Assert.h"
 
 namespace tickfx {
 namespace {

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "particles/ExactTime.h"
 #include "particles/Assert.h"
+#include "particles/ExactTime.h"
 
 namespace tickfx {
 namespace {

@@ -3,11 +3,11 @@
 #include <cstdio>
 #include <memory>
 
+#include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
-#include "fields/ForceSet.h"
 
 int main() {
   using namespace tickfx;

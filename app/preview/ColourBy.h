@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "io/cache/FrameData.h"
 #include "app/preview/SplatImage.h"
+#include "io/cache/FrameData.h"
 
 namespace tickfx::preview {
 

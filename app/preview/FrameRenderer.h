@@ -6,10 +6,10 @@
 #include <utility>
 #include <vector>
 
-#include "io/cache/FrameData.h"
 #include "app/preview/PinholeCamera.h"
 #include "app/preview/SceneGuides.h"
 #include "app/preview/SplatImage.h"
+#include "io/cache/FrameData.h"
 
 namespace tickfx::preview {
 

@@ -10,8 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "io/util/AtomicFile.h"
 #include "io/cache/RowBlocks.h"
+#include "io/util/AtomicFile.h"
 
 namespace tickfx::io {
 namespace {

@@ -6,10 +6,10 @@
 #include <string_view>
 #include <vector>
 
-#include "io/util/AtomicFile.h"
 #include "io/cache/CacheFormat.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/VdbPointCache.h"
+#include "io/util/AtomicFile.h"
 
 namespace tickfx::io {
 

@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "io/util/AtomicFile.h"
 #include "io/cache/RowBlocks.h"
+#include "io/util/AtomicFile.h"
 
 namespace tickfx::io {
 namespace {

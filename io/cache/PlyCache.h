@@ -3,8 +3,8 @@
 
 #include <filesystem>
 
-#include "io/util/AtomicFile.h"
 #include "io/cache/FrameData.h"
+#include "io/util/AtomicFile.h"
 
 namespace tickfx::io {
 

@@ -6,9 +6,9 @@
 #include <filesystem>
 #include <string>
 
-#include "io/util/AtomicFile.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/VdbCacheOptions.h"
+#include "io/util/AtomicFile.h"
 
 namespace tickfx::io {
 

@@ -3,10 +3,10 @@
 #include <exception>
 #include <new>
 
+#include "fields/ForceSet.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
-#include "fields/ForceSet.h"
 
 namespace tickfx {
 namespace {

@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "fields/ForceSet.h"
 #include "fields/vdb/VectorField.h"
 #include "io/cache/CacheFormat.h"
 #include "io/cache/VdbCacheOptions.h"
@@ -18,7 +19,6 @@
 #include "particles/Emitter.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Structure.h"
-#include "fields/ForceSet.h"
 
 namespace tickfx::io {
 
@@ -146,7 +146,7 @@ struct OutputSettings {
   double seconds = 10.0;
   std::optional<std::int64_t> frames;
   std::vector<CacheFormat> formats{CacheFormat::Csv};  // may be empty: simulate, write nothing
-  VdbCacheOptions vdb;  // vdb_compression, vdb_positions: how VDB caches are stored
+  VdbCacheOptions vdb;            // vdb_compression, vdb_positions: how VDB caches are stored
   std::string directory = "out";  // as written; relative to the working directory of the command
 
   /// Frames to write (>= 1).

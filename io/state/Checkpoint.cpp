@@ -12,10 +12,10 @@
 #include <type_traits>
 #include <vector>
 
+#include "fields/SpringNetwork.h"
+#include "integrators/Integrator.h"
 #include "io/util/AtomicFile.h"
 #include "particles/StateHash.h"
-#include "integrators/Integrator.h"
-#include "fields/SpringNetwork.h"
 
 namespace tickfx::io {
 namespace {

@@ -14,11 +14,11 @@
 #include <utility>
 #include <vector>
 
+#include "fields/ForceSet.h"
 #include "io/cache/FrameData.h"
 #include "io/effect/EffectLoader.h"
 #include "particles/StateHash.h"
 #include "python/bindings/Bindings.h"
-#include "fields/ForceSet.h"
 
 namespace tickfx::python {
 namespace {

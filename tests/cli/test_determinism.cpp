@@ -13,16 +13,16 @@
 
 #include "app/DeterminismCheck.h"
 #include "app/DifferenceImage.h"
+#include "app/FrameTimes.h"
+#include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
-#include "app/FrameTimes.h"
 #include "io/cache/FrameData.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectParser.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
-#include "fields/ForceSet.h"
 
 namespace fs = std::filesystem;
 

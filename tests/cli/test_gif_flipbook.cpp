@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "io/util/AtomicFile.h"
 #include "app/preview/GifFlipbook.h"
 #include "app/preview/SplatImage.h"
+#include "io/util/AtomicFile.h"
 
 namespace tickfx::preview {
 

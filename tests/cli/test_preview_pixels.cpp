@@ -51,15 +51,16 @@ TEST_F(PreviewPixels, ShowsEachParticleInItsOwnColourWhereTheCameraProjectsIt) {
   writeCache(dir_ / "cache", particles);
   const Result r = run("preview " + path("cache") +
                        " --camera 0,0,8 --lookat 0,0,0 --fov 40 --size 200x150 --point-size 9"
-                       " --no-guides --out " + path("png"));
+                       " --no-guides --out " +
+                       path("png"));
   ASSERT_EQ(r.exit, 0) << r.err;
   const test::DecodedPng png = test::decodePng(readAll(path("png/frame_0001.png")));
   ASSERT_EQ(png.error, "");
   ASSERT_EQ(png.width, 200);
   ASSERT_EQ(png.height, 150);
 
-  const preview::PinholeCamera camera({0.0, 0.0, 8.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 40.0,
-                                      200, 150);
+  const preview::PinholeCamera camera({0.0, 0.0, 8.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 40.0, 200,
+                                      150);
   const preview::Rgb background = preview::RenderSettings{}.background;
   const std::array<int, 3> bg = {background[0], background[1], background[2]};
   std::vector<std::array<int, 2>> centres;
@@ -70,8 +71,8 @@ TEST_F(PreviewPixels, ShowsEachParticleInItsOwnColourWhereTheCameraProjectsIt) {
     ASSERT_TRUE(x >= 0 && x < 200 && y >= 0 && y < 150);
     centres.push_back({x, y});
     // The splat's centre is the particle's own colour, whole.
-    EXPECT_EQ(png.at(x, y), p.colour) << "particle at " << p.position.transpose() << ", pixel "
-                                      << x << "," << y;
+    EXPECT_EQ(png.at(x, y), p.colour)
+        << "particle at " << p.position.transpose() << ", pixel " << x << "," << y;
   }
   // The particles are apart on the screen: none draws over another's centre.
   ASSERT_NE(centres[0], centres[1]);

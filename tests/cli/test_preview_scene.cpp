@@ -9,17 +9,17 @@
 #include <vector>
 
 #include "app/FrameTimes.h"
-#include "io/cache/CacheFolder.h"
-#include "io/cache/CsvCache.h"
-#include "io/cache/PlyCache.h"
-#include "io/effect/EffectBuilder.h"
-#include "io/effect/EffectParser.h"
 #include "app/preview/ColourBy.h"
 #include "app/preview/ColourMap.h"
 #include "app/preview/FrameRenderer.h"
 #include "app/preview/PinholeCamera.h"
 #include "app/preview/SceneGuides.h"
 #include "app/preview/SplatImage.h"
+#include "io/cache/CacheFolder.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/PlyCache.h"
+#include "io/effect/EffectBuilder.h"
+#include "io/effect/EffectParser.h"
 #include "particles/ParticleSystem.h"
 
 namespace tickfx::preview {

@@ -254,9 +254,9 @@ std::array<double, 2> discreteOscillator(const std::string& name, std::int64_t r
   return x;
 }
 
-// The round-off bound of tests/support/ObliqueTestSupport.h for this run: each tick's roundings (at most
-// 16 per component of the step and 24 per force evaluation, each u of what it rounds), carried to
-// the end by the scheme's own propagator (explicit Euler's grows, position Verlet's as n²).
+// The round-off bound of tests/support/ObliqueTestSupport.h for this run: each tick's roundings (at
+// most 16 per component of the step and 24 per force evaluation, each u of what it rounds), carried
+// to the end by the scheme's own propagator (explicit Euler's grows, position Verlet's as n²).
 struct Bound {
   double p, v;
 };

@@ -26,13 +26,13 @@
 #include <vector>
 
 #include "ObliqueTestSupport.h"
-#include "fields/vdb/AnalyticField.h"
 #include "fields/AnchorSpring.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
 #include "fields/SpringNetwork.h"
+#include "fields/vdb/AnalyticField.h"
 #include "fields/vdb/VectorField.h"
 #include "particles/ParallelFor.h"
 

@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
-#include "fields/vdb/AnalyticField.h"
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
+#include "fields/vdb/AnalyticField.h"
 #include "particles/Clock.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"

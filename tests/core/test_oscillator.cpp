@@ -196,12 +196,12 @@ INSTANTIATE_TEST_SUITE_P(AllSchemes, ConvergenceOrder,
 
 // The trajectories themselves at dt = 1/20 over 20 s: the symplectic schemes stay on the exact
 // solution to within their phase error, explicit Euler spirals out. The largest |p − (−cos t)| of
-// each float run is that of the scheme's own recurrence in double (tests/support/ObliqueTestSupport.h)
-// within the round-off bound there, where that bound is under a tenth of it: explicit Euler
-// (0.60 m), semi-implicit Euler (0.027 m) and midpoint (0.21 m). For velocity Verlet (1.9e-3 m
-// against a bound of 4.9e-4 m), position Verlet (1.9e-3 m; its bound grows as n², 5.4e-3 m) and
-// RK4 (7.7e-7 m; bound 1e-4 m) the run can only show an error under the recurrence's plus the
-// bound.
+// each float run is that of the scheme's own recurrence in double
+// (tests/support/ObliqueTestSupport.h) within the round-off bound there, where that bound is under
+// a tenth of it: explicit Euler (0.60 m), semi-implicit Euler (0.027 m) and midpoint (0.21 m). For
+// velocity Verlet (1.9e-3 m against a bound of 4.9e-4 m), position Verlet (1.9e-3 m; its bound
+// grows as n², 5.4e-3 m) and RK4 (7.7e-7 m; bound 1e-4 m) the run can only show an error under the
+// recurrence's plus the bound.
 TEST(Oscillator, TrajectoriesAt20HzStayNearTheExactSolution) {
   using oblique::Vec;
   const oblique::Accel accel = [](const std::vector<Vec>& p, const std::vector<Vec>&, double) {

@@ -12,9 +12,9 @@
 
 #include "FlippedBitTestSupport.h"
 #include "VdbTestData.h"
-#include "fields/vdb/AnalyticField.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
+#include "fields/vdb/AnalyticField.h"
 #include "fields/vdb/VectorField.h"
 #include "integrators/Integrator.h"
 #include "particles/ParticlePool.h"

@@ -19,9 +19,9 @@
 
 #include "../LittleEndianBytes.h"
 #include "FuzzScratch.h"
-#include "io/util/Fingerprint.h"
-#include "io/state/Checkpoint.h"
 #include "io/effect/EffectLoader.h"
+#include "io/state/Checkpoint.h"
+#include "io/util/Fingerprint.h"
 #include "particles/StateHash.h"
 
 namespace {

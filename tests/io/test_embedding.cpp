@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "io/state/Checkpoint.h"
+#include "WorkerPool.h"
 #include "io/effect/EffectLoader.h"
+#include "io/state/Checkpoint.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"
-#include "WorkerPool.h"
 
 namespace tickfx {
 namespace {

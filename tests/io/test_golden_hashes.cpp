@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "WorkerPool.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
 #include "particles/TaskExecutor.h"
-#include "WorkerPool.h"
 
 namespace tickfx::io {
 namespace {

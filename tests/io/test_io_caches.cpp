@@ -12,13 +12,13 @@
 #include <string>
 #include <utility>
 
-#include "fields/Gravity.h"
 #include "app/FrameTimes.h"
+#include "fields/ForceSet.h"
+#include "fields/Gravity.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/PlyCache.h"
 #include "particles/ParticleSystem.h"
-#include "fields/ForceSet.h"
 
 namespace fs = std::filesystem;
 
@@ -207,7 +207,8 @@ TEST(FrameTimes, SchedulesEndExactlyWhereAsked) {
     EXPECT_EQ(frames, app::jitteredFrames(seed, fiveSeconds)) << "a pure function of the seed";
   }
   EXPECT_NE(app::jitteredFrames(1, fiveSeconds), app::jitteredFrames(2, fiveSeconds));
-  const std::vector<Flicks> ntsc = app::fixedRateFrames(app::parseFrameRate("30000/1001"), fiveSeconds);
+  const std::vector<Flicks> ntsc =
+      app::fixedRateFrames(app::parseFrameRate("30000/1001"), fiveSeconds);
   EXPECT_EQ(ntsc.size(), 150u);  // 149 whole frames of 1001/30000 s and a shorter last one
   EXPECT_EQ(ntsc.front(), 23'543'520);
   EXPECT_EQ(std::accumulate(ntsc.begin(), ntsc.end(), Flicks{0}), fiveSeconds);

@@ -21,11 +21,11 @@
 #include "CoreTestSupport.h"
 #include "LittleEndianBytes.h"
 #include "fields/Gravity.h"
-#include "io/state/Checkpoint.h"
-#include "io/effect/EffectParser.h"
-#include "particles/StateHash.h"
-#include "integrators/Integrator.h"
 #include "fields/SpringNetwork.h"
+#include "integrators/Integrator.h"
+#include "io/effect/EffectParser.h"
+#include "io/state/Checkpoint.h"
+#include "particles/StateHash.h"
 
 namespace fs = std::filesystem;
 

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "integrators/Integrator.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"

@@ -13,11 +13,11 @@
 
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
+#include "fields/SpringNetwork.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
 #include "particles/StateHash.h"
-#include "fields/SpringNetwork.h"
 
 namespace tickfx::io {
 namespace {

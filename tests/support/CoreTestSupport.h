@@ -14,12 +14,12 @@
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
+#include "fields/SpringNetwork.h"
 #include "integrators/Integrator.h"
 #include "particles/Clock.h"
 #include "particles/ParticlePool.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Random.h"
-#include "fields/SpringNetwork.h"
 
 namespace tickfx::test {
 
