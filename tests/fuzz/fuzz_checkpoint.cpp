@@ -17,7 +17,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "../LittleEndianBytes.h"
+#include "../support/LittleEndianBytes.h"
 #include "FuzzScratch.h"
 #include "io/effect/EffectLoader.h"
 #include "io/state/Checkpoint.h"
