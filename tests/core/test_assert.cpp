@@ -49,7 +49,7 @@ TEST_F(Assert, AViewReadBelowItsBaseReachesTheHook) {
   const float values[4] = {1, 2, 3, 4};
   const Vec3View view{values, values, values, 10};
   const std::string expected =
-      kAssertsEnabled ? "ForceModule.h: row >= base (a row read below a view's base)" : "";
+      kAssertsEnabled ? "RowViews.h: row >= base (a row read below a view's base)" : "";
   EXPECT_EQ(reported([&] {
               if constexpr (kAssertsEnabled) view.at(5);  // undefined behaviour when unchecked
             }),
@@ -75,7 +75,7 @@ TEST_F(Assert, ARowRangePastItsColumnReachesTheHook) {
   EXPECT_EQ(reported([&] {
               if constexpr (kAssertsEnabled) Vec3Rows::of(column, RowRange{2, 9});
             }),
-            kAssertsEnabled ? "ForceModule.h: r.begin <= r.end && r.end <= "
+            kAssertsEnabled ? "RowViews.h: r.begin <= r.end && r.end <= "
                               "static_cast<std::size_t>(c.x.size()) (a row range past the end "
                               "of its column)"
                             : "");
