@@ -6,13 +6,14 @@
 #include <Eigen/Core>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "CliTestSupport.h"
 #include "DecodedPng.h"
 #include "app/preview/FrameRenderer.h"
 #include "app/preview/PinholeCamera.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/FrameData.h"
 
 namespace tickfx::cli_test {
 namespace {
@@ -31,17 +32,25 @@ struct Particle {
   std::array<int, 3> colour;
 };
 
-// One frame of a CSV cache, as `tickfx run --format csv` writes it, with Houdini's Cd.
+// One frame of a CSV cache, written by the cache writer `tickfx run` uses, with Houdini's Cd.
 void writeCache(const fs::path& dir, const std::vector<Particle>& particles) {
   fs::create_directories(dir);
-  std::ofstream csv(dir / "frame_0001.csv");
-  csv << "id,px,py,pz,vx,vy,vz,age,life,mass,Cd_r,Cd_g,Cd_b\n";
-  int id = 0;
-  for (const Particle& p : particles) {
-    csv << id++ << ',' << p.position.x() << ',' << p.position.y() << ',' << p.position.z()
-        << ",0,0,0,0.5,2,1," << p.colour[0] / 255.0 << ',' << p.colour[1] / 255.0 << ','
-        << p.colour[2] / 255.0 << '\n';
+  io::FrameData frame;
+  frame.resize(particles.size(), {"Cd_r", "Cd_g", "Cd_b"});
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    frame.id[i] = i;
+    for (int c = 0; c < 3; ++c) {
+      frame.position[c][r] = static_cast<float>(particles[i].position[c]);
+      frame.velocity[c][r] = 0.0f;
+      frame.attributes[static_cast<std::size_t>(c)][r] =
+          static_cast<float>(particles[i].colour[c]) / 255.0f;
+    }
+    frame.age[r] = 0.5f;
+    frame.life[r] = 2.0f;
+    frame.mass[r] = 1.0f;
   }
+  io::writeCsvCache(frame, dir / "frame_0001.csv");
 }
 
 TEST_F(PreviewPixels, ShowsEachParticleInItsOwnColourWhereTheCameraProjectsIt) {
