@@ -15,6 +15,7 @@
 
 #include "CliTestSupport.h"
 #include "DecodedPng.h"
+#include "app/preview/FrameRenderer.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
 
@@ -692,7 +693,8 @@ TEST_F(Cli, PreviewRendersTheFramesAskedForAsPngs) {
             0);
   const tickfx::test::DecodedPng shown = tickfx::test::decodePng(readAll(path("n/frame_0035.png")));
   ASSERT_EQ(shown.error, "");
-  const std::array<int, 3> background = {24, 24, 28};  // preview::RenderSettings' default
+  const tickfx::preview::Rgb bg = tickfx::preview::RenderSettings{}.background;
+  const std::array<int, 3> background = {bg[0], bg[1], bg[2]};
   int drawn = 0;
   for (int y = 16; y < shown.height; ++y) {
     for (int x = 0; x < shown.width; ++x) drawn += shown.at(x, y) != background ? 1 : 0;
