@@ -154,7 +154,7 @@ std::unique_ptr<PreparedRun> prepareRun(const RunSettings& s, const io::EffectSe
     std::fprintf(stderr, "%s\n", e.what());
     return nullptr;
   }
-  run->lint = io::lintEffect(effect, &run->system->forces());
+  run->lint = io::lintEffect(effect, &run->system->forces(), run->system->colliders());
   for (const io::Diagnostic& d : run->lint) std::fprintf(stderr, "%s\n", d.format().c_str());
   if (s.resume && !resumeRun(*run, *s.resume)) return nullptr;
   if (!checkOutputs(s, run->firstFrame)) return nullptr;

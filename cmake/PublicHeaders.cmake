@@ -25,6 +25,9 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   integrators/Integrator.h
   integrators/StepRows.h
   fields/AnchorSpring.h
+  fields/Collider.h
+  fields/ColliderMotion.h
+  fields/ColliderSet.h
   fields/ForceModule.h
   fields/ForceSet.h
   fields/Gravity.h
@@ -37,6 +40,7 @@ set(TICKFX_CORE_PUBLIC_HEADERS
 # OpenVDB's).
 set(TICKFX_VDB_PUBLIC_HEADERS
   fields/vdb/AnalyticField.h
+  fields/vdb/LevelSetCollider.h
   fields/vdb/VectorField.h
 )
 

@@ -2,12 +2,14 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <stdexcept>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
+#include "fields/ColliderSet.h"
 #include "fields/ForceSet.h"
 #include "fields/SpringNetwork.h"
 #include "integrators/Integrator.h"
@@ -82,6 +84,14 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     const std::int64_t tick = exact::tickAtOrAfter(structures[i].time, settings.stepRateHz);
     structures_.push_back(PendingStructure{std::move(build), tick});
   }
+}
+
+ParticleSystem::ParticleSystem(const SystemSettings& settings,
+                               const std::vector<EmitterSettings>& emitters, ForceSet forces,
+                               const std::vector<StructureSettings>& structures,
+                               ColliderSet colliders)
+    : ParticleSystem(settings, emitters, std::move(forces), structures) {
+  if (!colliders.empty()) colliders_ = std::make_unique<ColliderSet>(std::move(colliders));
 }
 
 ParticleSystem::~ParticleSystem() = default;
@@ -182,7 +192,7 @@ struct ParticleSystem::FrameStart {
 
 bool ParticleSystem::fusesTicks(std::int64_t ticks) const {
   if (ticks < 2 || tickObserver_ || settings_.nonfinite == NonfinitePolicy::Kill ||
-      !forces_->interleavesTicks()) {
+      !forces_->interleavesTicks() || colliders_) {
     return false;
   }
   for (const PendingStructure& p : structures_) {
@@ -281,6 +291,10 @@ void ParticleSystem::runTick(bool keepVelocities) {
   const bool check = settings_.nonfinite != NonfinitePolicy::Keep;
   integrator_->step(pool_, *forces_, time, check ? &nonfiniteCheck_ : nullptr);
   if (nonfiniteCheck_.found()) takeNonfinite();
+  if (colliders_) {
+    colliders_->collide(pool_, tick_, settings_.stepRateHz, integrator_->readsPreviousPosition());
+    pathsTick_ = tick_ + 1;
+  }
   pool_.markAllStepped();
   forces_->endTick(pool_, time.stage(2));
   endTicks(tick_ + 1, keepVelocities);
@@ -324,6 +338,7 @@ void ParticleSystem::takeNonfinite() {
 
 void ParticleSystem::restoreClock(std::int64_t tick, const Vec3Column* tickStartVelocities) {
   tick_ = tick;
+  pathsTick_ = -1;  // a restored state has no collision paths: frames follow straight lines
   alpha_ = driver_.alpha();
   frameOffset_ = driver_.frameOffset();
   velocitiesTick_ = tickStartVelocities != nullptr ? tick : -1;
@@ -395,6 +410,25 @@ void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
   const Vec3Destination to = columnsOf(out, pool_.size());
   runParallel(
       [&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, pool_.size(), to); });
+  followPaths(alpha, to);
+}
+
+void ParticleSystem::followPaths(float alpha, const Vec3Destination& out) const {
+  if (!colliders_ || pathsTick_ != tick_ || alpha == 1.0f) return;
+  const std::vector<std::uint64_t>& ids = pool_.id();
+  const std::size_t n = pool_.size();
+  float* const dst[3] = {out.x, out.y, out.z};
+  for (const CollisionPath& path : colliders_->paths()) {
+    // Rows are in id order; a particle the tick removed (a kill contact) is not shown.
+    const auto it =
+        std::lower_bound(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(n), path.id);
+    if (it == ids.begin() + static_cast<std::ptrdiff_t>(n) || *it != path.id) continue;
+    const auto row = static_cast<std::size_t>(it - ids.begin());
+    const auto r = static_cast<Eigen::Index>(row);
+    const Eigen::Vector3f end(pool_.position().x[r], pool_.position().y[r], pool_.position().z[r]);
+    const Eigen::Vector3f p = path.at(alpha, end);
+    for (int c = 0; c < 3; ++c) rowOf(dst[c], out.rowStride, row) = p[c];
+  }
 }
 
 void ParticleSystem::renderPositions(Vec3Column& out) const {
@@ -415,6 +449,7 @@ CopyResult ParticleSystem::copyRenderPositions(const Vec3Destination& out) const
   if (out.capacity < n) return {n, false};
   const float alpha = frameOffset_ == kFlicksPerSecond ? 1.0f : alpha_;
   runParallel([&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, n, out); });
+  followPaths(alpha, out);
   return {n, true};
 }
 

@@ -21,6 +21,7 @@ namespace tickfx {
 // The system composes the layers above particles/: its forces (fields/ForceSet.h) and its scheme
 // (integrators/Integrator.h). This header only declares them; a host that builds a system
 // includes fields/ForceSet.h for the ForceSet it hands over.
+class ColliderSet;
 class ForceSet;
 class Integrator;
 class SpringNetwork;
@@ -74,6 +75,12 @@ class ParticleSystem {
   /// system then uses the first SpringNetwork in `forces`, or appends one if there is none.
   ParticleSystem(const SystemSettings& settings, const std::vector<EmitterSettings>& emitters,
                  ForceSet forces, const std::vector<StructureSettings>& structures = {});
+  /// As above, with `colliders` (fields/ColliderSet.h) run after each tick's step: particles
+  /// never pass through them (see ColliderSet::collide). A system with colliders runs its frames
+  /// tick by tick (no fused frames).
+  ParticleSystem(const SystemSettings& settings, const std::vector<EmitterSettings>& emitters,
+                 ForceSet forces, const std::vector<StructureSettings>& structures,
+                 ColliderSet colliders);
   ~ParticleSystem();
   ParticleSystem(const ParticleSystem&) = delete;
   ParticleSystem& operator=(const ParticleSystem&) = delete;
@@ -119,7 +126,9 @@ class ParticleSystem {
   /// (α = 1) they are the tick's own values, bit for bit. A frame between ticks k and k + 1
   /// shows the particles alive after tick k + 1: those born in that tick move from their birth
   /// state, and those removed by it (they die or leave a kill region within it) are not shown.
-  /// Other columns (mass, lifetime, attributes) are those of the current tick.
+  /// Other columns (mass, lifetime, attributes) are those of the current tick. A particle that
+  /// touched a collider in the newest tick is shown on its path through the contacts
+  /// (CollisionPath), not on the straight line from its start, which may cut through a collider.
   void renderPositions(Vec3Column& out) const;
   void renderVelocities(Vec3Column& out) const;
   void renderAges(FloatColumn& out) const;
@@ -161,6 +170,8 @@ class ParticleSystem {
   FixedStepDriver& driver() { return driver_; }
   const SystemSettings& settings() const { return settings_; }
   const std::vector<Emitter>& emitters() const { return emitters_; }
+  /// The colliders (nullptr when the system has none).
+  const ColliderSet* colliders() const { return colliders_.get(); }
   /// The spring network structures use (nullptr when the system has neither).
   const SpringNetwork* springs() const { return springs_; }
   SpringNetwork* springs() { return springs_; }
@@ -195,6 +206,11 @@ class ParticleSystem {
   std::vector<Emitter> emitters_;
   std::unique_ptr<ForceSet> forces_;  // never null
   std::unique_ptr<Integrator> integrator_;
+  std::unique_ptr<ColliderSet> colliders_;  // null when none
+  std::int64_t pathsTick_ = -1;             // the tick after which colliders_->paths() were found
+  // Moves the rows of render positions `out` (rows [0, n)) that touched a collider in the newest
+  // tick onto their paths at `alpha`.
+  void followPaths(float alpha, const Vec3Destination& out) const;
   struct PendingStructure {
     StructureBuild build;  // built (so validated) once, by the constructor; born at `tick`
     std::int64_t tick;

@@ -4,10 +4,13 @@
 #include <stdexcept>
 
 #include "fields/AnchorSpring.h"
+#include "fields/ColliderSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
 #include "fields/PeriodicWind.h"
+#include "fields/vdb/LevelSetCollider.h"
 #include "io/effect/VectorFieldSource.h"
+#include "io/mesh/MeshFile.h"
 
 namespace tickfx::io {
 namespace {
@@ -77,6 +80,34 @@ ForceSet buildForces(const std::vector<ForceSettings>& forces) {
   return set;
 }
 
+ColliderSet buildColliders(const std::vector<ColliderSettings>& colliders) {
+  ColliderSet set;
+  for (std::size_t i = 0; i < colliders.size(); ++i) {
+    const ColliderSettings& c = colliders[i];
+    if (c.type != ColliderType::LevelSet) {
+      set.add(makeCollider(c));
+      continue;
+    }
+    // A level set reads a file or bakes a grid: its failures name the key that led there.
+    using Source = LevelSetSettings::Source;
+    const std::string key = "colliders." + std::to_string(i) +
+                            (c.levelSet.source == Source::File   ? ".file"
+                             : c.levelSet.source == Source::Mesh ? ".mesh"
+                                                                 : ".bake");
+    try {
+      if (c.levelSet.source == Source::Mesh) {
+        const TriangleMesh mesh = readMeshFile(c.levelSet.path);
+        set.add(makeLevelSetCollider(c, &mesh));
+      } else {
+        set.add(makeLevelSetCollider(c));
+      }
+    } catch (const std::runtime_error& e) {
+      throw BuildError(Diagnostic{Severity::Error, "", 0, 0, key, e.what()});
+    }
+  }
+  return set;
+}
+
 std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
                                             std::optional<int> threadsOverride) {
   SystemSettings settings = effect.simulation;
@@ -85,9 +116,12 @@ std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
     settings.threads = *threadsOverride;
   }
   ForceSet forces;
+  ColliderSet colliders;
   try {
     forces = buildForces(effect.forces);
+    colliders = buildColliders(effect.colliders);
   } catch (const BuildError& e) {
+    // The error at its key's place in the file.
     Diagnostic d = e.diagnostic();
     const SourceLocation at = effect.sources.find(d.keyPath);
     d.file = at.file.empty() ? "<effect>" : at.file;  // "<effect>": settings built in code
@@ -96,7 +130,7 @@ std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
     throw BuildError(std::move(d));
   }
   return std::make_unique<ParticleSystem>(settings, effect.emitters, std::move(forces),
-                                          effect.structures);
+                                          effect.structures, std::move(colliders));
 }
 
 std::unique_ptr<ParticleSystem> buildOfflineSystem(const EffectSettings& effect,

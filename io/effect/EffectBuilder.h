@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "fields/ColliderSet.h"
 #include "fields/ForceSet.h"
 #include "fields/PeriodicWind.h"
 #include "io/effect/Diagnostics.h"
@@ -44,11 +45,18 @@ SettingProblems forceProblems(const ForceSettings& force);
 /// from parseEffect() never are.
 ForceSet buildForces(const std::vector<ForceSettings>& forces);
 
+/// The colliders of `colliders`, in order. Level sets are read (a .vdb file, a mesh) or baked
+/// now. Throws BuildError (without a position: key path "colliders.<i>.file", ".mesh" or
+/// ".bake") when a level set cannot be made, and std::invalid_argument for settings the colliders
+/// refuse (ColliderSettings::validate()): settings from parseEffect() never are.
+ColliderSet buildColliders(const std::vector<ColliderSettings>& colliders);
+
 /// A new system for `effect`: its [simulation] settings (with `threadsOverride`, when given, in
-/// place of simulation.threads), its emitters, its structures and its forces. The caller owns the
-/// system; the effect is not referenced after the call. Throws BuildError, located through
-/// effect.sources, when a vector field cannot be loaded; std::invalid_argument as ParticleSystem
-/// does for settings out of range: settings from parseEffect() never are.
+/// place of simulation.threads), its emitters, its structures, its forces and its colliders. The
+/// caller owns the system; the effect is not referenced after the call. Throws BuildError, located
+/// through effect.sources, when a vector field or a level set cannot be loaded;
+/// std::invalid_argument as ParticleSystem does for settings out of range: settings from
+/// parseEffect() never are.
 std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
                                             std::optional<int> threadsOverride = std::nullopt);
 

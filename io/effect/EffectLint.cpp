@@ -8,6 +8,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "io/effect/ColliderLint.h"
 #include "io/effect/VectorFieldSource.h"
 
 namespace tickfx::io {
@@ -394,7 +395,8 @@ std::optional<double> springStabilityLimit(std::string_view integrator) {
   return std::nullopt;
 }
 
-std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built) {
+std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built,
+                                   const ColliderSet* colliders) {
   std::vector<Diagnostic> out;
   for (std::size_t i = 0; i < effect.forces.size(); ++i) {
     const std::string path = "forces." + std::to_string(i);
@@ -411,6 +413,7 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet*
   lintAnchorSprings(effect, out);
   lintStructures(effect, out);
   lintTickCap(effect, out);
+  detail::lintColliders(effect, colliders, out);
   sortDiagnostics(out);
   return out;
 }

@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fields/ColliderSet.h"
 #include "fields/ForceSet.h"
 #include "io/effect/Diagnostics.h"
 #include "io/effect/EffectSettings.h"
@@ -85,7 +86,10 @@ StructureStiffness structureStiffness(const StructureSettings& structure);
 /// `built`: the forces buildForces() (or a ParticleSystem built from `effect`) made, in effect
 /// order; their vector fields are then inspected instead of loaded again. Without it, fields are
 /// loaded (or baked) here.
-std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built = nullptr);
+/// `colliders`: the colliders the builder made, in effect order (level sets are then not read
+/// again); without them they are made here. Their warnings: see io/effect/ColliderLint.h.
+std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built = nullptr,
+                                   const ColliderSet* colliders = nullptr);
 
 /// Of lintEffect()'s findings, the first that says a step grows without bound or adds energy every
 /// step: the likely cause when a run's state stops being finite. nullptr when none says so.

@@ -14,6 +14,7 @@
 
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectMigration.h"
+#include "io/effect/ParseColliders.h"
 #include "io/effect/ParseEmitters.h"
 #include "io/effect/ParseForces.h"
 #include "io/effect/ParseOutput.h"
@@ -31,7 +32,7 @@ namespace tickfx::io {
 namespace detail {
 namespace {
 
-constexpr std::size_t kMaxEntries = 10'000;  // emitters, forces
+constexpr std::size_t kMaxEntries = 10'000;  // emitters, forces, colliders
 
 // An array of tables ([[emitters]], [[forces]]): each entry handed to `read`.
 template <typename Read>
@@ -106,6 +107,12 @@ EffectSettings readCurrentVersion(Context& cx, const toml::table& document) {
     }
   });
   checkAdvection(cx, effect, forceEntries);
+  readEntries(cx, top, "colliders", /*required=*/false,
+              [&](const toml::table& table, std::size_t i) {
+                if (auto collider = readCollider(cx, table, i)) {
+                  effect.colliders.push_back(*collider);
+                }
+              });
 
   if (const toml::node* node = top.take("output")) {
     if (const toml::table* table = node->as_table()) {

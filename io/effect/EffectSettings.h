@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "fields/Collider.h"
 #include "fields/ForceSet.h"
 #include "fields/vdb/VectorField.h"
 #include "io/cache/CacheFormat.h"
@@ -171,6 +172,8 @@ struct EffectSettings {
   /// one per structure; empty for settings made in code (see structureKeyPath).
   std::vector<std::size_t> structureEntries;
   std::vector<ForceSettings> forces;
+  /// [[colliders]], in file order (earlier colliders win a tie between contacts).
+  std::vector<ColliderSettings> colliders;
   OutputSettings output;
   /// Where each value was written (for lint findings); defaults are not recorded.
   SourceMap sources;

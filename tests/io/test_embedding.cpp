@@ -112,9 +112,10 @@ TEST_F(Embedding, ErrorsComeBackAsTheCheckCommandsLines) {
   EXPECT_FALSE(fx.effect.has_value());
   EXPECT_EQ(fx.fingerprint, 0u);
   ASSERT_EQ(lines(fx).size(), 2u) << fx.text();
-  EXPECT_EQ(lines(fx)[0], file +
-                              ":1:1: error: unknown_key: unknown key \"unknown_key\" (expected "
-                              "one of: format_version, simulation, emitters, forces, output)");
+  EXPECT_EQ(lines(fx)[0],
+            file +
+                ":1:1: error: unknown_key: unknown key \"unknown_key\" (expected "
+                "one of: format_version, simulation, emitters, forces, colliders, output)");
   EXPECT_EQ(lines(fx)[1].rfind("--set simulation.step_rate: error: simulation.step_rate: ", 0), 0u)
       << lines(fx)[1];
   EXPECT_EQ(fx.text(), lines(fx)[0] + "\n" + lines(fx)[1] + "\n");

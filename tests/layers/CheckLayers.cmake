@@ -3,10 +3,11 @@
 # (cmake -DSOURCE_DIR=... -P CheckLayers.cmake; fails naming each include that points up).
 #
 # One composition root is allowed: particles/ParticleSystem.cpp runs a tick, so it is where the
-# pool meets the forces and the scheme. Its header (the system's public face) only declares them.
+# pool meets the forces, the colliders and the scheme. Its header (the system's public face) only declares them.
 cmake_minimum_required(VERSION 3.22)
 set(layers particles fields integrators io app)
 set(allowed_up
+  "particles/ParticleSystem.cpp -> fields/ColliderSet.h"
   "particles/ParticleSystem.cpp -> fields/ForceSet.h"
   "particles/ParticleSystem.cpp -> fields/SpringNetwork.h"
   "particles/ParticleSystem.cpp -> integrators/Integrator.h")

@@ -1,0 +1,115 @@
+#include "fields/ColliderSet.h"
+
+#include "particles/ParallelFor.h"
+
+namespace tickfx {
+
+ColliderSet::ColliderSet() = default;
+ColliderSet::~ColliderSet() = default;
+ColliderSet::ColliderSet(ColliderSet&&) noexcept = default;
+ColliderSet& ColliderSet::operator=(ColliderSet&&) noexcept = default;
+
+Collider& ColliderSet::add(std::unique_ptr<Collider> collider) {
+  colliders_.push_back(std::move(collider));
+  return *colliders_.back();
+}
+
+Eigen::Vector3f CollisionPath::at(float alpha, const Eigen::Vector3f& end) const {
+  if (alpha <= 0.0f) return start;
+  if (alpha >= 1.0f) return end;
+  float f0 = 0.0f;
+  Eigen::Vector3f p0 = start;
+  for (int k = 0; k <= contacts; ++k) {
+    const float f1 = k < contacts ? fraction[k] : 1.0f;
+    const Eigen::Vector3f& p1 = k < contacts ? point[k] : end;
+    if (alpha <= f1) {
+      if (!(f1 > f0)) return p1;
+      const float w = (alpha - f0) / (f1 - f0);
+      return p0 + (p1 - p0) * w;
+    }
+    f0 = f1;
+    p0 = p1;
+  }
+  return end;
+}
+
+void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz,
+                          bool history) {
+  paths_.clear();
+  contacts_ = 0;
+  if (colliders_.empty()) return;
+  for (auto& c : colliders_) c->beginTick(tick, stepRateHz);
+  const float dt = static_cast<float>(1.0 / static_cast<double>(stepRateHz));
+  const std::size_t n = pool.size();
+  const std::size_t blocks = (n + kParallelBlockRows - 1) / kParallelBlockRows;
+  blockPaths_.resize(std::max(blockPaths_.size(), blocks));
+  Vec3Column& pos = pool.position();
+  Vec3Column& vel = pool.velocity();
+  Vec3Column& prev = pool.previousPosition();
+  std::uint8_t* dead = pool.dead().data();
+  const std::uint64_t* ids = pool.id().data();
+  parallelForRows(n, [&](std::size_t begin, std::size_t end) {
+    std::vector<CollisionPath>& found = blockPaths_[begin / kParallelBlockRows];
+    found.clear();
+    // Which rows may touch a collider: a screen over the block's columns first.
+    thread_local std::vector<std::uint8_t> flags;
+    flags.assign(end - begin, 0);
+    const float* const starts[3] = {prev.x.data() + begin, prev.y.data() + begin,
+                                    prev.z.data() + begin};
+    const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
+    for (const auto& c : colliders_) c->screen(starts, ends, end - begin, flags.data());
+    for (std::size_t i = begin; i < end; ++i) {
+      if (flags[i - begin] == 0) continue;
+      const auto row = static_cast<Eigen::Index>(i);
+      Eigen::Vector3f a(prev.x[row], prev.y[row], prev.z[row]);
+      Eigen::Vector3f b(pos.x[row], pos.y[row], pos.z[row]);
+      Eigen::Vector3f v(vel.x[row], vel.y[row], vel.z[row]);
+      CollisionPath path;
+      float from = 0.0f;
+      while (path.contacts < kMaxContactsPerTick) {
+        Contact best, contact;
+        const Collider* hit = nullptr;
+        for (const auto& c : colliders_) {
+          if (c->firstContact(a, from, b, contact) &&
+              (hit == nullptr || contact.fraction < best.fraction)) {
+            best = contact;
+            hit = c.get();
+          }
+        }
+        if (hit == nullptr) break;
+        if (path.contacts == 0) path.start = a;
+        path.fraction[path.contacts] = best.fraction;
+        path.point[path.contacts] = best.point;
+        ++path.contacts;
+        v = hit->respond(best, v);
+        a = best.point;
+        from = best.fraction;
+        if (hit->settings().response == ColliderResponse::Kill) {
+          dead[i] = static_cast<std::uint8_t>(dead[i] | 1);
+          b = a;
+          break;
+        }
+        // The rest of the tick at the new velocity; after the last contact allowed, carried
+        // along with the collider.
+        b = path.contacts < kMaxContactsPerTick ? Eigen::Vector3f(a + v * ((1.0f - from) * dt))
+                                                : hit->carried(best);
+      }
+      if (path.contacts == 0) continue;
+      for (int c = 0; c < 3; ++c) {
+        pos[c][row] = b[c];
+        vel[c][row] = v[c];
+        if (history) prev[c][row] = b[c] - v[c] * dt;
+      }
+      path.id = ids[i];
+      found.push_back(path);
+    }
+  });
+  for (std::size_t k = 0; k < blocks; ++k) {
+    for (const CollisionPath& p : blockPaths_[k]) {
+      contacts_ += static_cast<std::uint64_t>(p.contacts);
+      paths_.push_back(p);
+    }
+  }
+}
+
+}  // namespace tickfx

@@ -1,0 +1,72 @@
+// The colliders of a system and the collision pass of a tick.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "fields/Collider.h"
+#include "particles/ParticlePool.h"
+
+namespace tickfx {
+
+/// The most contacts a particle makes in one tick. After the last it stays where that contact
+/// placed it on the collider, carried along for the rest of the tick if the collider moves (a
+/// particle wedged between colliders cannot loop).
+inline constexpr int kMaxContactsPerTick = 4;
+
+/// Where a particle went within the last tick when it touched a collider: from `start` through
+/// each contact point at its fraction of the tick, to its position after the tick. Render copies
+/// between ticks follow this polyline, so a frame never shows a bounced particle on the straight
+/// line from start to end, which may cut through the collider.
+struct CollisionPath {
+  std::uint64_t id = 0;
+  Eigen::Vector3f start = Eigen::Vector3f::Zero();
+  int contacts = 0;
+  std::array<float, kMaxContactsPerTick> fraction{};
+  std::array<Eigen::Vector3f, kMaxContactsPerTick> point{};
+
+  /// The position at fraction `alpha` in [0, 1] of the tick, `end` being the tick's: exactly
+  /// `start` at 0 and `end` at 1, linear between consecutive points.
+  Eigen::Vector3f at(float alpha, const Eigen::Vector3f& end) const;
+};
+
+/// Owns the colliders of a system and runs them after each tick's step.
+class ColliderSet {
+ public:
+  ColliderSet();
+  ~ColliderSet();
+  ColliderSet(ColliderSet&&) noexcept;
+  ColliderSet& operator=(ColliderSet&&) noexcept;
+
+  /// Appends `collider` (taking ownership); returns it. Earlier colliders win ties.
+  Collider& add(std::unique_ptr<Collider> collider);
+  std::size_t size() const { return colliders_.size(); }
+  bool empty() const { return colliders_.empty(); }
+  const Collider& collider(std::size_t i) const { return *colliders_[i]; }
+
+  /// The tick's collisions, after the integrator moved rows [0, pool.size()) from
+  /// previousPosition() to position(). Each row's path is tested against every collider; at the
+  /// earliest contact the particle is placed there, its velocity responded (Collider::respond) and
+  /// the rest of the tick continued from there at the new velocity, up to kMaxContactsPerTick
+  /// contacts. A kill contact flags the particle dead (bit 1) at the contact. Rows are
+  /// independent: any thread count gives the same bits. When `history` (position Verlet, whose
+  /// previous position is its velocity), a row that touched gets previous = position − v·dt, so
+  /// that its next step carries the responded velocity.
+  void collide(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz, bool history);
+
+  /// The paths of the rows that touched a collider in the last collide(), in row order.
+  const std::vector<CollisionPath>& paths() const { return paths_; }
+  /// Contacts made in the last collide().
+  std::uint64_t contacts() const { return contacts_; }
+
+ private:
+  std::vector<std::unique_ptr<Collider>> colliders_;
+  std::vector<CollisionPath> paths_;
+  std::vector<std::vector<CollisionPath>> blockPaths_;
+  std::uint64_t contacts_ = 0;
+};
+
+}  // namespace tickfx

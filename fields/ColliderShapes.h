@@ -1,0 +1,210 @@
+// Internal to the colliders (not installed): the analytic shapes in their rest frame.
+//
+// Every shape is already grown (outside) or shrunk (inside) by the particles' radius, and its
+// phi(x) is the signed distance of a particle centre to the region it may not enter: >= 0 where
+// it may be, < 0 inside the forbidden region. Products and sums are written out component by
+// component, in a fixed order, so no library or vectoriser can reorder them.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+namespace tickfx::collide {
+
+using V3 = Eigen::Vector3f;
+
+inline float dot(const V3& a, const V3& b) { return a.x() * b.x() + a.y() * b.y() + a.z() * b.z(); }
+inline float maxAbs(const V3& a) {
+  return std::max(std::fabs(a.x()), std::max(std::fabs(a.y()), std::fabs(a.z())));
+}
+// m · v and mᵀ · v with the sums in column order.
+inline V3 mul(const Eigen::Matrix3f& m, const V3& v) {
+  return V3(m(0, 0) * v.x() + m(0, 1) * v.y() + m(0, 2) * v.z(),
+            m(1, 0) * v.x() + m(1, 1) * v.y() + m(1, 2) * v.z(),
+            m(2, 0) * v.x() + m(2, 1) * v.y() + m(2, 2) * v.z());
+}
+inline V3 mulTransposed(const Eigen::Matrix3f& m, const V3& v) {
+  return V3(m(0, 0) * v.x() + m(1, 0) * v.y() + m(2, 0) * v.z(),
+            m(0, 1) * v.x() + m(1, 1) * v.y() + m(2, 1) * v.z(),
+            m(0, 2) * v.x() + m(1, 2) * v.y() + m(2, 2) * v.z());
+}
+inline V3 cross(const V3& a, const V3& b) {
+  return V3(a.y() * b.z() - a.z() * b.y(), a.z() * b.x() - a.x() * b.z(),
+            a.x() * b.y() - a.y() * b.x());
+}
+inline float length(const V3& a) { return std::sqrt(dot(a, a)); }
+
+/// Where a rest-frame segment a → b first enters the forbidden region: at s in [0, 1].
+struct Entry {
+  float s = 0.0f;
+};
+
+/// Whether the boxes around a → b and [lo, hi] overlap.
+inline bool boxesMeet(const V3& a, const V3& b, const V3& lo, const V3& hi) {
+  return std::max(a.x(), b.x()) >= lo.x() && std::min(a.x(), b.x()) <= hi.x() &&
+         std::max(a.y(), b.y()) >= lo.y() && std::min(a.y(), b.y()) <= hi.y() &&
+         std::max(a.z(), b.z()) >= lo.z() && std::min(a.z(), b.z()) <= hi.z();
+}
+
+// How far a shape's screening box reaches past it: far more than the rounding of a contact test
+// (8 ulps), so that every path a test would find a contact on is screened in.
+inline float screenSlack(float extent) { return (1.0f + extent) * 0x1p-12f; }
+
+/// A half-space: forbidden where side · (n · (x − p)) < radius.
+struct PlaneShape {
+  V3 point, normal;  // normal unit, pointing to the allowed side
+  float offset;      // the particles' radius
+
+  float phi(const V3& x) const { return dot(normal, x - point) - offset; }
+  V3 normalAt(const V3& /*x*/) const { return normal; }
+  // A contact needs an end below −tolerance (linear between them): exact, not a bound.
+  bool mayTouch(const V3& a, const V3& b) const { return phi(a) < 0.0f || phi(b) < 0.0f; }
+  bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {
+    const float pa = phi(a), pb = phi(b);
+    if (pa < -tolerance) {
+      e.s = 0.0f;
+      return true;
+    }
+    if (!(pb < -tolerance)) return false;
+    e.s = pa > 0.0f ? pa / (pa - pb) : 0.0f;
+    return true;
+  }
+};
+
+/// A ball of radius rho around `center`, forbidden inside (obstacle) or outside (container).
+struct SphereShape {
+  V3 center;
+  float rho;  // the sphere's radius grown (obstacle) or shrunk (container) by the particles'
+  bool container;
+
+  // A container is convex: a path between two points inside it stays inside. An obstacle: the
+  // boxes around the path and the ball meet.
+  bool mayTouch(const V3& a, const V3& b) const {
+    if (container) return phi(a) < 0.0f || phi(b) < 0.0f;
+    const float r = rho + screenSlack(maxAbs(center) + rho);
+    return boxesMeet(a, b, center - V3::Constant(r), center + V3::Constant(r));
+  }
+
+  float phi(const V3& x) const {
+    const float d = length(x - center) - rho;
+    return container ? -d : d;
+  }
+  V3 normalAt(const V3& x) const {
+    const V3 r = x - center;
+    const float l = length(r);
+    if (!(l > 0.0f)) return V3(0.0f, container ? -1.0f : 1.0f, 0.0f);
+    const V3 n = r / l;
+    return container ? V3(-n) : n;
+  }
+  bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {
+    const float pa = phi(a), pb = phi(b);
+    if (pa < -tolerance) {
+      e.s = 0.0f;
+      return true;
+    }
+    const V3 m = a - center, d = b - a;
+    const float A = dot(d, d), B = dot(m, d), C = dot(m, m) - rho * rho;
+    const float disc = B * B - A * C;
+    if (!container) {
+      // Both ends outside: the path may still pass through the ball (entering, then leaving).
+      const bool through = pb >= -tolerance && C >= 0.0f && B < 0.0f && disc > 0.0f && -B < A;
+      if (!(pb < -tolerance) && !through) return false;
+      const float s = A > 0.0f && disc >= 0.0f ? (-B - std::sqrt(disc)) / A : 0.0f;
+      e.s = std::clamp(s, 0.0f, 1.0f);
+      return true;
+    }
+    if (!(pb < -tolerance)) return false;  // a container is convex: the path leaves it only there
+    const float s = A > 0.0f && disc >= 0.0f ? (-B + std::sqrt(disc)) / A : 0.0f;
+    e.s = std::clamp(s, 0.0f, 1.0f);
+    return true;
+  }
+};
+
+/// A box of half edges `half` around `center`, rotated by `rotation` (its frame to the rest
+/// frame), forbidden inside (obstacle) or outside (container). The particles' radius grows or
+/// shrinks each half edge (corners stay sharp).
+struct BoxShape {
+  V3 center, half;
+  Eigen::Matrix3f rotation;
+  bool container;
+
+  V3 local(const V3& x) const { return mulTransposed(rotation, x - center); }
+  // A container is convex (see SphereShape); an obstacle's box around its rotated corners.
+  bool mayTouch(const V3& a, const V3& b) const {
+    if (container) return phi(a) < 0.0f || phi(b) < 0.0f;
+    V3 reach;
+    for (int i = 0; i < 3; ++i) {
+      reach[i] = std::fabs(rotation(i, 0)) * half.x() + std::fabs(rotation(i, 1)) * half.y() +
+                 std::fabs(rotation(i, 2)) * half.z();
+    }
+    reach += V3::Constant(screenSlack(maxAbs(center) + maxAbs(reach)));
+    return boxesMeet(a, b, center - reach, center + reach);
+  }
+  // The box's signed distance in its own frame.
+  float sdf(const V3& l) const {
+    const V3 q(std::fabs(l.x()) - half.x(), std::fabs(l.y()) - half.y(),
+               std::fabs(l.z()) - half.z());
+    const V3 o(std::max(q.x(), 0.0f), std::max(q.y(), 0.0f), std::max(q.z(), 0.0f));
+    return length(o) + std::min(std::max(q.x(), std::max(q.y(), q.z())), 0.0f);
+  }
+  float phi(const V3& x) const {
+    const float d = sdf(local(x));
+    return container ? -d : d;
+  }
+  V3 normalAt(const V3& x) const {
+    const V3 l = local(x);
+    const V3 q(std::fabs(l.x()) - half.x(), std::fabs(l.y()) - half.y(),
+               std::fabs(l.z()) - half.z());
+    V3 n = V3::Zero();
+    if (q.x() > 0.0f || q.y() > 0.0f || q.z() > 0.0f) {
+      for (int i = 0; i < 3; ++i) n[i] = q[i] > 0.0f ? std::copysign(q[i], l[i]) : 0.0f;
+      n /= length(n);
+    } else {
+      int i = 0;
+      if (q.y() > q[i]) i = 1;
+      if (q.z() > q[i]) i = 2;
+      n[i] = std::copysign(1.0f, l[i]);
+    }
+    if (container) n = -n;
+    return mul(rotation, n);
+  }
+  bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {
+    const float pa = phi(a), pb = phi(b);
+    if (pa < -tolerance) {
+      e.s = 0.0f;
+      return true;
+    }
+    const V3 m = local(a), d = local(b) - m;
+    if (container) {
+      if (!(pb < -tolerance)) return false;  // convex: the path leaves it only there
+      float exit = 1.0f;
+      for (int i = 0; i < 3; ++i) {
+        if (d[i] == 0.0f) continue;
+        const float t = (std::copysign(half[i], d[i]) - m[i]) / d[i];
+        exit = std::min(exit, t);
+      }
+      e.s = std::max(exit, 0.0f);
+      return true;
+    }
+    // Slabs: the path is inside the box for s in (enter, leave).
+    float enter = -1.0f, leave = 2.0f;
+    for (int i = 0; i < 3; ++i) {
+      if (d[i] == 0.0f) {
+        if (!(std::fabs(m[i]) < half[i])) return false;
+        continue;
+      }
+      float t0 = (-half[i] - m[i]) / d[i], t1 = (half[i] - m[i]) / d[i];
+      if (t0 > t1) std::swap(t0, t1);
+      enter = std::max(enter, t0);
+      leave = std::min(leave, t1);
+    }
+    // A start on or within the margin of a face is not a contact unless the path goes deeper.
+    const bool through = enter >= 0.0f && enter < leave && enter <= 1.0f;
+    if (!(pb < -tolerance) && !through) return false;
+    e.s = std::clamp(enter, 0.0f, 1.0f);
+    return true;
+  }
+};
+
+}  // namespace tickfx::collide

@@ -1,0 +1,94 @@
+// Internal to the colliders (not installed): a collider made of a shape (ColliderShapes.h, or a
+// level set), the per-particle work written once for every shape as a template.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "fields/Collider.h"
+#include "fields/ColliderShapes.h"
+
+namespace tickfx::collide {
+
+// `x` (world) in the rest frame of a collider at `pose`, and back.
+inline V3 toRest(const ColliderPose& pose, const V3& x) {
+  return mulTransposed(pose.rotation, x - pose.pivot - pose.translation) + pose.pivot;
+}
+inline V3 toWorld(const ColliderPose& pose, const V3& x) {
+  return mul(pose.rotation, x - pose.pivot) + pose.pivot + pose.translation;
+}
+
+// A contact is placed where phi >= 0: from a point on the path (which rounding may leave a hair
+// inside), along the surface normal by the depth and 4 ulps more, at most four times.
+template <class Shape>
+inline V3 settle(const Shape& shape, V3 x) {
+  for (int k = 0; k < 4; ++k) {
+    const float depth = shape.phi(x);
+    if (depth >= 0.0f) break;
+    const float ulps = std::max(1.0f, collide::maxAbs(x)) * 0x1p-21f;  // exact: a power of 2
+    x = x + shape.normalAt(x) * (ulps - depth);
+  }
+  return x;
+}
+
+template <class Shape>
+class ShapeCollider final : public Collider {
+ public:
+  ShapeCollider(const ColliderSettings& settings, const Shape& shape)
+      : Collider(settings), shape_(shape) {}
+
+  bool firstContact(const V3& a, float fromFraction, const V3& b, Contact& out) const override {
+    V3 ra = a, rb = b;
+    ColliderPose from;
+    if (tick_.moving) {
+      from = tick_.at(fromFraction);
+      ra = toRest(from, a);
+      rb = toRest(tick_.end, b);
+    }
+    const float tolerance = margin(std::max(collide::maxAbs(ra), collide::maxAbs(rb)));
+    collide::Entry e;
+    if (!shape_.entry(ra, rb, tolerance, e)) return false;
+    const V3 point = settle(shape_, ra + (rb - ra) * e.s);
+    const V3 normal = shape_.normalAt(point);
+    out.fraction = fromFraction + e.s * (1.0f - fromFraction);
+    out.restPoint = point;
+    if (!tick_.moving) {
+      out.point = point;
+      out.normal = normal;
+      out.surfaceVelocity = V3::Zero();
+      return true;
+    }
+    const ColliderPose at = tick_.at(out.fraction);
+    out.point = toWorld(at, point);
+    out.normal = collide::mul(at.rotation, normal);
+    out.surfaceVelocity = tick_.surfaceVelocity(out.point, out.fraction);
+    return true;
+  }
+
+  const Shape& shape() const { return shape_; }
+
+  float restClearance(const V3& rest) const override { return shape_.phi(rest); }
+
+  void screen(const float* const a[3], const float* const b[3], std::size_t n,
+              std::uint8_t* flags) const override {
+    // The rest-frame points as firstContact() computes them from the tick's start: the same
+    // expressions, so the same bits.
+    if (!tick_.moving) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const V3 ra(a[0][i], a[1][i], a[2][i]), rb(b[0][i], b[1][i], b[2][i]);
+        if (shape_.mayTouch(ra, rb)) flags[i] = 1;
+      }
+      return;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const V3 ra = toRest(tick_.start, V3(a[0][i], a[1][i], a[2][i]));
+      const V3 rb = toRest(tick_.end, V3(b[0][i], b[1][i], b[2][i]));
+      if (shape_.mayTouch(ra, rb)) flags[i] = 1;
+    }
+  }
+
+ private:
+  Shape shape_;
+};
+
+}  // namespace tickfx::collide
