@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "fields/ColliderSet.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
@@ -32,7 +33,16 @@ int main() {
   forces.add(std::make_unique<Gravity>(Eigen::Vector3f(0.0f, -9.81f, 0.0f)));
   forces.add(std::make_unique<LinearDrag>(0.2f));
 
-  ParticleSystem system(settings, {fountain}, std::move(forces));
+  // The ground: the plane y = 0, where drops bounce low and skid.
+  ColliderSettings ground;
+  ground.type = ColliderType::Plane;
+  ground.normal = Eigen::Vector3d::UnitY();
+  ground.restitution = 0.3;
+  ground.friction = 0.4;
+  ColliderSet colliders;
+  colliders.add(makeCollider(ground));
+
+  ParticleSystem system(settings, {fountain}, std::move(forces), {}, std::move(colliders));
   const Flicks frame = frameDuration(FrameRate{60, 1});
   std::printf("fountain: %lld Hz steps, %s, 2000 particles/s, 5 s at 60 fps\n",
               static_cast<long long>(settings.stepRateHz), settings.integrator.c_str());

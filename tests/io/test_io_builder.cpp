@@ -49,7 +49,12 @@ TEST(ioBuilder, FountainSampleEqualsHandBuiltFountain) {
   ForceSet forces;
   forces.add(std::make_unique<Gravity>(Eigen::Vector3f(0.0f, -9.81f, 0.0f)));
   forces.add(std::make_unique<LinearDrag>(0.2f));
-  ParticleSystem byHand(settings, {nozzle}, std::move(forces));
+  ColliderSettings ground;  // the plane y = 0, normal +y
+  ground.restitution = 0.3;
+  ground.friction = 0.4;
+  ColliderSet colliders;
+  colliders.add(makeCollider(ground));
+  ParticleSystem byHand(settings, {nozzle}, std::move(forces), {}, std::move(colliders));
 
   const std::unique_ptr<ParticleSystem> built = buildSystem(effect);
   // 3 s: particles born, flying, and the first ones dead (lifetime 2.5 s ± 20 %).
