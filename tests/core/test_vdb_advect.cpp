@@ -292,6 +292,30 @@ TEST(VdbAdvect, ASequencesFrameComesFromTheIntegerClock) {
   EXPECT_EQ(f.second, 299u);
 }
 
+// The system asks a kill region at its tick's end, as the module is told to be asked: frame 2's
+// region (x = 3) decides at the end of tick 0 (1/49 s), not frame 1's (x = 0) at its middle. A
+// mutant of ParticleSystem's endTick instant survived the tests before this one.
+TEST(VdbAdvect, TheSystemAsksTheKillRegionAtTheTicksEnd) {
+  VectorField::Settings s = advect(VectorField::Outside::Kill);
+  s.fps = 49.0;
+  s.firstFrame = 1;
+  s.lastFrame = 2;
+  ForceSet forces;
+  forces.add(activeAt(s, {0.0f, 3.0f}));
+  SystemSettings settings;
+  settings.stepRateHz = 49;
+  settings.threads = 1;
+  ParticleSystem system(settings, {}, std::move(forces));
+  ParticleInit inside, outside;
+  inside.position = Eigen::Vector3f(3.0f, 0.0f, 0.0f);
+  outside.position = Eigen::Vector3f(0.0f, 0.0f, 0.0f);
+  system.editPool().spawn(inside, 0);
+  system.editPool().spawn(outside, 0);
+  system.step();
+  ASSERT_EQ(system.pool().size(), 1u);
+  EXPECT_EQ(system.pool().id()[0], 0u) << "the particle in frame 2's region lives";
+}
+
 // ---- rules ------------------------------------------------------------------------------------
 
 TEST(VdbAdvect, CannotBeMixedWithAccelerationForces) {
