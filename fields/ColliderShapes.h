@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 
 namespace tickfx::collide {
 
@@ -47,6 +49,24 @@ inline bool boxesMeet(const V3& a, const V3& b, const V3& lo, const V3& hi) {
          std::max(a.z(), b.z()) >= lo.z() && std::min(a.z(), b.z()) <= hi.z();
 }
 
+// flags[i] = 1 for rows [0, n) whose path a → b has a box meeting [lo, hi]: boxesMeet over
+// columns, without a branch a row, so that the compiler vectorises it.
+inline void screenBoxColumns(const float* const a[3], const float* const b[3], std::size_t n,
+                             const V3& lo, const V3& hi, std::uint8_t* flags) {
+  const float* ax = a[0];
+  const float* ay = a[1];
+  const float* az = a[2];
+  const float* bx = b[0];
+  const float* by = b[1];
+  const float* bz = b[2];
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool meets = (std::max(ax[i], bx[i]) >= lo.x()) & (std::min(ax[i], bx[i]) <= hi.x()) &
+                       (std::max(ay[i], by[i]) >= lo.y()) & (std::min(ay[i], by[i]) <= hi.y()) &
+                       (std::max(az[i], bz[i]) >= lo.z()) & (std::min(az[i], bz[i]) <= hi.z());
+    flags[i] = static_cast<std::uint8_t>(flags[i] | static_cast<std::uint8_t>(meets));
+  }
+}
+
 // How far a shape's screening box reaches past it: far more than the rounding of a contact test
 // (8 ulps), so that every path a test would find a contact on is screened in.
 inline float screenSlack(float extent) { return (1.0f + extent) * 0x1p-12f; }
@@ -60,6 +80,24 @@ struct PlaneShape {
   V3 normalAt(const V3& /*x*/) const { return normal; }
   // A contact needs an end below −tolerance (linear between them): exact, not a bound.
   bool mayTouch(const V3& a, const V3& b) const { return phi(a) < 0.0f || phi(b) < 0.0f; }
+  // mayTouch over columns: phi's operations in phi's order, no branch a row.
+  void screenColumns(const float* const a[3], const float* const b[3], std::size_t n,
+                     std::uint8_t* flags) const {
+    const float nx = normal.x(), ny = normal.y(), nz = normal.z();
+    const float px = point.x(), py = point.y(), pz = point.z();
+    const float* ax = a[0];
+    const float* ay = a[1];
+    const float* az = a[2];
+    const float* bx = b[0];
+    const float* by = b[1];
+    const float* bz = b[2];
+    for (std::size_t i = 0; i < n; ++i) {
+      const float da = nx * (ax[i] - px) + ny * (ay[i] - py) + nz * (az[i] - pz) - offset;
+      const float db = nx * (bx[i] - px) + ny * (by[i] - py) + nz * (bz[i] - pz) - offset;
+      flags[i] = static_cast<std::uint8_t>(flags[i] |
+                                           static_cast<std::uint8_t>((da < 0.0f) | (db < 0.0f)));
+    }
+  }
   bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {
     const float pa = phi(a), pb = phi(b);
     if (pa < -tolerance) {
@@ -84,6 +122,13 @@ struct SphereShape {
     if (container) return phi(a) < 0.0f || phi(b) < 0.0f;
     const float r = rho + screenSlack(maxAbs(center) + rho);
     return boxesMeet(a, b, center - V3::Constant(r), center + V3::Constant(r));
+  }
+  // An obstacle's box over columns; false for a container (its rows go through mayTouch).
+  bool screenBox(V3& lo, V3& hi) const {
+    const float r = rho + screenSlack(maxAbs(center) + rho);
+    lo = center - V3::Constant(r);
+    hi = center + V3::Constant(r);
+    return !container;
   }
 
   float phi(const V3& x) const {
@@ -133,13 +178,21 @@ struct BoxShape {
   // A container is convex (see SphereShape); an obstacle's box around its rotated corners.
   bool mayTouch(const V3& a, const V3& b) const {
     if (container) return phi(a) < 0.0f || phi(b) < 0.0f;
+    V3 lo, hi;
+    screenBox(lo, hi);
+    return boxesMeet(a, b, lo, hi);
+  }
+  // The box around the rotated corners; false for a container (see SphereShape).
+  bool screenBox(V3& lo, V3& hi) const {
     V3 reach;
     for (int i = 0; i < 3; ++i) {
       reach[i] = std::fabs(rotation(i, 0)) * half.x() + std::fabs(rotation(i, 1)) * half.y() +
                  std::fabs(rotation(i, 2)) * half.z();
     }
     reach += V3::Constant(screenSlack(maxAbs(center) + maxAbs(reach)));
-    return boxesMeet(a, b, center - reach, center + reach);
+    lo = center - reach;
+    hi = center + reach;
+    return !container;
   }
   // The box's signed distance in its own frame.
   float sdf(const V3& l) const {

@@ -74,6 +74,17 @@ class ShapeCollider final : public Collider {
     // The rest-frame points as firstContact() computes them from the tick's start: the same
     // expressions, so the same bits.
     if (!tick_.moving) {
+      // Still: a loop over the columns the compiler vectorises, where the shape has one.
+      if constexpr (requires { shape_.screenColumns(a, b, n, flags); }) {
+        shape_.screenColumns(a, b, n, flags);
+        return;
+      } else if constexpr (requires(V3 & v) { shape_.screenBox(v, v); }) {
+        V3 lo, hi;
+        if (shape_.screenBox(lo, hi)) {
+          screenBoxColumns(a, b, n, lo, hi, flags);
+          return;
+        }
+      }
       for (std::size_t i = 0; i < n; ++i) {
         const V3 ra(a[0][i], a[1][i], a[2][i]), rb(b[0][i], b[1][i], b[2][i]);
         if (shape_.mayTouch(ra, rb)) flags[i] = 1;

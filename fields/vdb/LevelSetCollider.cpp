@@ -91,6 +91,11 @@ struct LevelSetShape {
   bool touchesBox(const V3& a, const V3& b) const { return collide::boxesMeet(a, b, lo, hi); }
   // A container's outside is everywhere beyond its box: every path is tested.
   bool mayTouch(const V3& a, const V3& b) const { return container || touchesBox(a, b); }
+  bool screenBox(V3& below, V3& above) const {
+    below = lo;
+    above = hi;
+    return !container;
+  }
   bool entry(const V3& a, const V3& b, float tolerance, collide::Entry& e) const {
     // An obstacle's outside beyond its box is background (positive): nothing to find. A
     // container's is forbidden everywhere there, so it is always marched.
