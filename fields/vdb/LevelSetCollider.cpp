@@ -22,6 +22,17 @@ namespace {
 using collide::V3;
 using Accessor = openvdb::tree::ValueAccessor<const openvdb::FloatTree, /*IsSafe=*/false>;
 constexpr float kHalfWidth = 3.0f;  // voxels of narrow band each side of a baked surface
+// OpenVDB's coordinates are 32-bit: a grid whose voxels would lie farther out than this from the
+// origin (in voxels) is refused rather than wrapped.
+constexpr double kIndexReach = 0x1p30;
+
+void checkIndexReach(double extentInVoxels, const std::string& what) {
+  if (!(extentInVoxels < kIndexReach)) {
+    throw std::runtime_error(what + " lies " + settingNumber(std::floor(extentInVoxels)) +
+                             " voxels from the origin (at most 2^30: a larger voxel_size, or "
+                             "the shape nearer the origin)");
+  }
+}
 
 // A signed-distance grid sampled in float: index = (x − origin) / voxel, trilinear over the
 // eight voxels around it, the weights and sums in a fixed order (no double: one precision).
@@ -180,6 +191,7 @@ openvdb::FloatGrid::Ptr bake(const LevelSetSettings& l) {
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
   const Eigen::Vector3d extent = bakeExtent(l);
   const Eigen::Vector3d lo = (l.center - extent) / h, hi = (l.center + extent) / h;
+  checkIndexReach(std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()), "bake: the shape");
   const double voxels = (hi - lo + Eigen::Vector3d::Constant(2.0 * kHalfWidth + 2.0)).prod();
   if (!(voxels < 2.0e8)) {
     throw std::runtime_error("bake: voxel_size " + settingNumber(h) + " makes " +
@@ -207,6 +219,10 @@ openvdb::FloatGrid::Ptr fromMesh(const LevelSetSettings& l, const TriangleMesh& 
   if (const std::string p = meshProblem(mesh); !p.empty()) {
     throw std::runtime_error(l.mesh + ": " + p);
   }
+  double reach = 0.0;
+  for (const Eigen::Vector3f& p : mesh.points)
+    reach = std::max(reach, double(p.cwiseAbs().maxCoeff()));
+  checkIndexReach(reach / l.voxelSize + kHalfWidth, l.mesh + ": the mesh");
   std::vector<openvdb::Vec3s> points;
   points.reserve(mesh.points.size());
   for (const Eigen::Vector3f& p : mesh.points) points.emplace_back(p.x(), p.y(), p.z());
