@@ -199,8 +199,12 @@ TriangleMesh parsePly(std::string_view bytes, const std::string& label) {
       auto& props = layout.elements.back().properties;
       if (w.size() >= 5 && w[1] == "list") {
         props.push_back({std::string(w[4]), std::string(w[3]), std::string(w[2])});
-      } else if (w.size() >= 3) {
+      } else if (w.size() >= 3 && w[1] != "list") {
         props.push_back({std::string(w[2]), std::string(w[1]), ""});
+      } else {
+        fail(label,
+             "has a property line without a type and a name (expected property TYPE "
+             "NAME or property list COUNT_TYPE TYPE NAME)");
       }
       const auto& p = props.back();
       if (typeSize(p.type) == 0 || (!p.countType.empty() && typeSize(p.countType) == 0)) {

@@ -334,6 +334,18 @@ TEST(ioMeshFile, PlyAsciiAndBinaryReadTheSameTriangles) {
   EXPECT_THROW(parseMesh(binary.substr(0, binary.size() - 2), "c.ply"), std::runtime_error);
 }
 
+// fuzz_mesh: a property line too short to name its type read the last of no properties.
+TEST(ioMeshFile, APropertyLineWithoutTypeAndNameIsRefused) {
+  try {
+    parseMesh("ply\nformat ascii 1.0\nelement vertex 1\nproperty float\nend_header\n0\n", "d.ply");
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(),
+                 "d.ply: has a property line without a type and a name (expected property TYPE "
+                 "NAME or property list COUNT_TYPE TYPE NAME)");
+  }
+}
+
 }  // namespace
 }  // namespace tickfx::io
 
