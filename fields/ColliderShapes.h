@@ -60,10 +60,14 @@ inline void screenBoxColumns(const float* const a[3], const float* const b[3], s
   const float* by = b[1];
   const float* bz = b[2];
   for (std::size_t i = 0; i < n; ++i) {
-    const bool meets = (std::max(ax[i], bx[i]) >= lo.x()) & (std::min(ax[i], bx[i]) <= hi.x()) &
-                       (std::max(ay[i], by[i]) >= lo.y()) & (std::min(ay[i], by[i]) <= hi.y()) &
-                       (std::max(az[i], bz[i]) >= lo.z()) & (std::min(az[i], bz[i]) <= hi.z());
-    flags[i] = static_cast<std::uint8_t>(flags[i] | static_cast<std::uint8_t>(meets));
+    // Integers, not bools: & on every comparison, no short circuit to branch on.
+    const int meets = static_cast<int>(std::max(ax[i], bx[i]) >= lo.x()) &
+                      static_cast<int>(std::min(ax[i], bx[i]) <= hi.x()) &
+                      static_cast<int>(std::max(ay[i], by[i]) >= lo.y()) &
+                      static_cast<int>(std::min(ay[i], by[i]) <= hi.y()) &
+                      static_cast<int>(std::max(az[i], bz[i]) >= lo.z()) &
+                      static_cast<int>(std::min(az[i], bz[i]) <= hi.z());
+    flags[i] = static_cast<std::uint8_t>(flags[i] | meets);
   }
 }
 
@@ -94,8 +98,8 @@ struct PlaneShape {
     for (std::size_t i = 0; i < n; ++i) {
       const float da = nx * (ax[i] - px) + ny * (ay[i] - py) + nz * (az[i] - pz) - offset;
       const float db = nx * (bx[i] - px) + ny * (by[i] - py) + nz * (bz[i] - pz) - offset;
-      flags[i] = static_cast<std::uint8_t>(flags[i] |
-                                           static_cast<std::uint8_t>((da < 0.0f) | (db < 0.0f)));
+      const int below = static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f);
+      flags[i] = static_cast<std::uint8_t>(flags[i] | below);
     }
   }
   bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {
