@@ -13,10 +13,6 @@ namespace {
 
 using collide::V3;
 
-void checkFinite(const Eigen::Vector3d& v, const char* key, SettingProblems& out) {
-  if (!v.allFinite()) out.push_back({key, "is not finite", "three finite numbers"});
-}
-
 void checkRange(double v, double lo, double hi, const char* key, const char* expected,
                 SettingProblems& out) {
   if (!(v >= lo && v <= hi)) out.push_back({key, "is " + settingNumber(v), expected});

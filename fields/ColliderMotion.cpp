@@ -11,8 +11,6 @@
 namespace tickfx {
 namespace {
 
-bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
-
 // Rodrigues' rotation by `angle` about the unit `axis`, in double from det::sincos, rounded to
 // float once: the same bits on every build.
 Eigen::Matrix3f rotationAbout(const Eigen::Vector3d& axis, double angle) {
@@ -29,7 +27,7 @@ Eigen::Matrix3f rotationAbout(const Eigen::Vector3d& axis, double angle) {
 
 SettingProblems ColliderMotionSettings::validate() const {
   SettingProblems out;
-  if (!finite(velocity)) out.push_back({"velocity", "is not finite", "three finite numbers"});
+  checkFinite(velocity, "velocity", out);
   if (!keys.empty() && !velocity.isZero(0.0)) {
     out.push_back({"keys", "is given with a velocity", "either velocity or keys"});
   }
@@ -43,14 +41,12 @@ SettingProblems ColliderMotionSettings::validate() const {
                      "is not after the key before it (" + settingNumber(keys[i - 1].time) + ")",
                      "key times strictly increasing"});
     }
-    if (!finite(keys[i].translate)) {
-      out.push_back({at + ".translate", "is not finite", "three finite numbers"});
-    }
+    checkFinite(keys[i].translate, at + ".translate", out);
   }
   if (!std::isfinite(spinRate)) {
     out.push_back({"spin.rate", "is " + settingNumber(spinRate), "a finite number of rad/s"});
   }
-  if (!finite(spinCenter)) out.push_back({"spin.center", "is not finite", "three finite numbers"});
+  checkFinite(spinCenter, "spin.center", out);
   if (spinRate != 0.0) checkDirection(spinAxis, "spin.axis", out);
   return out;
 }

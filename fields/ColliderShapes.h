@@ -53,20 +53,14 @@ inline bool boxesMeet(const V3& a, const V3& b, const V3& lo, const V3& hi) {
 // columns, without a branch a row, so that the compiler vectorises it.
 inline void screenBoxColumns(const float* const a[3], const float* const b[3], std::size_t n,
                              const V3& lo, const V3& hi, std::uint8_t* flags) {
-  const float* ax = a[0];
-  const float* ay = a[1];
-  const float* az = a[2];
-  const float* bx = b[0];
-  const float* by = b[1];
-  const float* bz = b[2];
   for (std::size_t i = 0; i < n; ++i) {
     // Integers, not bools: & on every comparison, no short circuit to branch on.
-    const int meets = static_cast<int>(std::max(ax[i], bx[i]) >= lo.x()) &
-                      static_cast<int>(std::min(ax[i], bx[i]) <= hi.x()) &
-                      static_cast<int>(std::max(ay[i], by[i]) >= lo.y()) &
-                      static_cast<int>(std::min(ay[i], by[i]) <= hi.y()) &
-                      static_cast<int>(std::max(az[i], bz[i]) >= lo.z()) &
-                      static_cast<int>(std::min(az[i], bz[i]) <= hi.z());
+    const int meets = static_cast<int>(std::max(a[0][i], b[0][i]) >= lo.x()) &
+                      static_cast<int>(std::min(a[0][i], b[0][i]) <= hi.x()) &
+                      static_cast<int>(std::max(a[1][i], b[1][i]) >= lo.y()) &
+                      static_cast<int>(std::min(a[1][i], b[1][i]) <= hi.y()) &
+                      static_cast<int>(std::max(a[2][i], b[2][i]) >= lo.z()) &
+                      static_cast<int>(std::min(a[2][i], b[2][i]) <= hi.z());
     flags[i] = static_cast<std::uint8_t>(flags[i] | meets);
   }
 }
@@ -89,15 +83,9 @@ struct PlaneShape {
                      std::uint8_t* flags) const {
     const float nx = normal.x(), ny = normal.y(), nz = normal.z();
     const float px = point.x(), py = point.y(), pz = point.z();
-    const float* ax = a[0];
-    const float* ay = a[1];
-    const float* az = a[2];
-    const float* bx = b[0];
-    const float* by = b[1];
-    const float* bz = b[2];
     for (std::size_t i = 0; i < n; ++i) {
-      const float da = nx * (ax[i] - px) + ny * (ay[i] - py) + nz * (az[i] - pz) - offset;
-      const float db = nx * (bx[i] - px) + ny * (by[i] - py) + nz * (bz[i] - pz) - offset;
+      const float da = nx * (a[0][i] - px) + ny * (a[1][i] - py) + nz * (a[2][i] - pz) - offset;
+      const float db = nx * (b[0][i] - px) + ny * (b[1][i] - py) + nz * (b[2][i] - pz) - offset;
       const int below = static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f);
       flags[i] = static_cast<std::uint8_t>(flags[i] | below);
     }

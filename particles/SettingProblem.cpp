@@ -19,6 +19,10 @@ void throwIfAny(std::string_view owner, const SettingProblems& problems) {
   throw std::invalid_argument(std::string(owner) + " " + problems.front().text());
 }
 
+void checkFinite(const Eigen::Vector3d& v, const std::string& key, SettingProblems& out) {
+  if (!v.allFinite()) out.push_back({key, "is not finite", "three finite numbers"});
+}
+
 std::string settingNumber(double value) {
   if (std::isnan(value)) return "nan";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";

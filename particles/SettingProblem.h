@@ -42,6 +42,9 @@ bool normalisable(const Eigen::Matrix<T, 3, 1>& v);
 template <typename T>
 std::string shortestNormalisable();
 
+/// Adds "KEY: is not finite (expected three finite numbers)" unless every component of `v` is.
+void checkFinite(const Eigen::Vector3d& v, const std::string& key, SettingProblems& out);
+
 /// Adds a problem at `key` unless normalisable(v): v is a direction of any length, normalised in
 /// T by its owner (the message names the precision and the shortest length accepted).
 template <typename T>
