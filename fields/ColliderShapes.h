@@ -40,7 +40,25 @@ inline float length(const V3& a) { return std::sqrt(dot(a, a)); }
 /// Where a rest-frame segment a → b first enters the forbidden region: at s in [0, 1].
 struct Entry {
   float s = 0.0f;
+  // phi's rate of change along the path at the crossing, per metre, where the shape measured it
+  // (a level set, from the two samples that bracket the crossing); 0 where its normal is exact.
+  float slope = 0.0f;
 };
+
+/// `n`, turned if need be so that the path `d` approaches it as steeply as phi fell along the path
+/// (`slope` < 0, per metre), unit length. A sampled gradient need not face the path that crossed:
+/// for a grain sliding on a level set, its path all but tangent, the gradient can say the path
+/// leaves, the response then keeps the velocity, and the particle met the surface again and again
+/// at the same point, gaining speed. A gradient that says the path falls at least half as fast
+/// is kept: the march's bracket can span more than the stretch where phi is linear (the edge of
+/// a narrow band), so there the slope is the cruder of the two.
+inline V3 facingPath(const V3& n, const V3& d, float slope) {
+  const V3 u = d / length(d);
+  const float along = dot(n, u);
+  if (along <= 0.5f * slope) return n;
+  const V3 m = n + u * (slope - along);
+  return m / length(m);
+}
 
 /// Whether the boxes around a → b and [lo, hi] overlap.
 inline bool boxesMeet(const V3& a, const V3& b, const V3& lo, const V3& hi) {

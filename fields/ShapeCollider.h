@@ -49,7 +49,8 @@ class ShapeCollider final : public Collider {
     collide::Entry e;
     if (!shape_.entry(ra, rb, tolerance, e)) return false;
     const V3 point = settle(shape_, ra + (rb - ra) * e.s);
-    const V3 normal = shape_.normalAt(point);
+    V3 normal = shape_.normalAt(point);
+    if (e.slope < 0.0f) normal = collide::facingPath(normal, rb - ra, e.slope);
     out.fraction = fromFraction + e.s * (1.0f - fromFraction);
     out.restPoint = point;
     if (!tick_.moving) {

@@ -132,21 +132,23 @@ struct LevelSetShape {
         // The crossing lies in (s0, s1], where phi is all but linear (at most half a voxel, or a
         // stretch of guaranteed distance): four steps of regula falsi (Illinois) towards it, then
         // the contact is settled on the surface along its normal.
-        float outer = s0, inner = s1, pOuter = p0, pInner = p1;
+        float outer = s0, inner = s1, pOuter = p0, pInner = p1, wOuter = p0;
         for (int k = 0; k < 4 && pOuter > 0.0f; ++k) {
-          const float mid = outer + (inner - outer) * (pOuter / (pOuter - pInner));
+          const float mid = outer + (inner - outer) * (wOuter / (wOuter - pInner));
           if (!(mid > outer && mid < inner)) break;
           const float pm = phi(acc, a + d * mid);
           if (pm < 0.0f) {
             inner = mid;
             pInner = pm;
-            pOuter *= 0.5f;  // Illinois: the stale end's weight halved
+            wOuter *= 0.5f;  // Illinois: the stale end's weight halved
           } else {
             outer = mid;
-            pOuter = pm;
+            pOuter = wOuter = pm;
           }
         }
         e.s = outer;
+        // < 0: pInner < 0 <= pOuter, or pInner < -tolerance <= pOuter.
+        e.slope = (pInner - pOuter) / ((inner - outer) * length);
         return true;
       }
       s0 = s1;
