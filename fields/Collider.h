@@ -57,6 +57,9 @@ struct ColliderSettings {
   double friction = 0.0;        // >= 0: Coulomb's μ against the contact's normal impulse
   double particleRadius = 0.0;  // >= 0: the particles' collision radius
   ColliderMotionSettings motion;
+  /// Whether the particles' contacts with this collider are recorded in Houdini's hit
+  /// attributes (ColliderSet::kHitColumns), columns the pool then has.
+  bool recordHits = false;
 
   /// What the collider refuses (empty: it accepts them): non-finite or out-of-range values, a
   /// normal too short to normalise, a container (side inside) no larger than a particle.

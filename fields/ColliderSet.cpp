@@ -14,6 +14,17 @@ Collider& ColliderSet::add(std::unique_ptr<Collider> collider) {
   return *colliders_.back();
 }
 
+bool ColliderSet::recordsHits() const {
+  for (const auto& c : colliders_)
+    if (c->settings().recordHits) return true;
+  return false;
+}
+
+void ColliderSet::addHitColumns(ParticlePool& pool) const {
+  if (!recordsHits()) return;
+  for (const char* name : kHitColumns) pool.addAttribute(name, 0.0f);
+}
+
 Eigen::Vector3f CollisionPath::at(float alpha, const Eigen::Vector3f& end) const {
   if (alpha <= 0.0f) return start;
   if (alpha >= 1.0f) return end;
@@ -48,6 +59,15 @@ void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t st
   Vec3Column& prev = pool.previousPosition();
   std::uint8_t* dead = pool.dead().data();
   const std::uint64_t* ids = pool.id().data();
+  // The hit columns, where the pool has them; a contact's time is the tick's start (exact, then
+  // rounded to float once) plus its fraction of the step, in float.
+  std::array<float*, kHitColumns.size()> hits{};
+  if (pool.findAttribute(kHitColumns[0]) != ParticlePool::npos) {
+    for (std::size_t k = 0; k < kHitColumns.size(); ++k)
+      hits[k] = pool.attribute(pool.findAttribute(kHitColumns[k])).data();
+  }
+  const auto tickStart =
+      static_cast<float>(static_cast<double>(tick) / static_cast<double>(stepRateHz));
   parallelForRows(n, [&](std::size_t begin, std::size_t end) {
     std::vector<CollisionPath>& found = blockPaths_[begin / kParallelBlockRows];
     found.clear();
@@ -66,6 +86,9 @@ void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t st
       Eigen::Vector3f v(vel.x[row], vel.y[row], vel.z[row]);
       CollisionPath path;
       float from = 0.0f;
+      int recorded = 0;
+      Contact lastHit;
+      Eigen::Vector3f hitVelocity = Eigen::Vector3f::Zero();
       while (path.contacts < kMaxContactsPerTick) {
         Contact best, contact;
         const Collider* hit = nullptr;
@@ -81,6 +104,11 @@ void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t st
         path.fraction[path.contacts] = best.fraction;
         path.point[path.contacts] = best.point;
         ++path.contacts;
+        if (hits[0] != nullptr && hit->settings().recordHits) {
+          ++recorded;
+          lastHit = best;
+          hitVelocity = v;
+        }
         v = hit->respond(best, v);
         a = best.point;
         from = best.fraction;
@@ -99,6 +127,20 @@ void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t st
         pos[c][row] = b[c];
         vel[c][row] = v[c];
         if (history) prev[c][row] = b[c] - v[c] * dt;
+      }
+      if (recorded > 0) {
+        const float values[kHitColumns.size()] = {hits[0][i] + static_cast<float>(recorded),
+                                                  tickStart + lastHit.fraction * dt,
+                                                  lastHit.point.x(),
+                                                  lastHit.point.y(),
+                                                  lastHit.point.z(),
+                                                  lastHit.normal.x(),
+                                                  lastHit.normal.y(),
+                                                  lastHit.normal.z(),
+                                                  hitVelocity.x(),
+                                                  hitVelocity.y(),
+                                                  hitVelocity.z()};
+        for (std::size_t k = 0; k < kHitColumns.size(); ++k) hits[k][i] = values[k];
       }
       path.id = ids[i];
       found.push_back(path);

@@ -17,6 +17,15 @@ namespace tickfx {
 /// particle wedged between colliders cannot loop).
 inline constexpr int kMaxContactsPerTick = 4;
 
+/// Houdini's hit attributes, as columns of the pool: `hitnum` (the contacts so far, a whole
+/// number), `hittime` (s: the time of the last contact), `hitpos` (m: the particle's centre at
+/// it), `hitnml` (the surface's unit normal there, towards the side particles stay on) and `hitv`
+/// (m/s: the velocity just before that contact's response), each vector as three columns
+/// `<name>_x`, `_y`, `_z`. Only contacts with a collider that records hits count.
+inline constexpr std::array<const char*, 11> kHitColumns = {
+    "hitnum",   "hittime",  "hitpos_x", "hitpos_y", "hitpos_z", "hitnml_x",
+    "hitnml_y", "hitnml_z", "hitv_x",   "hitv_y",   "hitv_z"};
+
 /// Where a particle went within the last tick when it touched a collider: from `start` through
 /// each contact point at its fraction of the tick, to its position after the tick. Render copies
 /// between ticks follow this polyline, so a frame never shows a bounced particle on the straight
@@ -46,6 +55,11 @@ class ColliderSet {
   std::size_t size() const { return colliders_.size(); }
   bool empty() const { return colliders_.empty(); }
   const Collider& collider(std::size_t i) const { return *colliders_[i]; }
+  /// Whether a collider records hits (ColliderSettings::recordHits).
+  bool recordsHits() const;
+  /// Adds kHitColumns to `pool` (each 0 for every row) when a collider records hits; otherwise
+  /// the pool keeps its columns, and a particle its bytes.
+  void addHitColumns(ParticlePool& pool) const;
 
   /// The tick's collisions, after the integrator moved rows [0, pool.size()) from
   /// previousPosition() to position(). Each row's path is tested against every collider; at the
@@ -54,7 +68,8 @@ class ColliderSet {
   /// contacts. A kill contact flags the particle dead (bit 1) at the contact. Rows are
   /// independent: any thread count gives the same bits. When `history` (position Verlet, whose
   /// previous position is its velocity), a row that touched gets previous = position − v·dt, so
-  /// that its next step carries the responded velocity.
+  /// that its next step carries the responded velocity. Hits are recorded in the pool's hit
+  /// columns where it has them (addHitColumns), the tick starting at tick / stepRateHz seconds.
   void collide(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz, bool history);
 
   /// The paths of the rows that touched a collider in the last collide(), in row order.

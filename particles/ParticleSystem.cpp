@@ -91,7 +91,9 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
                                const std::vector<StructureSettings>& structures,
                                ColliderSet colliders)
     : ParticleSystem(settings, emitters, std::move(forces), structures) {
-  if (!colliders.empty()) colliders_ = std::make_unique<ColliderSet>(std::move(colliders));
+  if (colliders.empty()) return;
+  colliders.addHitColumns(pool_);
+  colliders_ = std::make_unique<ColliderSet>(std::move(colliders));
 }
 
 ParticleSystem::~ParticleSystem() = default;

@@ -77,7 +77,8 @@ class ParticleSystem {
                  ForceSet forces, const std::vector<StructureSettings>& structures = {});
   /// As above, with `colliders` (fields/ColliderSet.h) run after each tick's step: particles
   /// never pass through them (see ColliderSet::collide). A system with colliders runs its frames
-  /// tick by tick (no fused frames).
+  /// tick by tick (no fused frames). When a collider records hits, the pool gets the hit
+  /// columns (kHitColumns).
   ParticleSystem(const SystemSettings& settings, const std::vector<EmitterSettings>& emitters,
                  ForceSet forces, const std::vector<StructureSettings>& structures,
                  ColliderSet colliders);

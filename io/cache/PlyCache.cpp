@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/cache/AttributeGroups.h"
 #include "io/cache/RowBlocks.h"
 #include "io/util/AtomicFile.h"
 
@@ -47,9 +48,13 @@ void writePlyCache(const FrameData& frame, const std::filesystem::path& path,
         out << "property double id\n";
         for (const char* name : kFixedFloats) out << "property float " << name << "\n";
         for (const std::string& name : frame.attributeNames)
-          out << "property float " << name << "\n";
+          out << "property " << (isIntAttribute(name) ? "int " : "float ") << name << "\n";
         out << "end_header\n";
         const std::vector<const FloatColumn*> cols = floatColumns(frame);
+        // Houdini's integers (hitnum) as 32-bit ints: their columns hold whole numbers.
+        std::vector<bool> ints(cols.size(), false);
+        for (std::size_t a = 0; a < frame.attributeNames.size(); ++a)
+          ints[9 + a] = isIntAttribute(frame.attributeNames[a]);
         const std::size_t rowBytes = sizeof(double) + cols.size() * sizeof(float);
         // Column by column into each block's interleaved rows: every pass reads one column in
         // order.
@@ -62,6 +67,13 @@ void writePlyCache(const FrameData& frame, const std::filesystem::path& path,
                             for (std::size_t c = 0; c < cols.size(); ++c) {
                               const float* const column = cols[c]->data();
                               char* at = bytes + sizeof(double) + c * sizeof(float);
+                              if (ints[c]) {
+                                for (std::size_t i = begin; i < end; ++i, at += rowBytes) {
+                                  const auto v = static_cast<std::int32_t>(column[i]);
+                                  std::memcpy(at, &v, sizeof v);
+                                }
+                                continue;
+                              }
                               for (std::size_t i = begin; i < end; ++i, at += rowBytes)
                                 std::memcpy(at, column + i, sizeof(float));
                             }
@@ -83,7 +95,8 @@ FrameData readPlyCache(const std::filesystem::path& path) {
     fail("not binary little-endian PLY");
   FrameData frame;
   std::size_t count = 0;
-  std::vector<std::string> floats;
+  std::vector<std::string> floats;  // every 4-byte property, floats and ints
+  std::vector<bool> ints;
   bool sawId = false;
   while (std::getline(in, line) && line != "end_header") {
     std::istringstream words(line);
@@ -101,8 +114,9 @@ FrameData readPlyCache(const std::filesystem::path& path) {
       words >> type >> name;
       if (type == "double" && name == "id" && floats.empty()) {
         sawId = true;
-      } else if (type == "float") {
+      } else if ((type == "float" || (type == "int" && floats.size() >= 9)) && !name.empty()) {
         floats.push_back(name);
+        ints.push_back(type == "int");
       } else {
         fail("unexpected property '" + line + "'");
       }
@@ -144,8 +158,15 @@ FrameData readPlyCache(const std::filesystem::path& path) {
     }
     frame.id[i] = static_cast<std::uint64_t>(id);
     for (std::size_t c = 0; c < cols.size(); ++c) {
-      std::memcpy(&(*cols[c])[static_cast<Eigen::Index>(i)],
-                  row.data() + sizeof(double) + c * sizeof(float), sizeof(float));
+      const char* at = row.data() + sizeof(double) + c * sizeof(float);
+      float& value = (*cols[c])[static_cast<Eigen::Index>(i)];
+      if (ints[c]) {
+        std::int32_t v = 0;
+        std::memcpy(&v, at, sizeof v);
+        value = static_cast<float>(v);
+      } else {
+        std::memcpy(&value, at, sizeof(float));
+      }
     }
   }
   return frame;

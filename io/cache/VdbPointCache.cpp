@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "fields/vdb/VdbGridFile.h"
+#include "io/cache/AttributeGroups.h"
 #include "io/util/AtomicFile.h"
 #include "io/util/Fingerprint.h"
 
@@ -56,6 +57,7 @@ using QuantisedPositionArray =
 using VectorArray = vdbp::TypedAttributeArray<openvdb::Vec3f, vdbp::NullCodec>;
 using IdArray = vdbp::TypedAttributeArray<std::int64_t, vdbp::NullCodec>;
 using FloatArray = vdbp::TypedAttributeArray<float, vdbp::NullCodec>;
+using IntArray = vdbp::TypedAttributeArray<std::int32_t, vdbp::NullCodec>;
 
 std::string where(const std::string& path) { return vdbGridLabel(path, kGridName); }
 
@@ -114,7 +116,7 @@ void checkColumns(const FrameData& frame) {
   for (int c = 0; c < 3; ++c) ok = ok && sized(frame.position[c]) && sized(frame.velocity[c]);
   for (const FloatColumn& a : frame.attributes) ok = ok && sized(a);
   if (!ok) throw std::invalid_argument("frame columns of different lengths");
-  for (const std::string& name : frame.attributeNames) checkAttributeName(name);
+  for (const AttributeGroup& g : attributeGroups(frame.attributeNames)) checkAttributeName(g.name);
 }
 
 using Leaf = vdbp::PointDataTree::LeafNodeType;
@@ -298,9 +300,24 @@ std::unique_ptr<Leaf> makeLeaf(const FrameData& frame, const std::vector<PointSl
   floats(3, frame.age);
   floats(4, frame.life);
   floats(5, frame.mass);
-  const std::size_t firstCustom = standardAttributes().size();
-  for (std::size_t a = 0; a < frame.attributes.size(); ++a)
-    floats(firstCustom + a, frame.attributes[a]);
+  // The frame's columns as Houdini's typed attributes (hitnum an int32, hitpos a vec3s, ...).
+  std::size_t pos = standardAttributes().size();
+  for (const AttributeGroup& g : attributeGroups(frame.attributeNames)) {
+    const FloatColumn* c = &frame.attributes[g.column];
+    if (g.kind == AttributeKind::Float) {
+      floats(pos++, *c);
+    } else if (g.kind == AttributeKind::Int) {
+      auto& a = expandedArray<IntArray>(*leaf, pos++);
+      for (openvdb::Index k = 0; k < count; ++k)
+        a.setUnsafe(k, static_cast<std::int32_t>((*c)[rows[k]]));
+    } else {
+      auto& a = expandedArray<VectorArray>(*leaf, pos++);
+      for (openvdb::Index k = 0; k < count; ++k) {
+        const Eigen::Index r = rows[k];
+        a.setUnsafe(k, openvdb::Vec3f(c[0][r], c[1][r], c[2][r]));
+      }
+    }
+  }
   return leaf;
 }
 
@@ -321,8 +338,12 @@ vdbp::PointDataTree::Ptr makeTree(const FrameData& frame) {
   descriptor = descriptor->duplicateAppend("id", IdArray::attributeType());
   for (const char* name : {"age", "life", "mass"})
     descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
-  for (const std::string& name : frame.attributeNames)
-    descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
+  for (const AttributeGroup& g : attributeGroups(frame.attributeNames)) {
+    descriptor = descriptor->duplicateAppend(
+        g.name, g.kind == AttributeKind::Int    ? IntArray::attributeType()
+                : g.kind == AttributeKind::Vec3 ? VectorArray::attributeType()
+                                                : FloatArray::attributeType());
+  }
 
   // Leaves are independent: filled in parallel (as OpenVDB's point conversion does), then
   // handed to the tree in order.
@@ -516,15 +537,25 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
     const std::size_t id32Pos = find("id", std::int32_t());
     const std::size_t agePos = find("age", float()), lifePos = find("life", float()),
                       massPos = find("mass", float());
+    // Every other attribute of a type a frame holds, in the file's order: a float, an int32 (a
+    // float column of whole numbers) or a vec3s (three columns: vectorColumns()).
     std::vector<std::size_t> customPos;
+    std::vector<AttributeKind> customKinds;
     std::vector<std::string> names(d.size());
     for (const auto& [name, pos] : d.map()) names[pos] = name;
     for (std::size_t pos = 0; pos < d.size(); ++pos) {
-      if (!isStandard(names[pos]) && leaf->constAttributeArray(pos).hasValueType<float>())
-        customPos.push_back(pos);
+      if (isStandard(names[pos])) continue;
+      const vdbp::AttributeArray& array = leaf->constAttributeArray(pos);
+      const bool isFloat = array.hasValueType<float>(), isInt = array.hasValueType<std::int32_t>(),
+                 isVector = array.hasValueType<openvdb::Vec3f>();
+      if (!isFloat && !isInt && !isVector) continue;
+      customPos.push_back(pos);
+      customKinds.push_back(isVector ? AttributeKind::Vec3
+                            : isInt  ? AttributeKind::Int
+                                     : AttributeKind::Float);
     }
-    // Houdini's colour, a vec3s, as tickfx names it in a pool: three floats Cd_r, Cd_g, Cd_b.
-    const std::size_t cdPos = find("Cd", openvdb::Vec3f());
+    std::size_t customColumns = 0;
+    for (AttributeKind k : customKinds) customColumns += k == AttributeKind::Vec3 ? 3 : 1;
     if (first) {
       found.hasVelocity = vPos != vdbp::AttributeSet::INVALID_POS;
       found.hasId =
@@ -532,9 +563,13 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
       found.hasAge = agePos != vdbp::AttributeSet::INVALID_POS;
       found.hasLife = lifePos != vdbp::AttributeSet::INVALID_POS;
       found.hasMass = massPos != vdbp::AttributeSet::INVALID_POS;
-      for (std::size_t pos : customPos) customNames.push_back(names[pos]);
-      if (cdPos != vdbp::AttributeSet::INVALID_POS) {
-        for (const char* channel : {"Cd_r", "Cd_g", "Cd_b"}) customNames.emplace_back(channel);
+      for (std::size_t a = 0; a < customPos.size(); ++a) {
+        if (customKinds[a] != AttributeKind::Vec3) {
+          customNames.push_back(names[customPos[a]]);
+          continue;
+        }
+        for (const std::string& column : vectorColumns(names[customPos[a]]))
+          customNames.push_back(column);
       }
       custom.resize(customNames.size());
       first = false;
@@ -584,17 +619,24 @@ FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents*
     readAll(agePos, age, 0.0f);
     readAll(lifePos, life, std::numeric_limits<float>::infinity());
     readAll(massPos, mass, 1.0f);
-    const std::size_t cdColumns = cdPos != vdbp::AttributeSet::INVALID_POS ? 3 : 0;
-    if (customPos.size() + cdColumns != custom.size()) {
+    if (customColumns != custom.size()) {
       throw std::runtime_error(where(file) + ": leaves with different attributes");
     }
-    for (std::size_t a = 0; a < customPos.size(); ++a) readAll(customPos[a], custom[a], 0.0f);
-    if (cdColumns > 0) {
-      std::vector<openvdb::Vec3f> cd;
-      readAll(cdPos, cd, openvdb::Vec3f(0.0f));
-      for (int c = 0; c < 3; ++c) {
-        std::vector<float>& column = custom[customPos.size() + static_cast<std::size_t>(c)];
-        for (const openvdb::Vec3f& v : cd) column.push_back(v[c]);
+    std::size_t column = 0;
+    for (std::size_t a = 0; a < customPos.size(); ++a) {
+      if (customKinds[a] == AttributeKind::Float) {
+        readAll(customPos[a], custom[column++], 0.0f);
+      } else if (customKinds[a] == AttributeKind::Int) {
+        std::vector<std::int32_t> values;
+        readAll(customPos[a], values, std::int32_t{0});
+        for (std::int32_t v : values) custom[column].push_back(static_cast<float>(v));
+        ++column;
+      } else {
+        std::vector<openvdb::Vec3f> values;
+        readAll(customPos[a], values, openvdb::Vec3f(0.0f));
+        for (int c = 0; c < 3; ++c, ++column) {
+          for (const openvdb::Vec3f& v : values) custom[column].push_back(v[c]);
+        }
       }
     }
     if (position.size() != id.size()) {

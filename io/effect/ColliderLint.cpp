@@ -111,7 +111,13 @@ void lintLevelSet(const EffectSettings& effect, std::size_t j, const Collider& c
 
 void lintColliders(const EffectSettings& effect, const ColliderSet* built,
                    std::vector<Diagnostic>& out) {
-  if (effect.colliders.empty()) return;
+  if (effect.colliders.empty()) {
+    if (effect.output.hits) {
+      out.push_back(warningAt(effect, "output.hits",
+                              "the effect has no [[colliders]]: no particle records a hit"));
+    }
+    return;
+  }
   ColliderSet owned;
   if (built == nullptr) {
     try {

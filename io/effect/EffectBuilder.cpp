@@ -119,7 +119,9 @@ std::unique_ptr<ParticleSystem> buildSystem(const EffectSettings& effect,
   ColliderSet colliders;
   try {
     forces = buildForces(effect.forces);
-    colliders = buildColliders(effect.colliders);
+    std::vector<ColliderSettings> colliderSettings = effect.colliders;
+    for (ColliderSettings& c : colliderSettings) c.recordHits = c.recordHits || effect.output.hits;
+    colliders = buildColliders(colliderSettings);
   } catch (const BuildError& e) {
     // The error at its key's place in the file.
     Diagnostic d = e.diagnostic();

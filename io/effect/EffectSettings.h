@@ -149,6 +149,9 @@ struct OutputSettings {
   std::vector<CacheFormat> formats{CacheFormat::Csv};  // may be empty: simulate, write nothing
   VdbCacheOptions vdb;            // vdb_compression, vdb_positions: how VDB caches are stored
   std::string directory = "out";  // as written; relative to the working directory of the command
+  /// Every collider records Houdini's hit attributes (ColliderSettings::recordHits), which the
+  /// caches then carry.
+  bool hits = false;
 
   /// Frames to write (>= 1).
   std::int64_t frameCount() const;

@@ -9,8 +9,9 @@ namespace tickfx::io::detail {
 namespace {
 
 const std::vector<std::string> kColliderTypes = {"plane", "sphere", "box", "level_set"};
-const std::vector<std::string> kColliderCommonKeys = {
-    "side", "response", "restitution", "friction", "velocity", "spin", "keys", "particle_radius"};
+const std::vector<std::string> kColliderCommonKeys = {"side",     "response",        "restitution",
+                                                      "friction", "velocity",        "spin",
+                                                      "keys",     "particle_radius", "hits"};
 
 // Collider type → the keys of its shape, to tell "does not apply here" from "unknown". `radius`
 // is the particles' collision radius for a plane or a box and the sphere's own radius for a
@@ -235,6 +236,7 @@ std::optional<ColliderSettings> readCollider(Context& cx, const toml::table& tab
   r.number("friction", c.friction, "Coulomb's coefficient, a number from 0 to 1e9",
            Range{0.0, kBig});
   r.vec3("velocity", c.motion.velocity, "[x, y, z] in m/s, each from -1e9 to 1e9", Range{});
+  r.boolean("hits", c.recordHits);
   readColliderSpin(cx, r, c.motion);
   readColliderKeys(cx, r, c.motion);
 

@@ -135,6 +135,7 @@ void readOutput(Context& cx, const toml::table& table, OutputSettings& out) {
     out.vdb.compression = *vdbCompressionNamed(name);
   if (r.choice("vdb_positions", name, vdbPositionsNames(), "VDB positions"))
     out.vdb.positions = *vdbPositionsNamed(name);
+  r.boolean("hits", out.hits);
   r.finish();
 }
 

@@ -17,6 +17,7 @@
 #include <tuple>
 #include <vector>
 
+#include "io/cache/AttributeGroups.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
 #include "io/cache/VdbPointCache.h"
@@ -172,20 +173,38 @@ py::dict frameToDict(const io::FrameData& frame) {
   out["age"] = floats(frame.age);
   out["life"] = floats(frame.life);
   out["mass"] = floats(frame.mass);
-  for (std::size_t a = 0; a < frame.attributes.size(); ++a) {
-    const std::string& name = frame.attributeNames[a];
-    if (out.contains(name)) {
-      const bool standard = std::find(std::begin(kStandardNames), std::end(kStandardNames), name) !=
-                            std::end(kStandardNames);
-      throw py::value_error("custom attribute '" + name + "' " +
+  // Houdini's types: a vec3 (hitpos, Cd) as (N, 3), an int (hitnum) as int32, others float32.
+  for (const io::AttributeGroup& g : io::attributeGroups(frame.attributeNames)) {
+    if (out.contains(g.name)) {
+      const bool standard = std::find(std::begin(kStandardNames), std::end(kStandardNames),
+                                      g.name) != std::end(kStandardNames);
+      throw py::value_error("custom attribute '" + g.name + "' " +
                             (standard ? "has the name of a standard column" : "appears twice"));
     }
-    out[py::str(name)] = floats(frame.attributes[a]);
+    const FloatColumn& column = frame.attributes[g.column];
+    if (g.kind == io::AttributeKind::Vec3) {
+      Vec3Column v{column, frame.attributes[g.column + 1], frame.attributes[g.column + 2]};
+      out[py::str(g.name)] = rowsOf3(v, n);
+    } else if (g.kind == io::AttributeKind::Int) {
+      py::array_t<std::int32_t> ints(static_cast<py::ssize_t>(n));
+      for (std::size_t i = 0; i < n; ++i)
+        ints.mutable_data()[i] = static_cast<std::int32_t>(column[static_cast<Eigen::Index>(i)]);
+      out[py::str(g.name)] = ints;
+    } else {
+      out[py::str(g.name)] = floats(column);
+    }
   }
   return out;
 }
 
 void bindCaches(py::module_& m) {
+  m.def(
+      "_vector_columns",
+      [](const std::string& name) {
+        const std::array<std::string, 3> c = io::vectorColumns(name);
+        return std::vector<std::string>(c.begin(), c.end());
+      },
+      py::arg("name"));
   m.def(
       "_read_cache",
       [](const std::string& path) {

@@ -320,7 +320,9 @@ void bindSystemClass(py::module_& m) {
           "The particles as the shown frame has them, as read_cache() returns a cache (new "
           "arrays): P (metres) and v (metres per second) at the shown time as (count, 3) "
           "float32, id int64, age (seconds) at the shown time, life (seconds), mass (kg) and the "
-          "custom attributes float32. write_cache(path, system.capture(), ...) writes what "
+          "custom attributes: Houdini's hit attributes when the effect records hits (hitnum "
+          "int32; hittime in seconds; hitpos, hitnml and hitv as (count, 3) float32), others "
+          "float32. write_cache(path, system.capture(), ...) writes what "
           "`tickfx run` writes for the frame.")
       .def("__repr__", [](const PySystem& s) {
         return "<tickfx.System " + s.path() + " tick=" + std::to_string(s.system().tickCount()) +

@@ -263,7 +263,7 @@ def _float32_column(name, value, rows):
                 f"is meant"
             )
         array = array.astype(np.float32)
-    expected = (rows, 3) if name in ("P", "v") else (rows,)
+    expected = (rows, 3) if name in ("P", "v") or array.ndim == 2 else (rows,)
     if rows is None:
         if array.ndim != 2 or array.shape[1] != 3:
             raise ValueError(f"write_cache: 'P' must have shape (N, 3), not {array.shape}")
@@ -280,7 +280,9 @@ def write_cache(path, columns, *, frame=0, time=0.0, system=None):
         metres, (N, 3), and "id", any integer dtype (stored modulo 2^64, so the int64 ids of
         read_cache() come back as they were). Optional, with what a missing one is written as:
         "v" metres per second, (N, 3) (0); "age" seconds (0); "life" seconds (inf: never dies);
-        "mass" kilograms (1). Every other key is a custom float attribute of shape (N,). Float
+        "mass" kilograms (1). Every other key is a custom attribute: float of shape (N,), a
+        vector of shape (N, 3) (stored as three columns, a vec3 in .vdb), or whole numbers of an
+        integer dtype up to 2^24 (hitnum: an int in .ply and .vdb, read back as int32). Float
         columns must be float32 or convert to it exactly (float64 is refused: call
         .astype(numpy.float32) to round on purpose).
     frame, time: the frame number and its time in seconds, recorded in the file's metadata
@@ -322,8 +324,26 @@ def write_cache(path, columns, *, frame=0, time=0.0, system=None):
     age = optional("age", 0.0)
     life = optional("life", np.inf)
     mass = optional("mass", 1.0)
-    names = [key for key in columns if key not in _STANDARD_COLUMNS]
-    attributes = [_float32_column(name, columns[name], rows) for name in names]
+    names, attributes = [], []
+    for key in columns:
+        if key in _STANDARD_COLUMNS:
+            continue
+        value = np.asarray(columns[key])
+        if value.dtype.kind in "iu":
+            # An integer attribute (Houdini's hitnum): whole numbers a float32 holds exactly.
+            if value.size and np.abs(value.astype(np.int64)).max() > 2**24:
+                raise ValueError(f"write_cache: '{key}' has integers past 2^24, which a cache "
+                                 f"column (float32) does not hold exactly")
+            value = value.astype(np.float32)
+        array = _float32_column(key, value, rows)
+        if array.ndim == 2:
+            # A vector attribute (Houdini's hitpos, Cd): three columns of the frame.
+            for c, column in enumerate(_tickfx._vector_columns(key)):
+                names.append(column)
+                attributes.append(np.ascontiguousarray(array[:, c]))
+        else:
+            names.append(key)
+            attributes.append(array)
     if isinstance(frame, bool) or not isinstance(frame, numbers.Integral):
         raise TypeError("write_cache: frame must be an int")
     metadata = _tickfx._vdb_metadata(system) if system is not None else None

@@ -375,6 +375,106 @@ TEST(MovingCollider, ASpinningBoxPushesAParticleAtItsSideOutward) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Hit attributes: Houdini's hitnum, hittime, hitpos, hitnml and hitv, in the pool's columns only
+// when a collider records hits.
+
+float hitColumn(const ParticleSystem& s, const char* name, std::size_t row = 0) {
+  const std::size_t a = s.pool().findAttribute(name);
+  EXPECT_NE(a, ParticlePool::npos) << name;
+  return a == ParticlePool::npos ? 0.0f : s.pool().attribute(a)[static_cast<Eigen::Index>(row)];
+}
+
+TEST(HitAttributes, AreColumnsOnlyWhenAColliderRecordsThem) {
+  auto without = systemWith("semi_implicit_euler", 240, gravityOnly(),
+                            {groundPlane(ColliderResponse::Bounce, 0.5, 0.0)});
+  auto none = systemWith("semi_implicit_euler", 240, gravityOnly(), {});
+  EXPECT_EQ(without->pool().attributeCount(), 0u);
+  EXPECT_EQ(without->pool().bytesPerRow(), none->pool().bytesPerRow());
+  ColliderSettings recording = groundPlane(ColliderResponse::Bounce, 0.5, 0.0);
+  recording.recordHits = true;
+  auto with = systemWith("semi_implicit_euler", 240, gravityOnly(), {recording});
+  ASSERT_EQ(with->pool().attributeCount(), kHitColumns.size());
+  for (std::size_t a = 0; a < kHitColumns.size(); ++a)
+    EXPECT_EQ(with->pool().attributeName(a), kHitColumns[a]);
+  EXPECT_EQ(with->pool().bytesPerRow(), none->pool().bytesPerRow() + 11 * sizeof(float));
+}
+
+// A ball dropped from 1 m at 1000 Hz: its first contact is at t = √(2h/g) and v = −√(2gh), to
+// the scheme's error (the bounce bound above: a tick and g·dt); the hit holds where it touched
+// (on the plane, y = 0 to its margin), the plane's normal exactly, and the velocity its
+// response turned: after the bounce, −e times hitv's normal part.
+TEST(HitAttributes, ADroppedBallRecordsItsFirstContact) {
+  ColliderSettings ground = groundPlane(ColliderResponse::Bounce, 0.5, 0.0);
+  ground.recordHits = true;
+  const std::int64_t rate = 1000;
+  auto system = systemWith("semi_implicit_euler", rate, gravityOnly(), {ground});
+  ParticleInit init;
+  init.position = Eigen::Vector3f(0.25f, 1.0f, -0.5f);
+  system->editPool().spawn(init, 0);
+  std::int64_t hitTick = -1;
+  float contactFraction = 0.0f;
+  while (hitTick < 0 && system->tickCount() < rate) {
+    const std::int64_t k = system->tickCount();
+    system->step();
+    EXPECT_EQ(hitColumn(*system, "hitnum"), system->colliders()->contacts() > 0 ? 1.0f : 0.0f);
+    if (system->colliders()->contacts() > 0) {
+      hitTick = k;
+      contactFraction = system->colliders()->paths()[0].fraction[0];
+    }
+  }
+  ASSERT_GE(hitTick, 0);
+  const float dt = static_cast<float>(1.0 / rate);
+  const float tickStart = static_cast<float>(static_cast<double>(hitTick) / rate);
+  EXPECT_EQ(hitColumn(*system, "hittime"), tickStart + contactFraction * dt);
+  EXPECT_NEAR(hitColumn(*system, "hittime"), std::sqrt(2.0 / kG), 1.5 * dt);
+  EXPECT_EQ(hitColumn(*system, "hitpos_x"), 0.25f);
+  EXPECT_NEAR(hitColumn(*system, "hitpos_y"), 0.0, Collider::margin(1.0f));
+  EXPECT_GE(hitColumn(*system, "hitpos_y"), 0.0f);
+  EXPECT_EQ(hitColumn(*system, "hitpos_z"), -0.5f);
+  EXPECT_EQ(hitColumn(*system, "hitnml_x"), 0.0f);
+  EXPECT_EQ(hitColumn(*system, "hitnml_y"), 1.0f);
+  EXPECT_EQ(hitColumn(*system, "hitnml_z"), 0.0f);
+  const float hitv = hitColumn(*system, "hitv_y");
+  EXPECT_NEAR(hitv, -std::sqrt(2.0 * kG), 1.5 * kG * dt);
+  EXPECT_EQ(hitColumn(*system, "hitv_x"), 0.0f);
+  EXPECT_EQ(system->pool().velocity().y[0], -0.5f * hitv);
+  // They hold until the next contact, which counts on.
+  const float first = hitColumn(*system, "hittime");
+  for (int k = 0; k < 100; ++k) system->step();
+  EXPECT_EQ(hitColumn(*system, "hitnum"), 1.0f);
+  EXPECT_EQ(hitColumn(*system, "hittime"), first);
+  while (system->colliders()->contacts() == 0 && system->tickCount() < 3 * rate) system->step();
+  EXPECT_EQ(hitColumn(*system, "hitnum"), 2.0f);
+  // Rising to e²h and back takes 2e·√(2h/g).
+  EXPECT_NEAR(hitColumn(*system, "hittime") - first, 2.0 * 0.5 * std::sqrt(2.0 / kG), 3.0 * dt);
+}
+
+// Only the contacts of colliders that record hits count: a ball bouncing between a recording
+// floor and a silent ceiling counts the floor's bounces alone.
+TEST(HitAttributes, OnlyRecordingCollidersCount) {
+  ColliderSettings floor = groundPlane(ColliderResponse::Bounce, 1.0, 0.0);
+  floor.recordHits = true;
+  ColliderSettings ceiling = groundPlane(ColliderResponse::Bounce, 1.0, 0.0);
+  ceiling.point = Eigen::Vector3d(0.0, 1.0, 0.0);
+  ceiling.normal = Eigen::Vector3d(0.0, -1.0, 0.0);
+  auto system = systemWith("semi_implicit_euler", 240, ForceSet{}, {floor, ceiling});
+  ParticleInit init;
+  init.position = Eigen::Vector3f(0.0f, 0.5f, 0.0f);
+  init.velocity = Eigen::Vector3f(0.0f, 12.0f, 0.0f);  // 0.5 m up, then 1 m a bounce
+  system->editPool().spawn(init, 0);
+  int floorHits = 0, ceilingHits = 0;
+  for (int k = 0; k < 240; ++k) {
+    system->step();
+    if (system->colliders()->contacts() == 0) continue;
+    (system->pool().velocity().y[0] > 0.0f ? floorHits : ceilingHits) += 1;
+    EXPECT_EQ(hitColumn(*system, "hitnum"), static_cast<float>(floorHits)) << "tick " << k;
+  }
+  EXPECT_EQ(floorHits, 6);
+  EXPECT_EQ(ceilingHits, 6);
+  EXPECT_EQ(hitColumn(*system, "hitnml_y"), 1.0f);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Frames between ticks follow the contacts: none shows a particle inside a still collider.
 
 TEST(CollisionFrames, NoFrameBetweenTicksShowsAParticleInsideAStillSphere) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/points/PointDataGrid.h>
 
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,10 @@
 #include <vector>
 
 #include "fields/ColliderSet.h"
+#include "io/cache/CsvCache.h"
+#include "io/cache/FrameData.h"
+#include "io/cache/PlyCache.h"
+#include "io/cache/VdbPointCache.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
@@ -61,6 +66,7 @@ radius = 2.0
 particle_radius = 0.1
 velocity = [1.0, 0.0, 0.0]
 response = "kill"
+hits = true
 )");
   ASSERT_EQ(e.colliders.size(), 2u);
   const ColliderSettings& b = e.colliders[0];
@@ -85,6 +91,8 @@ response = "kill"
   EXPECT_EQ(s.particleRadius, 0.1);
   EXPECT_EQ(s.motion.velocity, Eigen::Vector3d(1.0, 0.0, 0.0));
   EXPECT_EQ(s.response, ColliderResponse::Kill);
+  EXPECT_TRUE(s.recordHits);
+  EXPECT_FALSE(b.recordHits);
   // The system has them, in order.
   const auto system = buildSystem(e);
   ASSERT_NE(system->colliders(), nullptr);
@@ -122,7 +130,7 @@ radius = 0.01
              "and <= 1e9)",
              "bad.toml:17:1: error: colliders.3.size: does not apply to a collider of type "
              "\"plane\" (expected for plane: type, point, normal, radius, side, response, "
-             "restitution, friction, velocity, spin, keys, particle_radius)",
+             "restitution, friction, velocity, spin, keys, particle_radius, hits)",
              "bad.toml:18:12: error: colliders.3.response: unknown collision response \"bounc\" "
              "(did you mean \"bounce\"?)",
              "bad.toml:22:14: error: colliders.4.size.1: is no wider than a particle (radius "
@@ -309,6 +317,101 @@ TEST_F(ioCollidersOnDisk, VdbFilesMustHoldAFloatGrid) {
   const std::string tail = " of " + std::to_string(bytes.size() / 2) + ")";
   EXPECT_EQ(cut.substr(0, head.size()), head) << cut;
   EXPECT_EQ(cut.substr(cut.size() - std::min(cut.size(), tail.size())), tail) << cut;
+}
+
+// Hit attributes in every cache format, with Houdini's names and types where the format has
+// types: hitnum an int (PLY int, VDB int32), hitpos, hitnml and hitv vec3s in VDB (three float
+// columns <name>_x, _y, _z in CSV and PLY), hittime a float. Each reads back the same frame.
+TEST_F(ioCollidersOnDisk, HitsGoToEveryCacheFormatWithHoudinisTypes) {
+  const LoadResult loaded = parseEffect(R"(format_version = 1
+[simulation]
+step_rate = 240
+[[emitters]]
+position = [0.0, 1.0, 0.0]
+rate = 20
+speed = 1.0
+spread = 30.0
+[[forces]]
+type = "gravity"
+[[colliders]]
+type = "plane"
+restitution = 0.5
+[output]
+hits = true
+)",
+                                        "hits.toml", {});
+  ASSERT_TRUE(loaded.ok());
+  const EffectSettings& e = *loaded.effect;
+  EXPECT_TRUE(e.output.hits);
+  const auto system = buildSystem(e);
+  system->stepTicks(480);
+  const FrameData frame = captureFrame(*system, 48, 2.0);
+  const std::vector<std::string> hitColumns(kHitColumns.begin(), kHitColumns.end());
+  ASSERT_EQ(frame.attributeNames, hitColumns);
+  const auto hitnum = frame.attributes[0];
+  ASSERT_GT(hitnum.maxCoeff(), 1.0f) << "some particle should have bounced twice";
+  EXPECT_EQ(hitnum.minCoeff(), 0.0f) << "the newest particles have not landed";
+
+  writeCsvCache(frame, dir_ / "f.csv");
+  writePlyCache(frame, dir_ / "f.ply");
+  writeVdbPointCache(frame, VdbCacheMetadata{}, dir_ / "f.vdb");
+  EXPECT_EQ(frameHash(readCsvCache(dir_ / "f.csv")), frameHash(frame));
+  EXPECT_EQ(frameHash(readPlyCache(dir_ / "f.ply")), frameHash(frame));
+  EXPECT_EQ(frameHash(readVdbPointCache(dir_ / "f.vdb")), frameHash(frame));
+
+  std::ifstream csv(dir_ / "f.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header,
+            "id,px,py,pz,vx,vy,vz,age,life,mass,hitnum,hittime,hitpos_x,hitpos_y,hitpos_z,"
+            "hitnml_x,hitnml_y,hitnml_z,hitv_x,hitv_y,hitv_z");
+  std::ifstream ply(dir_ / "f.ply", std::ios::binary);
+  const std::string head((std::istreambuf_iterator<char>(ply)), std::istreambuf_iterator<char>());
+  EXPECT_NE(head.find("property float mass\nproperty int hitnum\nproperty float hittime\n"
+                      "property float hitpos_x\n"),
+            std::string::npos);
+
+  openvdb::initialize();
+  openvdb::io::File file((dir_ / "f.vdb").string());
+  file.open();
+  const auto grid = openvdb::gridPtrCast<openvdb::points::PointDataGrid>(file.readGrid("points"));
+  ASSERT_TRUE(grid);
+  const auto leaf = grid->tree().cbeginLeaf();
+  ASSERT_TRUE(leaf);
+  const auto& d = leaf->attributeSet().descriptor();
+  const std::vector<std::pair<std::string, std::string>> expected = {{"hitnum", "int32"},
+                                                                     {"hittime", "float"},
+                                                                     {"hitpos", "vec3s"},
+                                                                     {"hitnml", "vec3s"},
+                                                                     {"hitv", "vec3s"}};
+  for (const auto& [name, type] : expected) {
+    ASSERT_NE(d.find(name), openvdb::points::AttributeSet::INVALID_POS) << name;
+    EXPECT_EQ(d.valueType(d.find(name)), type) << name;
+  }
+  EXPECT_EQ(d.find("hitpos_x"), openvdb::points::AttributeSet::INVALID_POS);
+}
+
+TEST(ioCollidersLint, HitsWithoutCollidersAreWarnedAbout) {
+  const LoadResult r = parseEffect(std::string(kHead) + "[output]\nhits = true\n", "fx.toml", {});
+  ASSERT_TRUE(r.ok());
+  const std::vector<Diagnostic> w = lintEffect(*r.effect);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_EQ(w[0].format(),
+            "fx.toml:7:8: warning: output.hits: the effect has no [[colliders]]: no particle "
+            "records a hit");
+}
+
+TEST(ioColliders, HitsAreTrueOrFalse) {
+  EXPECT_EQ(
+      messages(R"([[colliders]]
+type = "plane"
+hits = "yes"
+[output]
+hits = 1
+)"),
+      (Lines{"bad.toml:8:8: error: colliders.0.hits: got a string \"yes\" (expected true "
+             "or false)",
+             "bad.toml:10:8: error: output.hits: got the integer 1 (expected true or false)"}));
 }
 
 TEST(ioMeshFile, PlyAsciiAndBinaryReadTheSameTriangles) {

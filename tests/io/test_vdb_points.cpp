@@ -341,8 +341,8 @@ TEST_F(ioVdbPoints, AnEmptyFrameIsAnEmptyGrid) {
 
 TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
   // Points as another tool writes them: OpenVDB's own conversion, a 0.25 m voxel, P in a 16-bit
-  // fixed-point codec, no v, id or age; one extra float attribute, an int one, and Houdini's
-  // colour Cd (vec3s), which reads as Cd_r, Cd_g and Cd_b.
+  // fixed-point codec, no v, id or age; one extra float attribute, an int32 one (a column of
+  // whole numbers), and Houdini's colour Cd (vec3s), which reads as Cd_r, Cd_g and Cd_b.
   vdbt::PointsFileSpec foreign;
   foreign.positions = {{0.1, 0.2, 0.3}, {-1.0, 2.0, 0.5}, {3.0, -3.0, 1.0}};
   foreign.voxelSize = 0.25;
@@ -358,7 +358,8 @@ TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
   ASSERT_EQ(back.size(), 3u);
   EXPECT_FALSE(contents.hasVelocity || contents.hasId || contents.hasAge || contents.hasLife ||
                contents.hasMass);
-  EXPECT_EQ(back.attributeNames, (std::vector<std::string>{"density", "Cd_r", "Cd_g", "Cd_b"}));
+  EXPECT_EQ(back.attributeNames,
+            (std::vector<std::string>{"density", "flags", "Cd_r", "Cd_g", "Cd_b"}));
   // Rows in file order, numbered from 0; positions within the codec's resolution.
   EXPECT_EQ(back.id, (std::vector<std::uint64_t>{0, 1, 2}));
   std::vector<bool> matched(3, false);
@@ -368,9 +369,10 @@ TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
     EXPECT_EQ(back.life[r], kInf);
     EXPECT_EQ(back.mass[r], 1.0f);
     EXPECT_EQ(back.attributes[0][r], 2.5f);
-    EXPECT_EQ(back.attributes[1][r], 0.25f);
-    EXPECT_EQ(back.attributes[2][r], 0.5f);
-    EXPECT_EQ(back.attributes[3][r], 1.0f);
+    EXPECT_EQ(back.attributes[1][r], 7.0f);
+    EXPECT_EQ(back.attributes[2][r], 0.25f);
+    EXPECT_EQ(back.attributes[3][r], 0.5f);
+    EXPECT_EQ(back.attributes[4][r], 1.0f);
     for (std::size_t k = 0; k < 3; ++k) {
       const Eigen::Vector3d p(back.position.x[r], back.position.y[r], back.position.z[r]);
       if ((p - Eigen::Vector3d(positions[k][0], positions[k][1], positions[k][2])).norm() < 1e-5)

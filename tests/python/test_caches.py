@@ -5,7 +5,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import tickfx
-from conftest import run_cli
+from conftest import run_cli, run_frames
 
 FORMATS = ["csv", "ply", "vdb"]
 STANDARD = ["P", "v", "id", "age", "life", "mass"]
@@ -49,6 +49,31 @@ def test_cli_cache_reads_as_the_python_frame(cli_frames, fmt):
     assert_same_bits(columns, system.capture())
     assert np.all(columns["mass"] == 1.0)
     assert columns["age"].max() <= 1.5
+
+
+def test_hit_attributes_in_every_format_as_capture_has_them(cli, samples, tmp_path):
+    # The fountain's drops bounce on its ground: with output.hits they carry Houdini's hit
+    # attributes, hitnum an int32 and the vectors (N, 3), in every format as in capture().
+    run_cli(cli, "run", samples / "fountain.toml", "--frames", "36", "--format", "csv,ply,vdb",
+            "--set", "output.hits=true", "--out", tmp_path, "--quiet")
+    system = tickfx.load_effect(samples / "fountain.toml", {"output.hits": True})
+    run_frames(system, 36)
+    shown = system.capture()
+    hits = ["hitnum", "hittime", "hitpos", "hitnml", "hitv"]
+    assert list(shown) == STANDARD + hits
+    n = system.count
+    assert shown["hitnum"].dtype == np.int32 and shown["hitnum"].max() >= 1
+    for name in ("hitpos", "hitnml", "hitv"):
+        assert shown[name].shape == (n, 3) and shown[name].dtype == np.float32
+    hit = shown["hitnum"] > 0
+    assert np.all(shown["hitnml"][hit] == [0.0, 1.0, 0.0])  # the ground's normal
+    assert np.all(shown["hitv"][hit][:, 1] < 0.0)  # falling onto it
+    assert np.all((shown["hittime"][hit] > 0.0) & (shown["hittime"][hit] <= 1.5))
+    for fmt in FORMATS:
+        assert_same_bits(tickfx.read_cache(tmp_path / f"frame_0036.{fmt}"), shown)
+        mine = tmp_path / f"mine.{fmt}"
+        tickfx.write_cache(mine, shown, frame=36, time=system.time, system=system)
+        assert mine.read_bytes() == (tmp_path / f"frame_0036.{fmt}").read_bytes(), fmt
 
 
 @pytest.mark.parametrize("fmt", FORMATS)
@@ -154,7 +179,8 @@ def test_write_cache_validates(tmp_path):
         ({**good, "v": np.zeros((3,), np.float32)}, r"'v' must have shape \(3, 3\)"),
         ({**good, "mass": np.ones(4, np.float32)}, r"'mass' must have shape \(3,\)"),
         ({**good, "heat": [1.0, 2.0, 3.0]}, "'heat' is float64"),
-        ({**good, "heat": np.ones(3, np.int32)}, "'heat' is int32"),
+        ({**good, "heat": np.array([1, 2, 2**24 + 1], np.int32)}, "'heat' has integers past 2"),
+        ({**good, "hitpos": np.zeros((3, 2), np.float32)}, r"'hitpos' must have shape \(3, 3\)"),
     ]
     for columns, message in cases:
         with pytest.raises(ValueError, match=message):
