@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
+#include "Sanitized.h"
 #include "fields/Collider.h"
 #include "fields/ColliderSet.h"
 #include "particles/StateHash.h"
@@ -165,7 +166,7 @@ INSTANTIATE_TEST_SUITE_P(AllSchemes, Friction, ::testing::ValuesIn(integratorNam
 // No tunnelling: 10⁵ particles at 10³ m/s aimed at a plane, a sphere and a thin rotated box, at
 // 24 and 1000 Hz. After every tick none is inside (clearance above −margin), and none crossed:
 // the path each took through the tick (start, contacts, end) never goes through the shape,
-// checked in double by an independent test.
+// checked in double by an independent test. (10⁴ under the sanitizers: test::kSanitized.)
 
 struct Aimed {
   ColliderSettings collider;
@@ -265,7 +266,7 @@ TEST_P(NoTunnelling, FastParticlesNeverEndATickInsideNorCrossTheShape) {
   const Aimed aimed = aimedAt(shape);
   auto system = systemWith("semi_implicit_euler", rate, ForceSet{}, {aimed.collider}, 2);
   std::mt19937_64 rng(31);
-  const std::size_t n = 100'000;
+  const std::size_t n = test::kSanitized ? 10'000 : 100'000;
   for (std::size_t i = 0; i < n; ++i) {
     // A start 20 to 30 m away from a point of the shape, coming at it at 1000 m/s.
     Eigen::Vector3d target, dir;
