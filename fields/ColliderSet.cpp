@@ -1,5 +1,8 @@
 #include "fields/ColliderSet.h"
 
+#include <cstring>
+
+#include "particles/Assert.h"
 #include "particles/ParallelFor.h"
 
 namespace tickfx {
@@ -46,107 +49,141 @@ Eigen::Vector3f CollisionPath::at(float alpha, const Eigen::Vector3f& end) const
 
 void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz,
                           bool history) {
+  beginTick(pool, tick, stepRateHz, history);
+  if (!colliders_.empty()) {
+    parallelForRows(pool.size(),
+                    [&](std::size_t begin, std::size_t end) { collideRows(pool, begin, end); });
+  }
+  endTick();
+}
+
+void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz,
+                            bool history) {
   paths_.clear();
   contacts_ = 0;
   if (colliders_.empty()) return;
   for (auto& c : colliders_) c->beginTick(tick, stepRateHz);
-  const float dt = static_cast<float>(1.0 / static_cast<double>(stepRateHz));
-  const std::size_t n = pool.size();
-  const std::size_t blocks = (n + kParallelBlockRows - 1) / kParallelBlockRows;
-  blockPaths_.resize(std::max(blockPaths_.size(), blocks));
+  TickState& t = tick_;
+  t.dt = static_cast<float>(1.0 / static_cast<double>(stepRateHz));
+  // A contact's time is the tick's start (exact, then rounded to float once) plus its fraction of
+  // the step, in float.
+  t.start = static_cast<float>(static_cast<double>(tick) / static_cast<double>(stepRateHz));
+  t.history = history;
+  t.blocks = (pool.size() + kParallelBlockRows - 1) / kParallelBlockRows;
+  blockPaths_.resize(std::max(blockPaths_.size(), t.blocks));
+  for (std::size_t k = 0; k < t.blocks; ++k) blockPaths_[k].clear();
+  // The hit columns, where the pool has them.
+  t.hits.fill(nullptr);
+  if (pool.findAttribute(kHitColumns[0]) != ParticlePool::npos) {
+    for (std::size_t k = 0; k < kHitColumns.size(); ++k)
+      t.hits[k] = pool.attribute(pool.findAttribute(kHitColumns[k])).data();
+  }
+}
+
+void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t end) {
+  if (colliders_.empty() || begin >= end) return;
+  TICKFX_ASSERT(begin % kParallelBlockRows == 0 && end - begin <= kParallelBlockRows,
+                "collideRows() takes whole blocks of kParallelBlockRows rows");
+  const TickState& t = tick_;
+  const float dt = t.dt;
   Vec3Column& pos = pool.position();
   Vec3Column& vel = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
   std::uint8_t* dead = pool.dead().data();
   const std::uint64_t* ids = pool.id().data();
-  // The hit columns, where the pool has them; a contact's time is the tick's start (exact, then
-  // rounded to float once) plus its fraction of the step, in float.
-  std::array<float*, kHitColumns.size()> hits{};
-  if (pool.findAttribute(kHitColumns[0]) != ParticlePool::npos) {
-    for (std::size_t k = 0; k < kHitColumns.size(); ++k)
-      hits[k] = pool.attribute(pool.findAttribute(kHitColumns[k])).data();
-  }
-  const auto tickStart =
-      static_cast<float>(static_cast<double>(tick) / static_cast<double>(stepRateHz));
-  parallelForRows(n, [&](std::size_t begin, std::size_t end) {
-    std::vector<CollisionPath>& found = blockPaths_[begin / kParallelBlockRows];
-    found.clear();
-    // Which rows may touch a collider: a screen over the block's columns first.
-    thread_local std::vector<std::uint8_t> flags;
-    flags.assign(end - begin, 0);
-    const float* const starts[3] = {prev.x.data() + begin, prev.y.data() + begin,
-                                    prev.z.data() + begin};
-    const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
-    for (const auto& c : colliders_) c->screen(starts, ends, end - begin, flags.data());
-    for (std::size_t i = begin; i < end; ++i) {
-      if (flags[i - begin] == 0) continue;
-      const auto row = static_cast<Eigen::Index>(i);
-      Eigen::Vector3f a(prev.x[row], prev.y[row], prev.z[row]);
-      Eigen::Vector3f b(pos.x[row], pos.y[row], pos.z[row]);
-      Eigen::Vector3f v(vel.x[row], vel.y[row], vel.z[row]);
-      CollisionPath path;
-      float from = 0.0f;
-      int recorded = 0;
-      Contact lastHit;
-      Eigen::Vector3f hitVelocity = Eigen::Vector3f::Zero();
-      while (path.contacts < kMaxContactsPerTick) {
-        Contact best, contact;
-        const Collider* hit = nullptr;
-        for (const auto& c : colliders_) {
-          if (c->firstContact(a, from, b, contact) &&
-              (hit == nullptr || contact.fraction < best.fraction)) {
-            best = contact;
-            hit = c.get();
-          }
-        }
-        if (hit == nullptr) break;
-        if (path.contacts == 0) path.start = a;
-        path.fraction[path.contacts] = best.fraction;
-        path.point[path.contacts] = best.point;
-        ++path.contacts;
-        if (hits[0] != nullptr && hit->settings().recordHits) {
-          ++recorded;
-          lastHit = best;
-          hitVelocity = v;
-        }
-        v = hit->respond(best, v);
-        a = best.point;
-        from = best.fraction;
-        if (hit->settings().response == ColliderResponse::Kill) {
-          dead[i] = static_cast<std::uint8_t>(dead[i] | 1);
-          b = a;
-          break;
-        }
-        // The rest of the tick at the new velocity; after the last contact allowed, carried
-        // along with the collider.
-        b = path.contacts < kMaxContactsPerTick ? Eigen::Vector3f(a + v * ((1.0f - from) * dt))
-                                                : hit->carried(best);
+  std::vector<CollisionPath>& found = blockPaths_[begin / kParallelBlockRows];
+  // Which rows may touch a collider: a screen over the block's columns first.
+  thread_local std::vector<std::uint8_t> flags;
+  flags.assign(end - begin, 0);
+  const float* const starts[3] = {prev.x.data() + begin, prev.y.data() + begin,
+                                  prev.z.data() + begin};
+  const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
+  for (const auto& c : colliders_) c->screen(starts, ends, end - begin, flags.data());
+  // Most rows are screened out: skipped eight at a time, through a pointer read once (the
+  // thread_local vector would be looked up again every row).
+  const std::uint8_t* const flagged = flags.data();
+  const std::size_t count = end - begin;
+  for (std::size_t k = 0; k < count; ++k) {
+    if ((k & 7) == 0 && k + 8 <= count) {
+      std::uint64_t eight = 0;
+      std::memcpy(&eight, flagged + k, sizeof eight);
+      if (eight == 0) {
+        k += 7;
+        continue;
       }
-      if (path.contacts == 0) continue;
-      for (int c = 0; c < 3; ++c) {
-        pos[c][row] = b[c];
-        vel[c][row] = v[c];
-        if (history) prev[c][row] = b[c] - v[c] * dt;
-      }
-      if (recorded > 0) {
-        const float values[kHitColumns.size()] = {hits[0][i] + static_cast<float>(recorded),
-                                                  tickStart + lastHit.fraction * dt,
-                                                  lastHit.point.x(),
-                                                  lastHit.point.y(),
-                                                  lastHit.point.z(),
-                                                  lastHit.normal.x(),
-                                                  lastHit.normal.y(),
-                                                  lastHit.normal.z(),
-                                                  hitVelocity.x(),
-                                                  hitVelocity.y(),
-                                                  hitVelocity.z()};
-        for (std::size_t k = 0; k < kHitColumns.size(); ++k) hits[k][i] = values[k];
-      }
-      path.id = ids[i];
-      found.push_back(path);
     }
-  });
-  for (std::size_t k = 0; k < blocks; ++k) {
+    if (flagged[k] == 0) continue;
+    const std::size_t i = begin + k;
+    const auto row = static_cast<Eigen::Index>(i);
+    Eigen::Vector3f a(prev.x[row], prev.y[row], prev.z[row]);
+    Eigen::Vector3f b(pos.x[row], pos.y[row], pos.z[row]);
+    Eigen::Vector3f v(vel.x[row], vel.y[row], vel.z[row]);
+    CollisionPath path;
+    float from = 0.0f;
+    int recorded = 0;
+    Contact lastHit;
+    Eigen::Vector3f hitVelocity = Eigen::Vector3f::Zero();
+    while (path.contacts < kMaxContactsPerTick) {
+      Contact best, contact;
+      const Collider* hit = nullptr;
+      for (const auto& c : colliders_) {
+        if (c->firstContact(a, from, b, contact) &&
+            (hit == nullptr || contact.fraction < best.fraction)) {
+          best = contact;
+          hit = c.get();
+        }
+      }
+      if (hit == nullptr) break;
+      if (path.contacts == 0) path.start = a;
+      path.fraction[path.contacts] = best.fraction;
+      path.point[path.contacts] = best.point;
+      ++path.contacts;
+      if (t.hits[0] != nullptr && hit->settings().recordHits) {
+        ++recorded;
+        lastHit = best;
+        hitVelocity = v;
+      }
+      v = hit->respond(best, v);
+      a = best.point;
+      from = best.fraction;
+      if (hit->settings().response == ColliderResponse::Kill) {
+        dead[i] = static_cast<std::uint8_t>(dead[i] | 1);
+        b = a;
+        break;
+      }
+      // The rest of the tick at the new velocity; after the last contact allowed, carried
+      // along with the collider.
+      b = path.contacts < kMaxContactsPerTick ? Eigen::Vector3f(a + v * ((1.0f - from) * dt))
+                                              : hit->carried(best);
+    }
+    if (path.contacts == 0) continue;
+    for (int c = 0; c < 3; ++c) {
+      pos[c][row] = b[c];
+      vel[c][row] = v[c];
+      if (t.history) prev[c][row] = b[c] - v[c] * dt;
+    }
+    if (recorded > 0) {
+      const float values[kHitColumns.size()] = {t.hits[0][i] + static_cast<float>(recorded),
+                                                t.start + lastHit.fraction * dt,
+                                                lastHit.point.x(),
+                                                lastHit.point.y(),
+                                                lastHit.point.z(),
+                                                lastHit.normal.x(),
+                                                lastHit.normal.y(),
+                                                lastHit.normal.z(),
+                                                hitVelocity.x(),
+                                                hitVelocity.y(),
+                                                hitVelocity.z()};
+      for (std::size_t h = 0; h < kHitColumns.size(); ++h) t.hits[h][i] = values[h];
+    }
+    path.id = ids[i];
+    found.push_back(path);
+  }
+}
+
+void ColliderSet::endTick() {
+  if (colliders_.empty()) return;
+  for (std::size_t k = 0; k < tick_.blocks; ++k) {
     for (const CollisionPath& p : blockPaths_[k]) {
       contacts_ += static_cast<std::uint64_t>(p.contacts);
       paths_.push_back(p);

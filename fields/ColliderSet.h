@@ -72,13 +72,31 @@ class ColliderSet {
   /// columns where it has them (addHitColumns), the tick starting at tick / stepRateHz seconds.
   void collide(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz, bool history);
 
+  /// collide() in three parts, for a caller that collides each block of rows right after its
+  /// step, while the block is in cache: beginTick() once, collideRows() for disjoint blocks
+  /// [begin, end) of at most kParallelBlockRows rows, each begin a multiple of it, from any
+  /// threads at once, then endTick(). No spawn or removal in between. The same bits as collide().
+  void beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz, bool history);
+  void collideRows(ParticlePool& pool, std::size_t begin, std::size_t end);
+  void endTick();
+
   /// The paths of the rows that touched a collider in the last collide(), in row order.
   const std::vector<CollisionPath>& paths() const { return paths_; }
   /// Contacts made in the last collide().
   std::uint64_t contacts() const { return contacts_; }
 
  private:
+  // What beginTick() sets for the tick's collideRows().
+  struct TickState {
+    float dt = 0.0f;     // s
+    float start = 0.0f;  // s: the tick's start, for hittime
+    bool history = false;
+    std::size_t blocks = 0;
+    std::array<float*, kHitColumns.size()> hits{};  // the pool's hit columns, or null
+  };
+
   std::vector<std::unique_ptr<Collider>> colliders_;
+  TickState tick_;
   std::vector<CollisionPath> paths_;
   std::vector<std::vector<CollisionPath>> blockPaths_;
   std::uint64_t contacts_ = 0;

@@ -71,15 +71,25 @@ inline bool boxesMeet(const V3& a, const V3& b, const V3& lo, const V3& hi) {
 // columns, without a branch a row, so that the compiler vectorises it.
 inline void screenBoxColumns(const float* const a[3], const float* const b[3], std::size_t n,
                              const V3& lo, const V3& hi, std::uint8_t* flags) {
+  // Restricted local copies: the flags are bytes, which may alias anything, so without them the
+  // compiler reloads every pointer and bound a row and does not vectorise (measured: scalar).
+  const float* __restrict ax = a[0];
+  const float* __restrict ay = a[1];
+  const float* __restrict az = a[2];
+  const float* __restrict bx = b[0];
+  const float* __restrict by = b[1];
+  const float* __restrict bz = b[2];
+  std::uint8_t* __restrict f = flags;
+  const float lx = lo.x(), ly = lo.y(), lz = lo.z(), hx = hi.x(), hy = hi.y(), hz = hi.z();
   for (std::size_t i = 0; i < n; ++i) {
     // Integers, not bools: & on every comparison, no short circuit to branch on.
-    const int meets = static_cast<int>(std::max(a[0][i], b[0][i]) >= lo.x()) &
-                      static_cast<int>(std::min(a[0][i], b[0][i]) <= hi.x()) &
-                      static_cast<int>(std::max(a[1][i], b[1][i]) >= lo.y()) &
-                      static_cast<int>(std::min(a[1][i], b[1][i]) <= hi.y()) &
-                      static_cast<int>(std::max(a[2][i], b[2][i]) >= lo.z()) &
-                      static_cast<int>(std::min(a[2][i], b[2][i]) <= hi.z());
-    flags[i] = static_cast<std::uint8_t>(flags[i] | meets);
+    const int meets = static_cast<int>(std::max(ax[i], bx[i]) >= lx) &
+                      static_cast<int>(std::min(ax[i], bx[i]) <= hx) &
+                      static_cast<int>(std::max(ay[i], by[i]) >= ly) &
+                      static_cast<int>(std::min(ay[i], by[i]) <= hy) &
+                      static_cast<int>(std::max(az[i], bz[i]) >= lz) &
+                      static_cast<int>(std::min(az[i], bz[i]) <= hz);
+    f[i] = static_cast<std::uint8_t>(f[i] | meets);
   }
 }
 
@@ -100,12 +110,38 @@ struct PlaneShape {
   void screenColumns(const float* const a[3], const float* const b[3], std::size_t n,
                      std::uint8_t* flags) const {
     const float nx = normal.x(), ny = normal.y(), nz = normal.z();
-    const float px = point.x(), py = point.y(), pz = point.z();
+    const float px = point.x(), py = point.y(), pz = point.z(), r = offset;
+    // An axis-aligned normal (a ground plane's): phi is ±(x_axis − p_axis) − r, the other terms
+    // being 0 · (finite) = ±0, so one column decides. (Where a coordinate is not finite phi is
+    // NaN and flags nothing; this may flag such a row, which the exact test then refuses.)
+    const int axis = ny == 0.0f && nz == 0.0f   ? 0
+                     : nx == 0.0f && nz == 0.0f ? 1
+                     : nx == 0.0f && ny == 0.0f ? 2
+                                                : -1;
+    if (axis >= 0) {
+      const float sign = normal[axis], p = point[axis];
+      const float* __restrict aa = a[axis];
+      const float* __restrict ba = b[axis];
+      std::uint8_t* __restrict f = flags;
+      for (std::size_t i = 0; i < n; ++i) {
+        const float da = sign * (aa[i] - p) - r, db = sign * (ba[i] - p) - r;
+        f[i] = static_cast<std::uint8_t>(
+            f[i] | (static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f)));
+      }
+      return;
+    }
+    const float* __restrict ax = a[0];  // restricted: see screenBoxColumns()
+    const float* __restrict ay = a[1];
+    const float* __restrict az = a[2];
+    const float* __restrict bx = b[0];
+    const float* __restrict by = b[1];
+    const float* __restrict bz = b[2];
+    std::uint8_t* __restrict f = flags;
     for (std::size_t i = 0; i < n; ++i) {
-      const float da = nx * (a[0][i] - px) + ny * (a[1][i] - py) + nz * (a[2][i] - pz) - offset;
-      const float db = nx * (b[0][i] - px) + ny * (b[1][i] - py) + nz * (b[2][i] - pz) - offset;
+      const float da = nx * (ax[i] - px) + ny * (ay[i] - py) + nz * (az[i] - pz) - r;
+      const float db = nx * (bx[i] - px) + ny * (by[i] - py) + nz * (bz[i] - pz) - r;
       const int below = static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f);
-      flags[i] = static_cast<std::uint8_t>(flags[i] | below);
+      f[i] = static_cast<std::uint8_t>(f[i] | below);
     }
   }
   bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {

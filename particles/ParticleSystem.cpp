@@ -290,16 +290,39 @@ void ParticleSystem::runTick(bool keepVelocities) {
   }
   forces_->beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};
-  const bool check = settings_.nonfinite != NonfinitePolicy::Keep;
-  integrator_->step(pool_, *forces_, time, check ? &nonfiniteCheck_ : nullptr);
-  if (nonfiniteCheck_.found()) takeNonfinite();
-  if (colliders_) {
-    colliders_->collide(pool_, tick_, settings_.stepRateHz, integrator_->readsPreviousPosition());
-    pathsTick_ = tick_ + 1;
+  NonfiniteCheck* const check =
+      settings_.nonfinite != NonfinitePolicy::Keep ? &nonfiniteCheck_ : nullptr;
+  if (colliders_ && forces_->isLocal()) {
+    stepAndCollideBlocks(time, check);
+  } else {
+    integrator_->step(pool_, *forces_, time, check);
+    if (colliders_) {
+      colliders_->collide(pool_, tick_, settings_.stepRateHz, integrator_->readsPreviousPosition());
+    }
   }
+  // (A non-finite row is flagged with NonfiniteCheck::kFlag, which collisions neither read nor
+  // write: the same rows whether they ran first or not.)
+  if (nonfiniteCheck_.found()) takeNonfinite();
+  if (colliders_) pathsTick_ = tick_ + 1;
   pool_.markAllStepped();
   forces_->endTick(pool_, time.stage(2));
   endTicks(tick_ + 1, keepVelocities);
+}
+
+void ParticleSystem::stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check) {
+  // Each block is stepped and then collided on one thread, its rows still in that core's cache:
+  // the collision pass is not a second trip through memory. Local forces give a block the bits
+  // of a whole step (Integrator::stepRows), and collisions are per row.
+  integrator_->prepare(pool_, *forces_);
+  colliders_->beginTick(pool_, tick_, settings_.stepRateHz, integrator_->readsPreviousPosition());
+  const std::size_t n = pool_.size(), stepped = pool_.firstUnstepped();
+  parallelForTasks((n + kParallelBlockRows - 1) / kParallelBlockRows, [&](std::size_t i) {
+    const std::size_t begin = i * kParallelBlockRows, end = std::min(n, begin + kParallelBlockRows);
+    const StepRows rows{RowRange{begin, end}, std::clamp(stepped, begin, end), true};
+    integrator_->stepRows(pool_, *forces_, time, rows, check);
+    colliders_->collideRows(pool_, begin, end);
+  });
+  colliders_->endTick();
 }
 
 void ParticleSystem::endTicks(std::int64_t tick, bool keepVelocities) {

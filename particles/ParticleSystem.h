@@ -25,6 +25,7 @@ class ColliderSet;
 class ForceSet;
 class Integrator;
 class SpringNetwork;
+struct StepTime;
 class TaskExecutor;
 
 /// Settings of a whole simulation (the [simulation] table of an effect file).
@@ -194,6 +195,8 @@ class ParticleSystem {
   struct PendingStructure;
   void runTicks(std::int64_t ticks, bool keepVelocities);
   void runTick(bool keepVelocities);
+  // A tick's step and collisions block by block (colliders with local forces).
+  void stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check);
   bool fusesTicks(std::int64_t ticks) const;
   bool runFusedTicks(std::int64_t ticks, bool keepVelocities);
   // After the ticks up to `tick` (the count it sets): ages, the kept velocities' rows matched to

@@ -58,9 +58,30 @@ struct LevelSetShape {
       return static_cast<openvdb::Int32>(std::clamp(f, -1.0e9f, 1.0e9f));
     };
     const openvdb::Int32 i = index(fx), j = index(fy), k = index(fz);
-    const auto at = [&](int di, int dj, int dk) {
-      return acc.getValue(openvdb::Coord(i + di, j + dj, k + dk));
-    };
+    // The cell's eight corners: from one leaf's buffer when the cell lies in one leaf (7 cells
+    // in 8 along each axis), one probe instead of eight lookups; else through the accessor.
+    float v[2][2][2];
+    using Leaf = openvdb::FloatTree::LeafNodeType;
+    const openvdb::Coord ijk(i, j, k);
+    const Leaf* leaf = nullptr;
+    constexpr openvdb::Int32 kLast = Leaf::DIM - 1;
+    if ((i & kLast) != kLast && (j & kLast) != kLast && (k & kLast) != kLast)
+      leaf = acc.probeConstLeaf(ijk);
+    if (leaf != nullptr) {
+      const openvdb::Index o = Leaf::coordToOffset(ijk);
+      constexpr openvdb::Index dx = Leaf::DIM * Leaf::DIM, dy = Leaf::DIM, dz = 1;
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+          for (int c = 0; c < 2; ++c)
+            v[a][b][c] = leaf->getValue(o + static_cast<openvdb::Index>(a) * dx +
+                                        static_cast<openvdb::Index>(b) * dy +
+                                        static_cast<openvdb::Index>(c) * dz);
+    } else {
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+          for (int c = 0; c < 2; ++c) v[a][b][c] = acc.getValue(ijk.offsetBy(a, b, c));
+    }
+    const auto at = [&](int di, int dj, int dk) { return v[di][dj][dk]; };
     const float c00 = at(0, 0, 0) + (at(1, 0, 0) - at(0, 0, 0)) * tx;
     const float c10 = at(0, 1, 0) + (at(1, 1, 0) - at(0, 1, 0)) * tx;
     const float c01 = at(0, 0, 1) + (at(1, 0, 1) - at(0, 0, 1)) * tx;
