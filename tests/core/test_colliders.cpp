@@ -156,6 +156,8 @@ TEST_P(Friction, ASlidingParticleStopsAfterV0SquaredOverTwoMuG) {
   const double dt = test::floatDt(rate);
   const double stop = v0 * v0 / (2.0 * mu * kG);
   EXPECT_NEAR(system->pool().position().x[0], stop, 2.0 * v0 * dt) << integrator;
+  RecordProperty("error", std::to_string(system->pool().position().x[0] - stop));
+  RecordProperty("bound", std::to_string(2.0 * v0 * dt));
   EXPECT_EQ(system->pool().velocity().x[0], 0.0f);
   EXPECT_GE(system->pool().position().y[0], -Collider::margin(3.0f));
 }
