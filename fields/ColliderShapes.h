@@ -67,12 +67,14 @@ inline bool boxesMeet(const V3& a, const V3& b, const V3& lo, const V3& hi) {
          std::max(a.z(), b.z()) >= lo.z() && std::min(a.z(), b.z()) <= hi.z();
 }
 
-// flags[i] = 1 for rows [0, n) whose path a → b has a box meeting [lo, hi]: boxesMeet over
-// columns, without a branch a row, so that the compiler vectorises it.
-inline void screenBoxColumns(const float* const a[3], const float* const b[3], std::size_t n,
-                             const V3& lo, const V3& hi, std::uint8_t* flags) {
-  // Restricted local copies: the flags are bytes, which may alias anything, so without them the
-  // compiler reloads every pointer and bound a row and does not vectorise (measured: scalar).
+// flags[i] |= rowFlag(a's x, y, z, b's x, y, z) (0 or 1) for rows [0, n), a screen over a block's
+// start and end columns. Restricted copies of the pointers: the flags are bytes, which may alias
+// anything, so without them the compiler reloads every pointer and bound a row and does not
+// vectorise (measured: scalar). A rowFlag without branches vectorises; columns it ignores are not
+// read.
+template <class RowFlag>
+inline void screenRows(const float* const a[3], const float* const b[3], std::size_t n,
+                       std::uint8_t* flags, const RowFlag& rowFlag) {
   const float* __restrict ax = a[0];
   const float* __restrict ay = a[1];
   const float* __restrict az = a[2];
@@ -80,17 +82,21 @@ inline void screenBoxColumns(const float* const a[3], const float* const b[3], s
   const float* __restrict by = b[1];
   const float* __restrict bz = b[2];
   std::uint8_t* __restrict f = flags;
+  for (std::size_t i = 0; i < n; ++i)
+    f[i] = static_cast<std::uint8_t>(f[i] | rowFlag(ax[i], ay[i], az[i], bx[i], by[i], bz[i]));
+}
+
+// flags[i] = 1 for rows [0, n) whose path a → b has a box meeting [lo, hi]: boxesMeet over
+// columns, without a branch a row, so that the compiler vectorises it.
+inline void screenBoxColumns(const float* const a[3], const float* const b[3], std::size_t n,
+                             const V3& lo, const V3& hi, std::uint8_t* flags) {
   const float lx = lo.x(), ly = lo.y(), lz = lo.z(), hx = hi.x(), hy = hi.y(), hz = hi.z();
-  for (std::size_t i = 0; i < n; ++i) {
+  screenRows(a, b, n, flags, [=](float ax, float ay, float az, float bx, float by, float bz) {
     // Integers, not bools: & on every comparison, no short circuit to branch on.
-    const int meets = static_cast<int>(std::max(ax[i], bx[i]) >= lx) &
-                      static_cast<int>(std::min(ax[i], bx[i]) <= hx) &
-                      static_cast<int>(std::max(ay[i], by[i]) >= ly) &
-                      static_cast<int>(std::min(ay[i], by[i]) <= hy) &
-                      static_cast<int>(std::max(az[i], bz[i]) >= lz) &
-                      static_cast<int>(std::min(az[i], bz[i]) <= hz);
-    f[i] = static_cast<std::uint8_t>(f[i] | meets);
-  }
+    return static_cast<int>(std::max(ax, bx) >= lx) & static_cast<int>(std::min(ax, bx) <= hx) &
+           static_cast<int>(std::max(ay, by) >= ly) & static_cast<int>(std::min(ay, by) <= hy) &
+           static_cast<int>(std::max(az, bz) >= lz) & static_cast<int>(std::min(az, bz) <= hz);
+  });
 }
 
 // How far a shape's screening box reaches past it: far more than the rounding of a contact test
@@ -120,29 +126,19 @@ struct PlaneShape {
                                                 : -1;
     if (axis >= 0) {
       const float sign = normal[axis], p = point[axis];
-      const float* __restrict aa = a[axis];
-      const float* __restrict ba = b[axis];
-      std::uint8_t* __restrict f = flags;
-      for (std::size_t i = 0; i < n; ++i) {
-        const float da = sign * (aa[i] - p) - r, db = sign * (ba[i] - p) - r;
-        f[i] = static_cast<std::uint8_t>(
-            f[i] | (static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f)));
-      }
+      const float* const aa[3] = {a[axis], a[axis], a[axis]};
+      const float* const ba[3] = {b[axis], b[axis], b[axis]};
+      screenRows(aa, ba, n, flags, [=](float ac, float, float, float bc, float, float) {
+        return static_cast<int>(sign * (ac - p) - r < 0.0f) |
+               static_cast<int>(sign * (bc - p) - r < 0.0f);
+      });
       return;
     }
-    const float* __restrict ax = a[0];  // restricted: see screenBoxColumns()
-    const float* __restrict ay = a[1];
-    const float* __restrict az = a[2];
-    const float* __restrict bx = b[0];
-    const float* __restrict by = b[1];
-    const float* __restrict bz = b[2];
-    std::uint8_t* __restrict f = flags;
-    for (std::size_t i = 0; i < n; ++i) {
-      const float da = nx * (ax[i] - px) + ny * (ay[i] - py) + nz * (az[i] - pz) - r;
-      const float db = nx * (bx[i] - px) + ny * (by[i] - py) + nz * (bz[i] - pz) - r;
-      const int below = static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f);
-      f[i] = static_cast<std::uint8_t>(f[i] | below);
-    }
+    screenRows(a, b, n, flags, [=](float ax, float ay, float az, float bx, float by, float bz) {
+      const float da = nx * (ax - px) + ny * (ay - py) + nz * (az - pz) - r;
+      const float db = nx * (bx - px) + ny * (by - py) + nz * (bz - pz) - r;
+      return static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f);
+    });
   }
   bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {
     const float pa = phi(a), pb = phi(b);
