@@ -59,7 +59,7 @@ DriveTrace traceDrive(const io::EffectSettings& effect, const DriveCase& drive,
         !std::binary_search(onlyTicks.begin(), onlyTicks.end(), s.tickCount()))
       return;
     trace.ticks.push_back(s.tickCount());
-    trace.hashes.push_back(stateHash(s.pool()));
+    trace.hashes.push_back(stateHash(s));
   });
   const auto start = std::chrono::steady_clock::now();
   for (Flicks frame : drive.frames) trace.ticksDropped += system->advance(frame).ticksDropped;

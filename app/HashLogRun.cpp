@@ -117,7 +117,7 @@ io::HashLog recordHashLog(const io::EffectSettings& effect, io::HashLogHeader he
   header.columns = stateColumnNames(system->pool());
   system->setTickObserver([&](const ParticleSystem& s) {
     const ParticlePool& pool = s.pool();
-    log.ticks.push_back({s.tickCount(), stateHash(pool), stateColumnHashes(pool)});
+    log.ticks.push_back({s.tickCount(), stateHash(s), stateColumnHashes(pool)});
     if (std::binary_search(snapshotTicks.begin(), snapshotTicks.end(), s.tickCount())) {
       io::HashLogSnapshot snapshot{s.tickCount(), {}};
       for (std::size_t row = 0; row < pool.size(); ++row)
@@ -154,7 +154,7 @@ LogComparison compareWithHashLog(const io::EffectSettings& effect, std::uint64_t
     const std::int64_t tick = s.tickCount();
     if (c.partTick >= 0) return;
     const ParticlePool& pool = s.pool();
-    const std::uint64_t hash = stateHash(pool);
+    const std::uint64_t hash = stateHash(s);
     if (tick > static_cast<std::int64_t>(log.ticks.size())) {
       // Cannot happen for a log this function accepts (same rate, same length), but a log that
       // ends early must not pass as identical.
@@ -187,7 +187,7 @@ LogComparison compareWithHashLog(const io::EffectSettings& effect, std::uint64_t
     return c.partTick < 0;
   });
   c.ticks = system->tickCount();
-  c.lastHash = stateHash(system->pool());
+  c.lastHash = stateHash(*system);
   if (c.partTick < 0 && c.ticks < h.ticks) c.partTick = c.ticks + 1;  // the log goes on
   return c;
 }

@@ -161,7 +161,7 @@ std::unique_ptr<PreparedRun> prepareRun(const RunSettings& s, const io::EffectSe
   if (s.trace) {
     PreparedRun* const r = run.get();
     r->system->setTickObserver([r](const ParticleSystem& system) {
-      r->tickHashes.emplace_back(system.tickCount(), stateHash(system.pool()));
+      r->tickHashes.emplace_back(system.tickCount(), stateHash(system));
     });
   }
   const io::CacheTargets* const targets = &s.caches;
@@ -424,7 +424,7 @@ int runCommand(Arguments& args) {
   writeEndFiles(*settings, *run, frames.lastFrame());
   if (!settings->quiet) printRunSummary(*settings, *run, frames);
   if (settings->printHash) {
-    std::printf("state-hash: %s\n", hashToHex(stateHash(run->system->pool())).c_str());
+    std::printf("state-hash: %s\n", hashToHex(stateHash(*run->system)).c_str());
     std::printf("ticks: %lld\n", static_cast<long long>(run->system->tickCount()));
   }
   return kExitOk;

@@ -8,8 +8,12 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   particles/Clock.h
   particles/EmissionRate.h
   particles/Emitter.h
+  particles/EventEmission.h
   particles/FixedStepDriver.h
+  particles/LifeAttribute.h
+  particles/LifeAttributeSet.h
   particles/NonfiniteState.h
+  particles/ParticleEvent.h
   particles/ParticlePool.h
   particles/ParticleSystem.h
   particles/Random.h

@@ -72,6 +72,12 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
   t.blocks = (pool.size() + kParallelBlockRows - 1) / kParallelBlockRows;
   blockPaths_.resize(std::max(blockPaths_.size(), t.blocks));
   for (std::size_t k = 0; k < t.blocks; ++k) blockPaths_[k].clear();
+  t.counts = nullptr;
+  if (!countColumn_.empty()) {
+    t.counts = pool.attribute(pool.findAttribute(countColumn_)).data();
+    blockContacts_.resize(std::max(blockContacts_.size(), t.blocks));
+    for (std::size_t k = 0; k < t.blocks; ++k) blockContacts_[k].clear();
+  }
   // The hit columns, where the pool has them.
   t.hits.fill(nullptr);
   if (pool.findAttribute(kHitColumns[0]) != ParticlePool::npos) {
@@ -123,6 +129,8 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
     int recorded = 0;
     Contact lastHit;
     Eigen::Vector3f hitVelocity = Eigen::Vector3f::Zero();
+    std::vector<ContactRecord>* records =
+        t.counts != nullptr ? &blockContacts_[begin / kParallelBlockRows] : nullptr;
     while (path.contacts < kMaxContactsPerTick) {
       Contact best, contact;
       const Collider* hit = nullptr;
@@ -138,6 +146,12 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
       path.fraction[path.contacts] = best.fraction;
       path.point[path.contacts] = best.point;
       ++path.contacts;
+      if (records != nullptr) {
+        records->push_back(ContactRecord{
+            static_cast<std::uint32_t>(i),
+            static_cast<std::uint32_t>(t.counts[i]) + static_cast<std::uint32_t>(path.contacts - 1),
+            best.point, best.normal, v});
+      }
       if (t.hits[0] != nullptr && hit->settings().recordHits) {
         ++recorded;
         lastHit = best;
@@ -157,6 +171,7 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
                                               : hit->carried(best);
     }
     if (path.contacts == 0) continue;
+    if (t.counts != nullptr) t.counts[i] += static_cast<float>(path.contacts);
     for (int c = 0; c < 3; ++c) {
       pos[c][row] = b[c];
       vel[c][row] = v[c];

@@ -5,9 +5,12 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include <span>
 #include "fields/Collider.h"
+#include "particles/ParticleEvent.h"
 #include "particles/ParticlePool.h"
 
 namespace tickfx {
@@ -80,6 +83,17 @@ class ColliderSet {
   void collideRows(ParticlePool& pool, std::size_t begin, std::size_t end);
   void endTick();
 
+  /// From the next tick on, records every contact (ContactRecord) for collision events, and counts
+  /// each particle's contacts in the pool column `countColumn` (a float attribute the caller
+  /// added; a contact's ordinal is the count before it).
+  void recordContacts(const std::string& countColumn) { countColumn_ = countColumn; }
+  /// The last collide()'s contacts when recorded: one list a block of kParallelBlockRows rows,
+  /// each in row order and, within a row, in the order they happened. Empty otherwise.
+  std::span<const std::vector<ContactRecord>> contactBlocks() const {
+    if (countColumn_.empty()) return {};
+    return {blockContacts_.data(), tick_.blocks};
+  }
+
   /// The paths of the rows that touched a collider in the last collide(), in row order.
   const std::vector<CollisionPath>& paths() const { return paths_; }
   /// Contacts made in the last collide().
@@ -93,12 +107,15 @@ class ColliderSet {
     bool history = false;
     std::size_t blocks = 0;
     std::array<float*, kHitColumns.size()> hits{};  // the pool's hit columns, or null
+    float* counts = nullptr;                        // the contact count column, or null
   };
 
   std::vector<std::unique_ptr<Collider>> colliders_;
   TickState tick_;
   std::vector<CollisionPath> paths_;
   std::vector<std::vector<CollisionPath>> blockPaths_;
+  std::string countColumn_;  // empty: contacts not recorded
+  std::vector<std::vector<ContactRecord>> blockContacts_;
   std::uint64_t contacts_ = 0;
 };
 

@@ -23,6 +23,48 @@ void basis(const Eigen::Vector3d& n, Eigen::Vector3d& b1, Eigen::Vector3d& b2) {
   b2 = Eigen::Vector3d(b, sign + n.y() * n.y() * a, -n.y());
 }
 
+void validateSub(const EmitterSettings& e, SettingProblems& out) {
+  const SubEmitterSettings& sub = e.sub;
+  if (sub.parent.empty()) {
+    if (sub.on != EmitterEvent::None) {
+      out.push_back({"on", "is set without a parent", "a parent emitter with on"});
+    }
+    return;
+  }
+  if (sub.on == EmitterEvent::None) {
+    out.push_back({"on", "is missing", "\"birth\", \"death\" or \"collision\""});
+  }
+  if (e.rate != 0.0 || !e.bursts.empty()) {
+    out.push_back({e.rate != 0.0 ? "rate" : "bursts", "is set on a sub-emitter",
+                   "no rate and no bursts: a sub-emitter emits at its parent's events"});
+  }
+  if (std::holds_alternative<PointListShape>(e.shape)) {
+    out.push_back({"file", "is set on a sub-emitter", "a shape around the event's position"});
+  }
+  if (sub.countMin > sub.countMax || sub.countMax > 1'000'000) {
+    out.push_back({"count_range",
+                   "[" + std::to_string(sub.countMin) + ", " + std::to_string(sub.countMax) +
+                       "] is out of range",
+                   "[a, b] with 0 <= a <= b <= 1000000"});
+  }
+  if (!(sub.inheritVelocity >= 0.0 && sub.inheritVelocity <= 1.0)) {
+    out.push_back({"inherit_velocity", settingNumber(sub.inheritVelocity) + " is out of range",
+                   "a fraction from 0 to 1"});
+  }
+  if (sub.alongNormal && sub.on != EmitterEvent::Collision) {
+    out.push_back({"direction", "\"normal\" needs on = \"collision\"",
+                   "a direction [x, y, z], or \"normal\" on a collision"});
+  }
+  for (std::size_t i = 0; i < sub.inherit.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (sub.inherit[i] == sub.inherit[j]) {
+        out.push_back({"inherit." + std::to_string(i), "names " + sub.inherit[i] + " twice",
+                       "each attribute once"});
+      }
+    }
+  }
+}
+
 }  // namespace
 
 SettingProblems EmitterSettings::validate() const {
@@ -81,6 +123,24 @@ SettingProblems EmitterSettings::validate() const {
       if (!v.allFinite()) {
         bad("has a velocity that is not finite", "velocities of finite coordinates");
         break;
+      }
+    }
+  }
+  validateSub(*this, out);
+  for (std::size_t i = 0; i < attributes.size(); ++i) {
+    for (SettingProblem p : attributes[i].validate()) {
+      p.key = "attributes." + attributes[i].name + (p.key == "value" ? "" : "." + p.key);
+      out.push_back(std::move(p));
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (attributes[j].name == attributes[i].name) {
+        out.push_back({"attributes." + attributes[i].name, "is declared twice", "each once"});
+      }
+    }
+    for (const std::string& inherited : sub.inherit) {
+      if (inherited == attributes[i].name) {
+        out.push_back({"attributes." + inherited, "is also inherited from the parent",
+                       "an attribute declared or inherited, not both"});
       }
     }
   }
@@ -144,14 +204,15 @@ std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t
   return last - first;
 }
 
-ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
-  const ParticleRandom random(seed, index_, serial);
+ParticleInit Emitter::draw(const ParticleRandom& random, const Eigen::Vector3d& direction,
+                           const Eigen::Vector3d& b1, const Eigen::Vector3d& b2,
+                           Eigen::Vector3d& offset) const {
   const auto uniform = [&](RandomPurpose purpose) {
     return random.uniform(static_cast<std::uint32_t>(purpose));
   };
   constexpr double kTwoPi = 2.0 * det::kPi;
 
-  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  offset = Eigen::Vector3d::Zero();
   if (const auto* sphere = std::get_if<SphereShape>(&s_.shape)) {
     const double z = 1.0 - 2.0 * uniform(RandomPurpose::PositionU);
     const double rxy = std::sqrt(std::max(0.0, 1.0 - z * z));
@@ -173,14 +234,14 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
     offset = (r * cosPhi) * discB1_ + (r * sinPhi) * discB2_;
   }
 
-  Eigen::Vector3d dir = s_.direction;
+  Eigen::Vector3d dir = direction;
   if (s_.spreadDegrees > 0.0) {
     // Uniform over the spherical cap of half-angle `spread` around the direction.
     const double cosT = 1.0 - uniform(RandomPurpose::DirectionU) * (1.0 - cosSpread_);
     const double sinT = std::sqrt(std::max(0.0, 1.0 - cosT * cosT));
     double sinPhi = 0.0, cosPhi = 0.0;
     det::sincos(kTwoPi * uniform(RandomPurpose::DirectionV), sinPhi, cosPhi);
-    dir = (sinT * cosPhi) * directionB1_ + (sinT * sinPhi) * directionB2_ + cosT * s_.direction;
+    dir = (sinT * cosPhi) * b1 + (sinT * sinPhi) * b2 + cosT * direction;
   }
   const double speed =
       s_.speed * (1.0 + s_.speedJitter * (2.0 * uniform(RandomPurpose::Speed) - 1.0));
@@ -188,8 +249,17 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
       s_.lifetime * (1.0 + s_.lifetimeJitter * (2.0 * uniform(RandomPurpose::Lifetime) - 1.0));
 
   ParticleInit init;
-  init.position = (s_.position + offset).cast<float>();
   init.velocity = (speed * dir).cast<float>();
+  init.lifetime = static_cast<float>(life);
+  init.mass = static_cast<float>(s_.mass);
+  return init;
+}
+
+ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
+  Eigen::Vector3d offset;
+  ParticleInit init =
+      draw(ParticleRandom(seed, index_, serial), s_.direction, directionB1_, directionB2_, offset);
+  init.position = (s_.position + offset).cast<float>();
   if (const auto* list = std::get_if<PointListShape>(&s_.shape)) {
     const std::size_t point = serial % list->positions.size();
     const Eigen::Vector3f& p = list->positions[point];
@@ -200,8 +270,61 @@ ParticleInit Emitter::sample(std::uint64_t seed, std::uint64_t serial) const {
     init.position = s_.position.isZero(0.0) ? p : Eigen::Vector3f(s_.position.cast<float>() + p);
     if (!list->velocities.empty()) init.velocity = list->velocities[point];
   }
-  init.lifetime = static_cast<float>(life);
-  init.mass = static_cast<float>(s_.mass);
+  return init;
+}
+
+namespace {
+
+// The counter of an event and of one of its children, standing for the serial of an emitted
+// particle in the random key: bijective mixes, so distinct (parent, ordinal, child) give distinct
+// keys but for 64-bit collisions.
+std::uint64_t eventKey(const ParticleEvent& event) {
+  return mix64(mix64(event.parentId + 0x632be59bd9b4e019ULL) ^
+               (static_cast<std::uint64_t>(event.ordinal) * 0x9e3779b97f4a7c15ULL +
+                static_cast<std::uint64_t>(event.kind)));
+}
+
+std::uint64_t childKey(const ParticleEvent& event, std::uint64_t child) {
+  return mix64(eventKey(event) ^ ((child + 1) * 0xd1b54a32d192ed03ULL));
+}
+
+}  // namespace
+
+std::uint64_t Emitter::childCount(std::uint64_t seed, const ParticleEvent& event) const {
+  const SubEmitterSettings& sub = s_.sub;
+  if (sub.firstOnly && event.ordinal > 0) return 0;
+  if (sub.countMax <= sub.countMin) return sub.countMin;
+  const ParticleRandom random(seed, index_, eventKey(event));
+  const std::uint64_t span = sub.countMax - sub.countMin + 1;
+  // Lemire's multiply-shift: uniform up to a bias of span / 2^64, exact in integers.
+  const auto wide = static_cast<unsigned __int128>(
+                        random.bits(static_cast<std::uint32_t>(RandomPurpose::ChildCount))) *
+                    span;
+  return sub.countMin + static_cast<std::uint64_t>(wide >> 64);
+}
+
+ParticleInit Emitter::sampleChild(std::uint64_t seed, const ParticleEvent& event,
+                                  std::uint64_t child) const {
+  const ParticleRandom random(seed, index_, childKey(event, child));
+  Eigen::Vector3d offset;
+  ParticleInit init;
+  if (s_.sub.alongNormal) {
+    Eigen::Vector3d n = event.normal.cast<double>();
+    if (!normalisable(n)) n = s_.direction;  // no contact normal: the emitter's direction
+    n.normalize();
+    Eigen::Vector3d b1, b2;
+    basis(n, b1, b2);
+    init = draw(random, n, b1, b2, offset);
+  } else {
+    init = draw(random, s_.direction, directionB1_, directionB2_, offset);
+  }
+  // In float from the event on (it is float): the offset and the emitted velocity are rounded to
+  // float once, then added, so no float value goes through double and back.
+  const Eigen::Vector3f shift = (s_.position + offset).cast<float>();
+  init.position = shift.isZero(0.0f) ? event.position : Eigen::Vector3f(event.position + shift);
+  if (s_.sub.inheritVelocity != 0.0) {
+    init.velocity += static_cast<float>(s_.sub.inheritVelocity) * event.velocity;
+  }
   return init;
 }
 

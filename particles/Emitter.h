@@ -9,7 +9,10 @@
 #include <vector>
 
 #include "particles/EmissionRate.h"
+#include "particles/LifeAttribute.h"
+#include "particles/ParticleEvent.h"
 #include "particles/ParticlePool.h"
+#include "particles/Random.h"
 #include "particles/SettingProblem.h"
 
 namespace tickfx {
@@ -48,6 +51,27 @@ struct Burst {
   std::uint64_t count = 0;
 };
 
+/// The most sub-emitters in a chain of parents (a child's parent's parent ...): 8.
+inline constexpr int kMaxSubEmitterDepth = 8;
+
+/// What makes an emitter a sub-emitter: it emits from another emitter's particles at their
+/// events instead of at times (it has no rate and no bursts). Its children start at the event's
+/// position plus the emitter's position and shape offset, with the emitter's speed, spread,
+/// lifetime and mass, their random numbers a pure function of (seed, this emitter, parent id,
+/// event ordinal, child index).
+struct SubEmitterSettings {
+  std::string parent;  // the parent emitter's name; empty: not a sub-emitter
+  EmitterEvent on = EmitterEvent::None;
+  /// Children per event: countMin when equal to countMax, else drawn per event in [min, max].
+  std::uint64_t countMin = 1, countMax = 1;
+  double inheritVelocity = 0.0;  // fraction (0 to 1) of the parent's velocity at the event
+  bool alongNormal = false;      // direction: the contact's normal (on = collision only)
+  /// Attributes the children copy from the parent at the event ("Cd", "pscale", a custom or hit
+  /// attribute): its value then, kept in a pool column for the children's life.
+  std::vector<std::string> inherit;
+  bool firstOnly = false;  // only the parent's first event of the kind
+};
+
 /// An emitter's settings. Scalars are double so that the per-particle arithmetic, done in double
 /// and rounded to float once, never round-trips a float through double.
 struct EmitterSettings {
@@ -66,6 +90,9 @@ struct EmitterSettings {
   double lifetime = std::numeric_limits<double>::infinity();  // seconds
   double lifetimeJitter = 0.0;                                // fraction: lifetime · (1 ± jitter)
   double mass = 1.0;                                          // kilograms
+  SubEmitterSettings sub;                                     // parent and event, for a sub-emitter
+  /// Attributes over life of this emitter's particles (each name once; not one it inherits).
+  std::vector<LifeAttributeSettings> attributes;
 
   /// What an Emitter refuses in these settings (empty: it accepts them), each problem keyed as
   /// effect files write it: "rate", "stop", "direction", "normal", "bursts.<i>.time", and "file"
@@ -95,10 +122,24 @@ class Emitter {
   /// The particle with serial `serial` as it is born (pure function of seed, index and serial).
   ParticleInit sample(std::uint64_t seed, std::uint64_t serial) const;
 
+  /// A sub-emitter's children for `event`: how many (count, or drawn per event from count_range;
+  /// 0 past the first event when first_only), and child `child` as it is born. Pure functions of
+  /// (seed, this emitter, parent id, event ordinal, child index).
+  std::uint64_t childCount(std::uint64_t seed, const ParticleEvent& event) const;
+  ParticleInit sampleChild(std::uint64_t seed, const ParticleEvent& event,
+                           std::uint64_t child) const;
+  bool isSubEmitter() const { return !s_.sub.parent.empty(); }
+  std::uint32_t index() const { return index_; }
+
   const EmitterSettings& settings() const { return s_; }
 
  private:
   std::uint64_t rateCountBefore(std::int64_t tick) const;
+  // A particle of `random` at `origin` plus the shape's offset, going along `dir` (unit) within the
+  // spread around it (b1, b2 completing it to a basis).
+  ParticleInit draw(const ParticleRandom& random, const Eigen::Vector3d& dir,
+                    const Eigen::Vector3d& b1, const Eigen::Vector3d& b2,
+                    Eigen::Vector3d& offset) const;
 
   EmitterSettings s_;
   std::uint32_t index_;

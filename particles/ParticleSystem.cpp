@@ -60,6 +60,12 @@ std::vector<Emitter> makeEmitters(const std::vector<EmitterSettings>& settings, 
 ParticleSystem::ParticleSystem(const SystemSettings& settings,
                                const std::vector<EmitterSettings>& emitters, ForceSet forces,
                                const std::vector<StructureSettings>& structures)
+    : ParticleSystem(settings, emitters, std::move(forces), structures, ColliderSet{}) {}
+
+ParticleSystem::ParticleSystem(const SystemSettings& settings,
+                               const std::vector<EmitterSettings>& emitters, ForceSet forces,
+                               const std::vector<StructureSettings>& structures,
+                               ColliderSet colliders)
     : settings_(settings),
       pool_(settings.maxParticles),
       emitters_(makeEmitters(emitters, settings.stepRateHz)),
@@ -84,16 +90,20 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     const std::int64_t tick = exact::tickAtOrAfter(structures[i].time, settings.stepRateHz);
     structures_.push_back(PendingStructure{std::move(build), tick});
   }
-}
-
-ParticleSystem::ParticleSystem(const SystemSettings& settings,
-                               const std::vector<EmitterSettings>& emitters, ForceSet forces,
-                               const std::vector<StructureSettings>& structures,
-                               ColliderSet colliders)
-    : ParticleSystem(settings, emitters, std::move(forces), structures) {
-  if (colliders.empty()) return;
-  colliders.addHitColumns(pool_);
-  colliders_ = std::make_unique<ColliderSet>(std::move(colliders));
+  if (!colliders.empty()) {
+    colliders.addHitColumns(pool_);
+    colliders_ = std::make_unique<ColliderSet>(std::move(colliders));
+  }
+  lifeAttributes_ = LifeAttributeSet(emitters, settings.seed, !structures.empty());
+  if (lifeAttributes_.needsEmitterColumn()) pool_.addAttribute(kEmitterColumn, -1.0f);
+  bool subEmitters = false;
+  for (const Emitter& e : emitters_) subEmitters |= e.isSubEmitter();
+  if (subEmitters) {
+    events_ = std::make_unique<EventEmission>(emitters_, &lifeAttributes_, settings.seed, pool_);
+    if (colliders_ && events_->listensTo(EmitterEvent::Collision)) {
+      colliders_->recordContacts(kContactsColumn);
+    }
+  }
 }
 
 ParticleSystem::~ParticleSystem() = default;
@@ -194,7 +204,7 @@ struct ParticleSystem::FrameStart {
 
 bool ParticleSystem::fusesTicks(std::int64_t ticks) const {
   if (ticks < 2 || tickObserver_ || settings_.nonfinite == NonfinitePolicy::Kill ||
-      !forces_->interleavesTicks() || colliders_) {
+      !forces_->interleavesTicks() || colliders_ || events_) {
     return false;
   }
   for (const PendingStructure& p : structures_) {
@@ -216,7 +226,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
   // Rows born at tick first + j end at bornBy[j]; rows before bornBy[0] step from the first tick.
   std::vector<std::size_t> bornBy(static_cast<std::size_t>(ticks));
   for (std::int64_t j = 0; j < ticks; ++j) {
-    for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, first + j);
+    emitTick(first + j);
     bornBy[static_cast<std::size_t>(j)] = pool_.size();
   }
   const std::size_t rows = pool_.size();
@@ -277,8 +287,24 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
   return true;
 }
 
+void ParticleSystem::emitTick(std::int64_t tick) {
+  const std::size_t firstNew = pool_.size();
+  const std::size_t tag = pool_.findAttribute(kEmitterColumn);
+  for (const Emitter& e : emitters_) {
+    const std::size_t before = pool_.size();
+    e.emit(pool_, settings_.seed, tick);
+    if (tag != ParticlePool::npos && pool_.size() > before) {
+      pool_.attribute(tag)
+          .segment(static_cast<Eigen::Index>(before),
+                   static_cast<Eigen::Index>(pool_.size() - before))
+          .setConstant(static_cast<float>(e.index()));
+    }
+  }
+  if (events_) events_->spawn(pool_, tick, firstNew);
+}
+
 void ParticleSystem::runTick(bool keepVelocities) {
-  for (const Emitter& e : emitters_) e.emit(pool_, settings_.seed, tick_);
+  emitTick(tick_);
   for (PendingStructure& p : structures_) {
     if (p.tick == tick_) spawnStructure(p.build);
     if (p.tick <= tick_) p.build = {};  // born (or before a restored tick): not needed again
@@ -331,6 +357,10 @@ void ParticleSystem::endTicks(std::int64_t tick, bool keepVelocities) {
   nonfiniteCheck_.setSteppedRowsFinite(settings_.nonfinite != NonfinitePolicy::Keep &&
                                        !nonfiniteStop_);
   pool_.updateAges(tick_, settings_.stepRateHz);
+  if (events_) {
+    events_->gather(pool_, colliders_ ? colliders_->contactBlocks()
+                                      : std::span<const std::vector<ContactRecord>>{});
+  }
   if (keepVelocities) {
     pool_.applyRemovalTo(previousVelocity_);
     velocitiesTick_ = tick_;
@@ -528,6 +558,18 @@ std::optional<CopyResult> ParticleSystem::copyColumn(std::string_view name,
     column = &pool_.lifetime();
   } else if (name == "mass") {
     column = &pool_.mass();
+  } else if (const int life = lifeAttributes_.find(std::string(name)); life >= 0) {
+    const std::size_t n = pool_.size();
+    if (out.capacity < n) return CopyResult{n, false};
+    // On a tick the ages are the pool's own; between ticks they are worked out once here.
+    const float* ages = pool_.age().data();
+    FloatColumn shown;
+    if (frameOffset_ != kFlicksPerSecond) {
+      renderAges(shown);
+      ages = shown.data();
+    }
+    runParallel([&] { lifeAttributes_.evaluate(life, pool_, ages, out); });
+    return CopyResult{n, true};
   } else {
     const std::size_t a = pool_.findAttribute(std::string(name));
     if (a == ParticlePool::npos) return std::nullopt;
@@ -538,6 +580,15 @@ std::optional<CopyResult> ParticleSystem::copyColumn(std::string_view name,
   const float* values = column->data();
   for (std::size_t i = 0; i < n; ++i) rowOf(out.data, out.rowStride, i) = values[i];
   return CopyResult{n, true};
+}
+
+std::vector<std::string> ParticleSystem::attributeNames() const {
+  std::vector<std::string> names;
+  for (std::size_t a = 0; a < pool_.attributeCount(); ++a) names.push_back(pool_.attributeName(a));
+  for (const std::string& c : lifeAttributes_.columns()) {
+    if (pool_.findAttribute(c) == ParticlePool::npos) names.push_back(c);
+  }
+  return names;
 }
 
 }  // namespace tickfx

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "particles/Emitter.h"
+#include "particles/EventEmission.h"
 #include "particles/FixedStepDriver.h"
+#include "particles/LifeAttributeSet.h"
 #include "particles/NonfiniteState.h"
 #include "particles/ParticlePool.h"
 #include "particles/RenderDestination.h"
@@ -80,6 +82,10 @@ class ParticleSystem {
   /// never pass through them (see ColliderSet::collide). A system with colliders runs its frames
   /// tick by tick (no fused frames). When a collider records hits, the pool gets the hit
   /// columns (kHitColumns).
+  ///
+  /// Emitters with a parent are sub-emitters (EventEmission): a system with any runs its frames
+  /// tick by tick. Emitters' attributes over life (LifeAttributeSet) add no column to the pool
+  /// but kEmitterColumn where rows must be told apart.
   ParticleSystem(const SystemSettings& settings, const std::vector<EmitterSettings>& emitters,
                  ForceSet forces, const std::vector<StructureSettings>& structures,
                  ColliderSet colliders);
@@ -148,9 +154,18 @@ class ParticleSystem {
   CopyResult copyRenderAges(const FloatDestination& out) const;
   /// Particle ids (unique per system, in increasing order of birth).
   CopyResult copyIds(const IdDestination& out) const;
-  /// A float column of the current tick by name: "lifetime" (seconds), "mass" (kg), or an
-  /// attribute of the pool (see ParticlePool::addAttribute). Empty for any other name.
+  /// A float column by name: "lifetime" (seconds), "mass" (kg), an attribute of the pool (see
+  /// ParticlePool::addAttribute) as of the current tick, or an attribute over life
+  /// (lifeAttributes()) at the shown time. Empty for any other name.
   std::optional<CopyResult> copyColumn(std::string_view name, const FloatDestination& out) const;
+  /// The attribute columns a frame shows, in order: the pool's attributes, then the attributes
+  /// over life that no pool column holds (copyColumn() gives each).
+  std::vector<std::string> attributeNames() const;
+  /// The emitters' attributes over life, evaluated when a frame is shown, never in a tick.
+  const LifeAttributeSet& lifeAttributes() const { return lifeAttributes_; }
+  /// The sub-emitters (nullptr when the effect has none).
+  const EventEmission* events() const { return events_.get(); }
+  EventEmission* events() { return events_.get(); }
 
   /// Runs this system's parallel loops on a host's job system from the next tick on, or on the
   /// system's own TBB arena for nullptr (the default). Not owned: the executor must outlive the
@@ -204,6 +219,8 @@ class ParticleSystem {
   void endTicks(std::int64_t tick, bool keepVelocities);
   void takeNonfinite();
   void spawnStructure(const StructureBuild& build);
+  // The births of tick `tick`: every emitter's, then the sub-emitters' children.
+  void emitTick(std::int64_t tick);
 
   SystemSettings settings_;
   ParticlePool pool_;
@@ -211,7 +228,9 @@ class ParticleSystem {
   std::unique_ptr<ForceSet> forces_;  // never null
   std::unique_ptr<Integrator> integrator_;
   std::unique_ptr<ColliderSet> colliders_;  // null when none
-  std::int64_t pathsTick_ = -1;             // the tick after which colliders_->paths() were found
+  LifeAttributeSet lifeAttributes_;
+  std::unique_ptr<EventEmission> events_;  // null when no emitter has a parent
+  std::int64_t pathsTick_ = -1;            // the tick after which colliders_->paths() were found
   // Moves the rows of render positions `out` (rows [0, n)) that touched a collider in the newest
   // tick onto their paths at `alpha`.
   void followPaths(float alpha, const Vec3Destination& out) const;

@@ -16,7 +16,9 @@ enum class RandomPurpose : std::uint32_t {
   Speed = 6,
   Lifetime = 7,
   Mass = 8,
-  Custom = 64,  // Custom + k for user-defined draws
+  ChildCount = 9,   // a sub-emitter's children per event, drawn from count_range
+  Custom = 64,      // Custom + k for user-defined draws
+  Attribute = 128,  // Attribute + k for an emitter's k-th attribute over life
 };
 
 /// The coordinates of one random number. Nothing here depends on the frame, the thread or the

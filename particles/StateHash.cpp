@@ -4,6 +4,8 @@
 #include <cstring>
 #include <utility>
 
+#include "particles/ParticleSystem.h"
+
 namespace tickfx {
 namespace {
 
@@ -59,10 +61,43 @@ std::vector<std::pair<std::string, const FloatColumn*>> floatColumns(const Parti
   return columns;
 }
 
+void addPool(Hasher& h, const ParticlePool& pool);
+
 }  // namespace
 
 std::uint64_t stateHash(const ParticlePool& pool) {
   Hasher h;
+  addPool(h, pool);
+  return h.value();
+}
+
+std::uint64_t stateHash(const ParticleSystem& system) {
+  Hasher h;
+  addPool(h, system.pool());
+  const EventEmission* events = system.events();
+  if (events == nullptr || events->pending().empty()) return h.value();
+  const auto floatBits = [](float f) {
+    std::uint32_t b = 0;
+    std::memcpy(&b, &f, sizeof b);
+    return static_cast<std::uint64_t>(b);
+  };
+  h.add(events->pending().size());
+  for (const ParticleEvent& e : events->pending()) {
+    h.add(e.parentId);
+    h.add(e.parentEmitter);
+    h.add(static_cast<std::uint64_t>(e.kind));
+    h.add(e.ordinal);
+    for (const Eigen::Vector3f* v : {&e.position, &e.velocity, &e.normal}) {
+      for (int c = 0; c < 3; ++c) h.add(floatBits((*v)[c]));
+    }
+  }
+  for (const float f : events->pendingValues()) h.add(floatBits(f));
+  return h.value();
+}
+
+namespace {
+
+void addPool(Hasher& h, const ParticlePool& pool) {
   const std::size_t n = pool.size();
   h.add(n);
   h.add(pool.nextId());
@@ -70,8 +105,9 @@ std::uint64_t stateHash(const ParticlePool& pool) {
   for (std::size_t i = 0; i < n; ++i) h.add(pool.id()[i]);
   for (std::size_t i = 0; i < n; ++i) h.add(static_cast<std::uint64_t>(pool.birthTick()[i]));
   for (const auto& column : floatColumns(pool)) h.addFloats(column.second, n);
-  return h.value();
 }
+
+}  // namespace
 
 std::vector<std::string> stateColumnNames(const ParticlePool& pool) {
   std::vector<std::string> names = {"counters", "id", "birth_tick"};

@@ -14,6 +14,13 @@ namespace tickfx {
 /// only if (barring collisions) every float is bitwise equal; −0 and +0 differ, as they should.
 std::uint64_t stateHash(const ParticlePool& pool);
 
+class ParticleSystem;
+/// The state hash of a whole system: stateHash(system.pool()) when no sub-emitter event waits
+/// for the next tick, else that hash continued over the pending events (EventEmission::pending():
+/// each event's parent id, emitter, kind, ordinal, position, velocity, normal and inherited
+/// values), which are state too: the next tick's children come from them.
+std::uint64_t stateHash(const ParticleSystem& system);
+
 /// The columns stateHash() covers, in its order, so a difference can be named: "counters" (row
 /// count, next id, dropped spawns), "id", "birth_tick", "position.x" ... "acceleration.z", "age",
 /// "lifetime", "mass", "inverse_mass", then "attribute.NAME" for each custom attribute.

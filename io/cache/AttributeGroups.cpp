@@ -7,7 +7,9 @@ std::array<std::string, 3> vectorColumns(const std::string& name) {
   return {name + "_x", name + "_y", name + "_z"};
 }
 
-bool isIntAttribute(const std::string& name) { return name == "hitnum"; }
+bool isIntAttribute(const std::string& name) {
+  return name == "hitnum" || name == "contacts" || name == "emitter";
+}
 
 namespace {
 

@@ -23,7 +23,8 @@ struct AttributeGroup {
 std::array<std::string, 3> vectorColumns(const std::string& name);
 
 /// Whether Houdini's attribute `name` is an integer (`hitnum`): its column holds whole numbers,
-/// written as 32-bit integers where the format has them.
+/// written as 32-bit integers where the format has them. So are `contacts` (every
+/// contact, for collision sub-emitters) and `emitter` (the index of the emitter that made the row).
 bool isIntAttribute(const std::string& name);
 
 /// `columns` (a frame's attribute names, in order) as attributes: three consecutive columns

@@ -29,9 +29,19 @@ FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double 
   system.renderAges(data.age);
   data.life = pool.lifetime().head(n);
   data.mass = pool.mass().head(n);
-  for (std::size_t a = 0; a < pool.attributeCount(); ++a) {
-    data.attributeNames.push_back(pool.attributeName(a));
-    data.attributes.emplace_back(pool.attribute(a).head(n));
+  // Attributes over life are evaluated here, at the frame's ages: nothing of them is stored.
+  const LifeAttributeSet& life = system.lifeAttributes();
+  for (std::string& name : system.attributeNames()) {
+    const int declared = life.find(name);
+    if (declared >= 0) {
+      FloatColumn values(n);
+      life.evaluate(declared, pool, data.age.data(),
+                    FloatDestination{values.data(), sizeof(float), pool.size()});
+      data.attributes.push_back(std::move(values));
+    } else {
+      data.attributes.emplace_back(pool.attribute(pool.findAttribute(name)).head(n));
+    }
+    data.attributeNames.push_back(std::move(name));
   }
   return data;
 }

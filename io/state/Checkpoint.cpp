@@ -21,6 +21,8 @@ namespace tickfx::io {
 namespace {
 
 constexpr std::string_view kCheckpointMagic = "TICKFXCK";
+// Header flag: the pending events of sub-emitters follow the springs.
+constexpr std::uint32_t kPendingEventsFlag = 1;
 constexpr std::size_t kHeaderBytes = 32;  // magic, version, flags, length, effect hash
 constexpr std::size_t kTrailerBytes = 8;  // checksum
 constexpr std::size_t kMinimumBytes = kHeaderBytes + kTrailerBytes;
@@ -172,9 +174,49 @@ struct Parsed {
   std::vector<std::pair<std::string_view, const char*>> attributes;
   std::vector<Spring> springs;
   std::uint64_t springsBroken = 0;
+  std::uint32_t inheritedColumns = 0;
+  std::vector<ParticleEvent> events;
+  std::vector<float> eventValues;
 };
 
-Parsed parsePayload(std::string_view payload) {
+// A pending event on file: u64 parent id, u32 emitter, u32 kind, u32 ordinal, f32 × 9.
+constexpr std::size_t kEventBytes = 8 + 3 * 4 + 9 * 4;
+
+void readPendingEvents(CheckpointReader& r, Parsed& p) {
+  const std::uint64_t count = r.u64("the pending event count");
+  p.inheritedColumns = r.u32("the inherited column count");
+  if (count == 0 || count > r.remaining() / kEventBytes) {
+    throw Malformed{count == 0 ? "a pending events section with no events"
+                               : "it ends inside the pending events"};
+  }
+  p.events.resize(static_cast<std::size_t>(count));
+  const auto f32 = [&](const char* what) {
+    const std::uint32_t bits = r.u32(what);
+    float f = 0.0f;
+    std::memcpy(&f, &bits, 4);
+    return f;
+  };
+  for (ParticleEvent& e : p.events) {
+    e.parentId = r.u64("a pending event");
+    e.parentEmitter = r.u32("a pending event");
+    const std::uint32_t kind = r.u32("a pending event");
+    if (kind < 1 || kind > 3)
+      throw Malformed{"a pending event of unknown kind " + std::to_string(kind)};
+    e.kind = static_cast<EmitterEvent>(kind);
+    e.ordinal = r.u32("a pending event");
+    for (Eigen::Vector3f* v : {&e.position, &e.velocity, &e.normal}) {
+      for (int c = 0; c < 3; ++c) (*v)[c] = f32("a pending event");
+    }
+  }
+  const std::uint64_t values = count * p.inheritedColumns;
+  if (p.inheritedColumns > r.remaining() / 4 / count) {
+    throw Malformed{"it ends inside the pending events' inherited values"};
+  }
+  p.eventValues.resize(static_cast<std::size_t>(values));
+  for (float& v : p.eventValues) v = f32("an inherited value");
+}
+
+Parsed parsePayload(std::string_view payload, bool pendingEvents) {
   CheckpointReader r(payload);
   Parsed p;
   p.stepRateHz = r.i64("the step rate");
@@ -219,8 +261,10 @@ Parsed parsePayload(std::string_view payload) {
     std::memcpy(&spring.damping, &fields[2], 4);
     std::memcpy(&spring.breakRatio, &fields[3], 4);
   }
+  if (pendingEvents) readPendingEvents(r, p);
   if (r.remaining() != 0) {
-    throw Malformed{std::to_string(r.remaining()) + " bytes follow the last spring"};
+    throw Malformed{std::to_string(r.remaining()) + " bytes follow the last " +
+                    (pendingEvents ? "pending event" : "spring")};
   }
   if (p.tick < 0) throw Malformed{"negative tick count"};
   if (p.overrunPolicy > 1)
@@ -291,6 +335,24 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
     return "checkpoint has " + std::to_string(p.springs.size()) +
            " springs (expected none: this effect has no structures)";
   }
+  if (!p.events.empty()) {
+    const EventEmission* events = system.events();
+    if (events == nullptr) {
+      return "checkpoint has " + std::to_string(p.events.size()) +
+             " pending events (expected none: this effect has no sub-emitters)";
+    }
+    if (p.inheritedColumns != events->inheritedColumns().size()) {
+      return "checkpoint has pending events with " + std::to_string(p.inheritedColumns) +
+             " inherited values each (expected " +
+             std::to_string(events->inheritedColumns().size()) + ")";
+    }
+    for (const ParticleEvent& e : p.events) {
+      if (e.parentEmitter >= system.emitters().size() || e.parentId >= p.nextId) {
+        return "checkpoint is malformed (a pending event of parent " + std::to_string(e.parentId) +
+               " from emitter " + std::to_string(e.parentEmitter) + ")";
+      }
+    }
+  }
   if (!system.driver().canRestore(p.ticksIssued, p.ticksDropped, p.ticksDue, p.remainder)) {
     return "checkpoint is malformed (a driver state no run reaches: ticks issued " +
            std::to_string(p.ticksIssued) + ", dropped " + std::to_string(p.ticksDropped) +
@@ -336,6 +398,7 @@ void apply(const Parsed& p, ParticleSystem& system) {
   // Between ticks no particle is flagged; a used target may have stale flags past its old size.
   std::fill_n(pool.dead().begin(), n, std::uint8_t{0});
   if (system.springs() != nullptr) system.springs()->restore(p.springs, p.springsBroken);
+  if (system.events() != nullptr) system.events()->restorePending(p.events, p.eventValues);
   system.driver().restore(p.ticksIssued, p.ticksDropped, p.ticksDue, p.remainder);
   Vec3Column velocities;
   if (p.tickStartVelocities != nullptr) {
@@ -378,7 +441,9 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   Writer w;
   w.bytes().append(kCheckpointMagic);
   w.u32(kCheckpointVersion);
-  w.u32(0);  // flags: none defined in version 1
+  const EventEmission* events = system.events();
+  const bool pending = events != nullptr && !events->pending().empty();
+  w.u32(pending ? kPendingEventsFlag : 0u);
   w.u64(0);  // the file length, patched below
   w.u64(info.effectHash);
 
@@ -429,6 +494,26 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
     }
   }
 
+  if (pending) {
+    w.u64(events->pending().size());
+    w.u32(static_cast<std::uint32_t>(events->inheritedColumns().size()));
+    const auto bitsOf = [](float f) {
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, &f, 4);
+      return bits;
+    };
+    for (const ParticleEvent& e : events->pending()) {
+      w.u64(e.parentId);
+      w.u32(e.parentEmitter);
+      w.u32(static_cast<std::uint32_t>(e.kind));
+      w.u32(e.ordinal);
+      for (const Eigen::Vector3f* v : {&e.position, &e.velocity, &e.normal}) {
+        for (int c = 0; c < 3; ++c) w.u32(bitsOf((*v)[c]));
+      }
+    }
+    for (const float v : events->pendingValues()) w.u32(bitsOf(v));
+  }
+
   w.patchU64(kLengthOffset, w.bytes().size() + kTrailerBytes);
   w.u64(fingerprint(w.bytes()));
   writeFileAtomically(
@@ -462,9 +547,9 @@ CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem&
   }
   if (found < kEffectHashOffset) truncated("at least " + std::to_string(kMinimumBytes));
   const std::uint32_t flags = loadU32(bytes.data() + kFlagsOffset);
-  if (flags != 0) {
-    fail(path, "checkpoint has unknown flags " + std::to_string(flags) +
-                   " (this build reads files with flags 0)");
+  if ((flags & ~kPendingEventsFlag) != 0) {
+    fail(path, "checkpoint has unknown flags " + std::to_string(flags & ~kPendingEventsFlag) +
+                   " (this build reads files with flags 0 and 1)");
   }
   const std::uint64_t length = loadU64(bytes.data() + kLengthOffset);
   if (length < kMinimumBytes) {
@@ -488,7 +573,7 @@ CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem&
 
   Parsed parsed;
   try {
-    parsed = parsePayload(covered.substr(kHeaderBytes));
+    parsed = parsePayload(covered.substr(kHeaderBytes), (flags & kPendingEventsFlag) != 0);
   } catch (const Malformed& m) {
     fail(path, "checkpoint is malformed (" + m.what + ")");
   }

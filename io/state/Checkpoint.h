@@ -37,7 +37,7 @@ inline constexpr std::uint32_t kCheckpointVersion = 2;
 ///
 /// Layout, version 2, every integer little-endian, floats as their IEEE-754 bits:
 ///
-///     header   "TICKFXCK"  u32 version  u32 flags (0)  u64 file length  u64 effect hash
+///     header   "TICKFXCK"  u32 version  u32 flags  u64 file length  u64 effect hash
 ///     payload  i64 step rate (Hz)   str integrator   u64 max particles
 ///              i64 max ticks per frame   u32 overrun policy (0 drop excess, 1 fall behind)
 ///              i64 tick count   i64 ticks issued   i64 ticks dropped   i64 ticks due
@@ -53,6 +53,11 @@ inline constexpr std::uint32_t kCheckpointVersion = 2;
 ///              u64 spring count s   u64 springs broken so far
 ///              s × (u64 id a, u64 id b, f32 rest length, f32 stiffness, f32 damping, f32 break
 ///              ratio)
+///              with flag 1 (sub-emitters' events wait for the next tick; else nothing):
+///              u64 event count e (> 0)   u32 inherited columns k
+///              e × (u64 parent id, u32 parent emitter, u32 kind (1 birth, 2 death, 3 collision),
+///                   u32 ordinal, f32 × 9: position, velocity, normal)
+///              f32[e · k]: each event's inherited values
 ///     trailer  u64 checksum: fingerprint() of every byte before it
 ///
 /// where str is a u32 byte count followed by that many UTF-8 bytes.

@@ -249,7 +249,7 @@ void bindSystemClass(py::module_& m) {
           "Particles removed for a non-finite position or velocity under simulation.nonfinite = "
           "\"kill\".")
       .def(
-          "state_hash", [](const PySystem& s) { return hashToHex(stateHash(s.system().pool())); },
+          "state_hash", [](const PySystem& s) { return hashToHex(stateHash(s.system())); },
           "The state hash after the newest tick: the 16 hex digits `tickfx run --hash` prints as "
           "state-hash (every column of every particle, bit for bit).")
       .def_property_readonly(

@@ -150,7 +150,7 @@ TEST_P(goldenHashes, StateAfterTwoSecondsOfTicks) {
   const std::int64_t ticks = 2 * load.effect->simulation.stepRateHz;
   system->stepTicks(ticks);
   ASSERT_EQ(system->tickCount(), ticks);
-  const std::string actual = hashToHex(stateHash(system->pool()));
+  const std::string actual = hashToHex(stateHash(*system));
   EXPECT_EQ(actual, golden.hash)
       << golden.relativePath() << ": the state after " << ticks << " ticks changed.\n"
       << "  new line: " << golden.file << " " << actual << "\n"
@@ -174,7 +174,7 @@ TEST_P(goldenHashes, SameStateOnHostExecutors) {
     const std::unique_ptr<ParticleSystem> system = buildSystem(*load.effect);
     system->setTaskExecutor(executor);
     system->stepTicks(ticks);
-    EXPECT_EQ(hashToHex(stateHash(system->pool())), found->hash)
+    EXPECT_EQ(hashToHex(stateHash(*system)), found->hash)
         << (executor == &serial ? "serial executor" : "4 workers");
   }
 }
