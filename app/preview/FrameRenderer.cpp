@@ -54,6 +54,12 @@ SplatImage renderFrame(const PinholeCamera& camera, const io::FrameData& frame,
       pscale = &frame.attributes[static_cast<std::size_t>(it - frame.attributeNames.begin())];
     }
   }
+  // Houdini's Alpha, where the frame has it, is each splat's opacity (clamped to [0, 1]).
+  const FloatColumn* alpha = nullptr;
+  if (const auto it = std::find(frame.attributeNames.begin(), frame.attributeNames.end(), "Alpha");
+      it != frame.attributeNames.end()) {
+    alpha = &frame.attributes[static_cast<std::size_t>(it - frame.attributeNames.begin())];
+  }
   std::vector<Splat> splats;
   splats.reserve(frame.size());
   for (std::size_t i = 0; i < frame.size(); ++i) {
@@ -67,8 +73,11 @@ SplatImage renderFrame(const PinholeCamera& camera, const io::FrameData& frame,
     }
     // Half a pixel at least, so that far or tiny particles still show; a NaN radius too.
     radius = std::clamp(std::isnan(radius) ? 0.5 : radius, 0.5, 4096.0);
+    const float opacity =
+        alpha != nullptr ? std::clamp((*alpha)[static_cast<Eigen::Index>(i)], 0.0f, 1.0f) : 1.0f;
     splats.push_back({static_cast<float>(q->x), static_cast<float>(q->y),
-                      static_cast<float>(q->depth), static_cast<float>(radius), colours[i]});
+                      static_cast<float>(q->depth), static_cast<float>(radius), colours[i],
+                      std::isnan(opacity) ? 1.0f : opacity});
   }
   image.draw(std::move(splats));
   return image;

@@ -40,8 +40,8 @@ struct RenderSettings {
 
 /// Renders `frame` as `camera` sees it: the grid and axis marks, then `lines` (pairs of ids, such
 /// as a structure's springs; pairs naming an id not in the frame are skipped), then each row as a
-/// round splat of `colours[row]`, nearer over farther. The bytes depend only on the arguments,
-/// not on the thread count.
+/// round splat of `colours[row]` at the frame's `Alpha` as opacity (opaque without it), nearer
+/// over farther. The bytes depend only on the arguments, not on the thread count.
 SplatImage renderFrame(const PinholeCamera& camera, const io::FrameData& frame,
                        const std::vector<Rgb>& colours,
                        const std::vector<std::pair<std::uint64_t, std::uint64_t>>& lines,

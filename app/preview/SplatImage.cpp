@@ -51,7 +51,9 @@ void SplatImage::draw(std::vector<Splat> splats) {
   std::vector<std::vector<std::uint32_t>> inBand(static_cast<std::size_t>(bands));
   for (std::size_t i = 0; i < splats.size(); ++i) {
     const Splat& s = splats[i];
-    if (!(s.radius > 0.0f) || !std::isfinite(s.x) || !std::isfinite(s.y)) continue;
+    if (!(s.radius > 0.0f) || !(s.opacity > 0.0f) || !std::isfinite(s.x) || !std::isfinite(s.y)) {
+      continue;
+    }
     const float reach = s.radius + 0.5f;
     if (s.x + reach < 0.0f || s.x - reach > static_cast<float>(width_)) continue;
     const int top = std::max(0, static_cast<int>(std::floor(s.y - reach)));
@@ -73,7 +75,7 @@ void SplatImage::draw(std::vector<Splat> splats) {
         const float dy = static_cast<float>(y) + 0.5f - s.y;
         for (int x = xa; x <= xb; ++x) {
           const float dx = static_cast<float>(x) + 0.5f - s.x;
-          const float a = cover(std::sqrt(dx * dx + dy * dy), s.radius);
+          const float a = cover(std::sqrt(dx * dx + dy * dy), s.radius) * s.opacity;
           if (a <= 0.0f) continue;
           float* p = &rgb_[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) +
                             static_cast<std::size_t>(x)) *

@@ -11,13 +11,15 @@ namespace tickfx::preview {
 using Rgb = std::array<std::uint8_t, 3>;
 
 /// One particle as the image sees it: its centre in pixels (PinholeCamera::project), its depth
-/// (metres; farther splats are drawn first), its radius in pixels and its colour.
+/// (metres; farther splats are drawn first), its radius in pixels, its colour and its opacity
+/// (Houdini's Alpha: 0 transparent to 1 opaque).
 struct Splat {
   float x = 0.0f;
   float y = 0.0f;
   float depth = 0.0f;
   float radius = 1.0f;
   Rgb colour{255, 255, 255};
+  float opacity = 1.0f;
 };
 
 /// An 8-bit RGB image, rows top to bottom.

@@ -24,6 +24,25 @@ constexpr std::size_t kPlyRowsPerBlock = 32768;
 
 const char* const kFixedFloats[] = {"x", "y", "z", "vx", "vy", "vz", "age", "life", "mass"};
 
+// The PLY convention's names for Houdini's colour and opacity (red, green, blue, alpha: floats,
+// linear, as the frame holds them); every other attribute keeps its name.
+const std::pair<const char*, const char*> kPlyNames[] = {
+    {"Cd_r", "red"}, {"Cd_g", "green"}, {"Cd_b", "blue"}, {"Alpha", "alpha"}};
+
+std::string plyName(const std::string& column) {
+  for (const auto& [ours, ply] : kPlyNames) {
+    if (column == ours) return ply;
+  }
+  return column;
+}
+
+std::string columnName(const std::string& property) {
+  for (const auto& [ours, ply] : kPlyNames) {
+    if (property == ply) return ours;
+  }
+  return property;
+}
+
 std::vector<const FloatColumn*> floatColumns(const FrameData& f) {
   std::vector<const FloatColumn*> cols = {&f.position.x, &f.position.y, &f.position.z,
                                           &f.velocity.x, &f.velocity.y, &f.velocity.z,
@@ -48,7 +67,7 @@ void writePlyCache(const FrameData& frame, const std::filesystem::path& path,
         out << "property double id\n";
         for (const char* name : kFixedFloats) out << "property float " << name << "\n";
         for (const std::string& name : frame.attributeNames)
-          out << "property " << (isIntAttribute(name) ? "int " : "float ") << name << "\n";
+          out << "property " << (isIntAttribute(name) ? "int " : "float ") << plyName(name) << "\n";
         out << "end_header\n";
         const std::vector<const FloatColumn*> cols = floatColumns(frame);
         // Houdini's integers (hitnum) as 32-bit ints: their columns hold whole numbers.
@@ -115,7 +134,7 @@ FrameData readPlyCache(const std::filesystem::path& path) {
       if (type == "double" && name == "id" && floats.empty()) {
         sawId = true;
       } else if ((type == "float" || (type == "int" && floats.size() >= 9)) && !name.empty()) {
-        floats.push_back(name);
+        floats.push_back(floats.size() >= 9 ? columnName(name) : name);
         ints.push_back(type == "int");
       } else {
         fail("unexpected property '" + line + "'");

@@ -116,6 +116,13 @@ void lintColliders(const EffectSettings& effect, const ColliderSet* built,
       out.push_back(warningAt(effect, "output.hits",
                               "the effect has no [[colliders]]: no particle records a hit"));
     }
+    for (std::size_t i = 0; i < effect.emitters.size(); ++i) {
+      const EmitterSettings& e = effect.emitters[i];
+      if (e.sub.on != EmitterEvent::Collision) continue;
+      out.push_back(warningAt(effect, emitterKeyPath(effect, i) + ".on",
+                              "the effect has no [[colliders]]: \"" + e.sub.parent +
+                                  "\" never collides, and \"" + e.name + "\" never emits"));
+    }
     return;
   }
   ColliderSet owned;

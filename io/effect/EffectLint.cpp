@@ -395,6 +395,38 @@ std::optional<double> springStabilityLimit(std::string_view integrator) {
   return std::nullopt;
 }
 
+namespace {
+
+// Cd, Alpha or pscale declared by some emitters and not by another: that one's particles show
+// Houdini's default (1), which for pscale is a radius of a metre.
+void lintPartialAttributes(const EffectSettings& effect, std::vector<Diagnostic>& out) {
+  for (const char* name : {"Cd", "Alpha", "pscale"}) {
+    const EmitterSettings* declaring = nullptr;
+    for (const EmitterSettings& e : effect.emitters) {
+      for (const LifeAttributeSettings& a : e.attributes) {
+        if (a.name == name && declaring == nullptr) declaring = &e;
+      }
+    }
+    if (declaring == nullptr) continue;
+    for (std::size_t i = 0; i < effect.emitters.size(); ++i) {
+      const EmitterSettings& e = effect.emitters[i];
+      const auto has = [&](const std::string& n) { return n == name; };
+      if (std::any_of(e.attributes.begin(), e.attributes.end(),
+                      [&](const LifeAttributeSettings& a) { return has(a.name); }) ||
+          std::any_of(e.sub.inherit.begin(), e.sub.inherit.end(), has)) {
+        continue;
+      }
+      out.push_back(warning(effect, emitterKeyPath(effect, i),
+                            "\"" + e.name + "\" declares no " + name + " while \"" +
+                                declaring->name + "\" does: its particles show " + name +
+                                " = 1, Houdini's default" +
+                                (std::string(name) == "pscale" ? " (a radius of 1 m)" : "")));
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet* built,
                                    const ColliderSet* colliders) {
   std::vector<Diagnostic> out;
@@ -413,6 +445,7 @@ std::vector<Diagnostic> lintEffect(const EffectSettings& effect, const ForceSet*
   lintAnchorSprings(effect, out);
   lintStructures(effect, out);
   lintTickCap(effect, out);
+  lintPartialAttributes(effect, out);
   detail::lintColliders(effect, colliders, out);
   sortDiagnostics(out);
   return out;

@@ -19,6 +19,7 @@
 #include "io/effect/ParseForces.h"
 #include "io/effect/ParseOutput.h"
 #include "io/effect/ParseSimulation.h"
+#include "io/effect/ParseSubEmitters.h"
 #include "io/effect/ParseVectorFields.h"
 #include "io/effect/SettingOverrides.h"
 #include "io/effect/TableReader.h"
@@ -121,6 +122,7 @@ EffectSettings readCurrentVersion(Context& cx, const toml::table& document) {
       cx.error(cx.at(*node), "output", describe(*node) + " (expected an [output] table)");
     }
   }
+  checkSubEmitters(cx, effect);
   top.finish();
   return effect;
 }

@@ -77,6 +77,15 @@ std::string structureKeyPath(const EffectSettings& effect, std::size_t index) {
   return "structures." + std::to_string(index);
 }
 
+std::string emitterKeyPath(const EffectSettings& effect, std::size_t index) {
+  std::size_t entry = 0;
+  for (std::size_t seen = 0;; ++entry) {
+    const auto& taken = effect.structureEntries;
+    if (std::find(taken.begin(), taken.end(), entry) != taken.end()) continue;
+    if (seen++ == index) return "emitters." + std::to_string(entry);
+  }
+}
+
 std::int64_t OutputSettings::frameCount() const {
   if (frames) return *frames;
   const double exact =

@@ -186,4 +186,8 @@ struct EffectSettings {
 /// which entry it was read from, else "structures.<index>" (settings made in code).
 std::string structureKeyPath(const EffectSettings& effect, std::size_t index);
 
+/// The key path of emitter `index` of `effect.emitters`: "emitters.<entry>", the entries of
+/// structures (structureEntries) skipped.
+std::string emitterKeyPath(const EffectSettings& effect, std::size_t index);
+
 }  // namespace tickfx::io

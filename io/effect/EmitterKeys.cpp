@@ -10,9 +10,9 @@ namespace tickfx::io::detail {
 
 const std::vector<std::string>& fileEmitterKeys() {
   static const std::vector<std::string> keys = {
-      "type",         "name",   "file",     "position",        "rate",
-      "start",        "stop",   "bursts",   "direction",       "speed",
-      "speed_jitter", "spread", "lifetime", "lifetime_jitter", "mass"};
+      "type",   "name",      "file",  "position",     "rate",   "start",    "stop",
+      "bursts", "direction", "speed", "speed_jitter", "spread", "lifetime", "lifetime_jitter",
+      "mass",   "attributes"};
   return keys;
 }
 
@@ -43,9 +43,29 @@ const std::map<std::string, std::vector<std::string>>& structureKeys() {
 
 const std::vector<std::string>& particleEmitterKeys() {
   static const std::vector<std::string> keys = [] {
-    std::vector<std::string> k = {"type",         "name",   "position", "shape",           "rate",
-                                  "start",        "stop",   "bursts",   "direction",       "speed",
-                                  "speed_jitter", "spread", "lifetime", "lifetime_jitter", "mass"};
+    std::vector<std::string> k = {"type",
+                                  "name",
+                                  "position",
+                                  "shape",
+                                  "rate",
+                                  "start",
+                                  "stop",
+                                  "bursts",
+                                  "direction",
+                                  "speed",
+                                  "speed_jitter",
+                                  "spread",
+                                  "lifetime",
+                                  "lifetime_jitter",
+                                  "mass",
+                                  "attributes",
+                                  "parent",
+                                  "on",
+                                  "count",
+                                  "count_range",
+                                  "inherit_velocity",
+                                  "inherit",
+                                  "first_only"};
     for (const auto& [shape, own] : shapeKeys()) {
       for (const std::string& key : own) {
         if (std::find(k.begin(), k.end(), key) == k.end()) k.push_back(key);

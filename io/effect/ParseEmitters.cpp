@@ -8,6 +8,7 @@
 #include "io/effect/EmitterKeys.h"
 #include "io/effect/ParseFileEmitters.h"
 #include "io/effect/ParseStructures.h"
+#include "io/effect/ParseSubEmitters.h"
 
 namespace tickfx::io::detail {
 namespace {
@@ -105,6 +106,7 @@ void readEmitter(Context& cx, const toml::table& table, std::size_t index,
   r.string("name", e.name, "a name: a non-empty string, unique among the emitters");
   r.vec3("position", e.position, kPositionText, Range{-kBig, kBig});
   readShape(r, e);
+  readSubEmitter(cx, r, e);
   readEmission(cx, table, r, maxParticles, e);
 
   std::string shape = "point";
@@ -132,7 +134,8 @@ void readEmission(Context& cx, const toml::table& table, TableReader& r, std::in
     }
   }
   readBursts(cx, r, e, maxParticles);
-  r.vec3("direction", e.direction, kDirectionText, Range{-kBig, kBig}, /*nonZero=*/true);
+  if (!readNormalDirection(cx, r, e))
+    r.vec3("direction", e.direction, kDirectionText, Range{-kBig, kBig}, /*nonZero=*/true);
   r.number("speed", e.speed, "metres per second, a number from 0 to 1e9", Range{0.0, kBig});
   r.number("speed_jitter", e.speedJitter, "a fraction from 0 to 1", Range{0.0, 1.0});
   r.number("spread", e.spreadDegrees, "degrees, a number from 0 to 180", Range{0.0, 180.0});
@@ -140,6 +143,7 @@ void readEmission(Context& cx, const toml::table& table, TableReader& r, std::in
   r.number("lifetime_jitter", e.lifetimeJitter, "a fraction >= 0 and < 1",
            Range{0.0, 1.0, false, true});
   r.number("mass", e.mass, "kilograms, a number > 0 and <= 1e9", Range{0.0, kBig, true});
+  readLifeAttributes(cx, r, e);
 }
 
 // One [[emitters]] entry: a particle emitter or, by its `type`, a structure.

@@ -269,7 +269,7 @@ TEST_F(ioFileEmitter, KeysThatDoNotApplyAndAMissingFile) {
   const std::string fx = path("fx.toml");
   const std::string fileKeys =
       "(expected for a file emitter: type, name, file, position, rate, start, stop, bursts, "
-      "direction, speed, speed_jitter, spread, lifetime, lifetime_jitter, mass)";
+      "direction, speed, speed_jitter, spread, lifetime, lifetime_jitter, mass, attributes)";
   EXPECT_EQ(errors(kHead + R"([[emitters]]
 type = "file"
 fiel = "pts.csv"

@@ -16,9 +16,9 @@ namespace tickfx::io {
 namespace {
 
 const std::vector<std::string> kSamples = {
-    "fountain",   "oscillator",    "wind_aliasing", "wind_aliasing_fixed", "smoke_drift", "burst",
-    "rope_swing", "flag",          "jelly",         "vortex_smoke",        "leaves",      "rain",
-    "drum",       "sand_on_sphere"};
+    "fountain",   "oscillator",     "wind_aliasing", "wind_aliasing_fixed", "smoke_drift", "burst",
+    "rope_swing", "flag",           "jelly",         "vortex_smoke",        "leaves",      "rain",
+    "drum",       "sand_on_sphere", "fireworks",     "sparks_grind"};
 
 std::filesystem::path samplePath(const std::string& name) {
   return std::filesystem::path(TICKFX_SOURCE_DIR) / "samples" / (name + ".toml");

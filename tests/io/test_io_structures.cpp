@@ -298,8 +298,9 @@ type = 3
                    "(expected one of: particles, file, rope, cloth, cluster)",
                    "bad.toml:13:1: error: emitters.2.colour: unknown key \"colour\" (expected one "
                    "of: type, name, position, shape, rate, start, stop, bursts, direction, speed, "
-                   "speed_jitter, spread, lifetime, lifetime_jitter, mass, size, radius, normal, "
-                   "surface, file, time, stiffness, damping, break_ratio, velocity, end, count, "
+                   "speed_jitter, spread, lifetime, lifetime_jitter, mass, attributes, parent, on, "
+                   "count, count_range, inherit_velocity, inherit, first_only, size, radius, "
+                   "normal, surface, file, time, stiffness, damping, break_ratio, velocity, end, "
                    "pin_start, pin_end, origin, axis_u, axis_v, width, height, spacing, pins, "
                    "shear_scale, bend_scale, center, link_radius)",
                    "bad.toml:16:8: error: emitters.3.type: got the integer 3 (expected emitter "
@@ -640,8 +641,8 @@ width = 2
              // A particle emitter (no type) with structure keys: the message names the types.
              "bad.toml:22:1: error: emitters.2.stiffness: does not apply to an emitter of type "
              "\"particles\" (expected type = \"rope\", \"cloth\" or \"cluster\" for stiffness)",
-             "bad.toml:23:1: error: emitters.2.count: does not apply to an emitter of type "
-             "\"particles\" (expected type = \"rope\" or \"cluster\" for count)",
+             "bad.toml:23:1: error: emitters.2.count: applies to a sub-emitter or a structure "
+             "(expected parent = \"NAME\" with it, or type = \"rope\" or \"cluster\")",
              "bad.toml:24:1: error: emitters.2.width: does not apply to an emitter of type "
              "\"particles\" (expected type = \"cloth\" for width)"}));
 }

@@ -76,6 +76,31 @@ def test_hit_attributes_in_every_format_as_capture_has_them(cli, samples, tmp_pa
         assert mine.read_bytes() == (tmp_path / f"frame_0036.{fmt}").read_bytes(), fmt
 
 
+def test_colour_opacity_and_size_over_life_in_every_format(cli, samples, tmp_path):
+    # The fireworks' sparks at 3 s: Cd (N, 3), Alpha and pscale evaluated at the frame's own ages,
+    # the same in capture(), in every cache the command line wrote and in the module's own.
+    run_cli(cli, "run", samples / "fireworks.toml", "--frames", "72", "--format", "csv,ply,vdb",
+            "--out", tmp_path, "--quiet")
+    system = tickfx.load_effect(samples / "fireworks.toml")
+    run_frames(system, 72)
+    shown = system.capture()
+    assert list(shown) == STANDARD + ["emitter", "Alpha", "Cd", "pscale"]
+    sparks = shown["emitter"] == 1
+    assert sparks.sum() % 150 == 0 and sparks.sum() >= 300  # whole bursts of 150
+    assert shown["Cd"].shape == (system.count, 3) and shown["Cd"].dtype == np.float32
+    nage = np.minimum(shown["age"][sparks] / shown["life"][sparks], 1.0)
+    # pscale falls linearly from 6 cm to 1.5 cm over a spark's life (float arithmetic).
+    expected = np.float32(0.06) + (np.float32(0.015) - np.float32(0.06)) * nage.astype(np.float32)
+    assert np.allclose(shown["pscale"][sparks], expected, rtol=0, atol=1e-7)
+    assert np.all(shown["Alpha"][sparks] <= 1.0) and np.all(shown["Alpha"][sparks] >= 0.0)
+    assert np.all(shown["pscale"][~sparks] == np.float32(0.12))  # the shells' constant
+    for fmt in FORMATS:
+        assert_same_bits(tickfx.read_cache(tmp_path / f"frame_0072.{fmt}"), shown)
+        mine = tmp_path / f"mine.{fmt}"
+        tickfx.write_cache(mine, shown, frame=72, time=system.time, system=system)
+        assert mine.read_bytes() == (tmp_path / f"frame_0072.{fmt}").read_bytes(), fmt
+
+
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_write_cache_matches_the_cli(cli_frames, tmp_path, fmt):
     out, system = cli_frames
