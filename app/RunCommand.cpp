@@ -22,6 +22,7 @@
 #include "io/cache/BackgroundWriter.h"
 #include "io/cache/FrameCaches.h"
 #include "io/cache/FrameData.h"
+#include "io/cache/UsdaPointsWriter.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
@@ -47,8 +48,8 @@ constexpr const char* kRunHelp =
     "  --frame-times FILE    one frame duration in seconds a line\n"
     "Output:\n"
     "  --out DIR             cache directory (default: the effect's output.directory)\n"
-    "  --format LIST         comma-separated: csv, ply, vdb (OpenVDB points); 'none' writes no\n"
-    "                        caches\n"
+    "  --format LIST         comma-separated: csv, ply, vdb (OpenVDB points), usda (one USD\n"
+    "                        layer a run, DIR/EFFECT.usda); 'none' writes no caches\n"
     "  --hash                print 'state-hash: <16 hex digits>' and 'ticks: N' of the last tick\n"
     "  --dump FILE           write the last tick's state as CSV: id,px,py,pz,vx,vy,vz,age\n"
     "  --trace FILE          write the state hash after every tick (tick,state_hash): diff two\n"
@@ -90,7 +91,19 @@ struct PreparedRun {
   std::vector<std::pair<std::int64_t, std::uint64_t>> tickHashes;
   // Frame f's files are written while frame f + 1 simulates; the writer holds at most one frame.
   std::optional<io::BackgroundWriter> writer;
+  // The run's USD layer (--format usda), written whole by finishUsda(); and the cache targets
+  // that append to it.
+  std::unique_ptr<io::UsdaPointsWriter> usda;
+  io::CacheTargets targets;
 };
+
+// Writes the run's USD layer from the frames written so far (the writer drained), if it has one.
+void finishUsda(PreparedRun& run) {
+  if (run.usda && run.usda->hasFrames()) {
+    run.usda->finish();
+    run.usda.reset();
+  }
+}
 
 // Reads --resume's checkpoint into the system and skips the frames it covers. False after
 // printing why it does not fit this run: verified whole before anything is written, a refusal is
@@ -164,7 +177,26 @@ std::unique_ptr<PreparedRun> prepareRun(const RunSettings& s, const io::EffectSe
       r->tickHashes.emplace_back(system.tickCount(), stateHash(system));
     });
   }
-  const io::CacheTargets* const targets = &s.caches;
+  run->targets = s.caches;
+  if (std::find(s.caches.formats.begin(), s.caches.formats.end(), io::CacheFormat::Usda) !=
+      s.caches.formats.end()) {
+    if (s.resume) {
+      std::fprintf(stderr,
+                   "%s: error: --resume cannot continue a .usda layer, which a run writes whole "
+                   "(expected --format without usda, or the run from its start)\n",
+                   s.resume->c_str());
+      return nullptr;
+    }
+    try {
+      run->usda = std::make_unique<io::UsdaPointsWriter>(
+          s.usdaPath(), io::UsdaLayerSettings{s.framesPerSecond, "particles"}, s.caches.durability);
+    } catch (const io::WriteError& e) {
+      std::fprintf(stderr, "%s\n", e.what());
+      return nullptr;
+    }
+    run->targets.usda = run->usda.get();
+  }
+  const io::CacheTargets* const targets = &run->targets;
   run->writer.emplace([targets](const io::FrameData& d) { io::writeFrameCaches(d, *targets); },
                       s.overlap && s.writesCaches());
   return run;
@@ -277,6 +309,7 @@ std::optional<int> FrameLoop::run() {
     }
     run_.writer->finish();
     if (const int signal = InterruptCatcher::caught()) return stopAtInterruption(signal);
+    finishUsda(run_);
   } catch (const io::WriteError& e) {
     return stopAtWriteError(e);
   }
@@ -321,14 +354,16 @@ void FrameLoop::showProgress(std::int64_t f) {
 }
 
 int FrameLoop::stopAtNonfinite() {
-  // The frame holding the tick is not written; those before it are, whole.
+  // The frame holding the tick is not written; those before it are, whole (the USD layer too).
   run_.writer->finish();
+  finishUsda(run_);
   progress_.finish();
   reportNonfiniteStop(s_, run_, writtenThrough());
   return kExitFailure;
 }
 
 int FrameLoop::stopAtInterruption(int signal) {
+  finishUsda(run_);
   progress_.finish();
   // The state is that of the end of lastFrame: a checkpoint of it, unless one was just made.
   std::optional<std::filesystem::path> resumeFrom;
@@ -396,9 +431,16 @@ void printRunSummary(const RunSettings& s, const PreparedRun& run, const FrameLo
                 simulating, writing, s.overlap ? "overlapped" : "not overlapped (--no-overlap):",
                 std::max(0.0, simulating + writing - wall));
   }
-  if (s.writesCaches() && frames.lastFrame() >= run.firstFrame) {
+  const std::vector<io::CacheFormat>& formats = s.caches.formats;
+  const bool usda =
+      std::find(formats.begin(), formats.end(), io::CacheFormat::Usda) != formats.end();
+  if (formats.size() > (usda ? 1u : 0u) && frames.lastFrame() >= run.firstFrame) {
     std::printf("caches: %s\n",
                 cacheRange(s.caches.directory, run.firstFrame, frames.lastFrame()).c_str());
+  }
+  if (usda && frames.lastFrame() >= run.firstFrame) {
+    std::printf("usd layer: %s (time codes %lld to %lld)\n", s.usdaPath().c_str(),
+                static_cast<long long>(run.firstFrame), static_cast<long long>(frames.lastFrame()));
   }
   if (s.dump) std::printf("state dump: %s\n", s.dump->c_str());
 }

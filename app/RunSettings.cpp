@@ -25,12 +25,12 @@ std::vector<io::CacheFormat> parseFormats(const std::string& text) {
     const std::optional<io::CacheFormat> f = io::cacheFormatFromName(name);
     if (!f) {
       throw UsageError("run: --format: unknown format '" + name +
-                       "' (expected csv, ply, vdb or none)");
+                       "' (expected csv, ply, vdb, usda or none)");
     }
     formats.push_back(*f);
   }
   if (formats.empty())
-    throw UsageError("run: --format: empty list (expected csv, ply, vdb or none)");
+    throw UsageError("run: --format: empty list (expected csv, ply, vdb, usda or none)");
   return formats;
 }
 
@@ -173,6 +173,8 @@ std::optional<RunSettings> resolveRunSettings(const RunArguments& a, const io::L
   if (a.checkpointDir && !a.checkpointEvery)
     throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
   io::CacheTargets caches = cacheTargets(a, load, std::move(formats));
+  FrameRate rate = effect.output.fps;
+  if (a.fps) rate = parseFrameRate(*a.fps);  // planFrames() took it
   std::filesystem::path checkpointDir =
       a.checkpointDir ? std::filesystem::path(*a.checkpointDir) : caches.directory;
   return RunSettings{.effectPath = a.effectPath,
@@ -186,7 +188,13 @@ std::optional<RunSettings> resolveRunSettings(const RunArguments& a, const io::L
                      .trace = a.trace,
                      .overlap = a.overlap,
                      .printHash = a.printHash,
-                     .quiet = a.quiet};
+                     .quiet = a.quiet,
+                     .framesPerSecond = static_cast<double>(rate.numerator) /
+                                        static_cast<double>(rate.denominator)};
+}
+
+std::filesystem::path RunSettings::usdaPath() const {
+  return caches.directory / (std::filesystem::path(effectPath).stem().string() + ".usda");
 }
 
 std::filesystem::path RunSettings::checkpointPath(std::int64_t frame) const {

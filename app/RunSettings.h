@@ -54,7 +54,13 @@ struct RunSettings {
   bool printHash = false;
   bool quiet = false;
 
+  /// Frames a second of the run's frame rate (--fps, else the effect's): a USD layer's time
+  /// codes per second.
+  double framesPerSecond = 24.0;
+
   bool writesCaches() const { return !caches.formats.empty(); }
+  /// DIR/EFFECT.usda: the run's USD layer, when it writes one.
+  std::filesystem::path usdaPath() const;
   /// DIR/checkpoint_000012.tfxc: the checkpoint written after `frame`.
   std::filesystem::path checkpointPath(std::int64_t frame) const;
 };

@@ -10,6 +10,8 @@ std::string_view cacheFormatName(CacheFormat format) {
       return "ply";
     case CacheFormat::Vdb:
       return "vdb";
+    case CacheFormat::Usda:
+      return "usda";
   }
   return "csv";
 }

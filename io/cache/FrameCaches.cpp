@@ -6,6 +6,7 @@
 
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
+#include "io/cache/UsdaPointsWriter.h"
 
 namespace tickfx::io {
 
@@ -18,6 +19,10 @@ std::filesystem::path cacheFilePath(const std::filesystem::path& directory, std:
 
 void writeFrameCaches(const FrameData& frame, const CacheTargets& targets) {
   for (const CacheFormat format : targets.formats) {
+    if (format == CacheFormat::Usda) {
+      if (targets.usda != nullptr) targets.usda->write(frame);
+      continue;
+    }
     const std::filesystem::path path =
         cacheFilePath(targets.directory, frame.frame, cacheFormatName(format));
     switch (format) {
@@ -30,6 +35,8 @@ void writeFrameCaches(const FrameData& frame, const CacheTargets& targets) {
       case CacheFormat::Vdb:
         writeVdbPointCache(frame, targets.vdbMetadata, path, targets.vdbOptions,
                            targets.durability);
+        break;
+      case CacheFormat::Usda:
         break;
     }
   }

@@ -1,5 +1,5 @@
-// tickfx.read_cache and the core of tickfx.write_cache: frame caches (.csv, .ply, .vdb) as dicts
-// of numpy arrays keyed by Houdini's attribute names.
+// tickfx.read_cache and the core of tickfx.write_cache: frame caches (.csv, .ply, .vdb, and a
+// frame of a run's .usda layer) as dicts of numpy arrays keyed by Houdini's attribute names.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -20,13 +20,14 @@
 #include "io/cache/AttributeGroups.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
+#include "io/cache/UsdaReader.h"
 #include "io/cache/VdbPointCache.h"
 #include "python/bindings/Bindings.h"
 
 namespace tickfx::python {
 namespace {
 
-enum class Format { Csv, Ply, Vdb };
+enum class Format { Csv, Ply, Vdb, Usda };
 
 const char* const kStandardNames[] = {"P", "v", "id", "age", "life", "mass"};
 
@@ -37,7 +38,8 @@ Format formatOf(const std::string& path) {
   if (ext == ".csv") return Format::Csv;
   if (ext == ".ply") return Format::Ply;
   if (ext == ".vdb") return Format::Vdb;
-  throw py::value_error(path + ": not a cache file name (expected .csv, .ply or .vdb)");
+  if (ext == ".usda") return Format::Usda;
+  throw py::value_error(path + ": not a cache file name (expected .csv, .ply, .vdb or .usda)");
 }
 
 py::array_t<float> floats(const FloatColumn& column) {
@@ -110,6 +112,11 @@ void writeCache(
     const std::optional<std::tuple<std::string, std::uint64_t, std::int64_t, std::string>>&
         metadata) {
   const Format format = formatOf(path);
+  if (format == Format::Usda) {
+    throw py::value_error(path +
+                          ": a .usda layer holds a whole run, a time sample a frame "
+                          "(write it with tickfx run --format usda)");
+  }
   if (ids.ndim() != 1) throw py::value_error("id: wrong shape");
   if (names.size() != attributes.size()) throw py::value_error("one name per custom attribute");
   checkNames(format, names);
@@ -207,15 +214,30 @@ void bindCaches(py::module_& m) {
       py::arg("name"));
   m.def(
       "_read_cache",
-      [](const std::string& path) {
+      [](const std::string& path, std::optional<std::int64_t> frameNumber) {
         const Format format = formatOf(path);
+        if (frameNumber && format != Format::Usda) {
+          throw py::value_error(path + ": frame= picks a frame of a .usda layer; a ." +
+                                std::string(format == Format::Csv   ? "csv"
+                                            : format == Format::Ply ? "ply"
+                                                                    : "vdb") +
+                                " cache is one frame");
+        }
         const io::FrameData frame = guardedIo([&] {
           if (format == Format::Csv) return io::readCsvCache(path);
           if (format == Format::Ply) return io::readPlyCache(path);
-          return io::readVdbPointCache(path);
+          if (format == Format::Vdb) return io::readVdbPointCache(path);
+          if (frameNumber) return io::readUsdaFrame(path, *frameNumber);
+          const std::vector<std::int64_t> frames = io::usdaFrames(path);
+          if (frames.empty()) throw std::runtime_error(path + ": holds no frame");
+          return io::readUsdaFrame(path, frames.front());
         });
         return frameToDict(frame);
       },
+      py::arg("path"), py::arg("frame") = py::none());
+  m.def(
+      "_usda_frames",
+      [](const std::string& path) { return guardedIo([&] { return io::usdaFrames(path); }); },
       py::arg("path"));
 
   m.def("_write_cache", &writeCache, py::arg("path"), py::arg("id"), py::arg("P"), py::arg("v"),

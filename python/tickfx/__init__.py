@@ -36,6 +36,7 @@ __all__ = [
     "check",
     "load_effect",
     "read_cache",
+    "usda_frames",
     "write_cache",
 ]
 
@@ -233,9 +234,10 @@ _advance.__qualname__ = "System.advance"
 System.advance = _advance
 
 
-def read_cache(path):
+def read_cache(path, frame=None):
     """Reads one frame cache written by `tickfx run` or write_cache(): .csv, .ply or .vdb (by the
-    file name's extension; ValueError for any other).
+    file name's extension; ValueError for any other), or frame `frame` of a run's .usda layer
+    (`tickfx run --format usda`; its first frame when `frame` is None; usda_frames() lists them).
 
     Returns a dict of new numpy arrays keyed by Houdini's attribute names, rows in id order:
         "P": positions, metres, (N, 3) float32
@@ -247,7 +249,12 @@ def read_cache(path):
     v and age as 0, life as inf, mass as 1, and ids as the row numbers. Raises CacheError (an
     OSError) with tickfx's message, naming the file, when it is missing, truncated or malformed.
     """
-    return _tickfx._read_cache(_path_text(path))
+    return _tickfx._read_cache(_path_text(path), frame)
+
+
+def usda_frames(path):
+    """The frames (time codes) of a .usda layer written by `tickfx run --format usda`, rising."""
+    return _tickfx._usda_frames(_path_text(path))
 
 
 _STANDARD_COLUMNS = ("P", "v", "id", "age", "life", "mass")

@@ -15,6 +15,7 @@
 #include "CliTestSupport.h"
 #include "PointCacheTestSupport.h"
 #include "io/cache/CsvCache.h"
+#include "io/cache/UsdaReader.h"
 #include "io/cache/VdbPointCache.h"
 
 namespace fs = std::filesystem;
@@ -75,10 +76,47 @@ TEST_F(CliPoints, RunWritesVdbCachesHoldingTheCsvCachesBits) {
   EXPECT_NE(a.metadata.effectHash, b.metadata.effectHash);
 }
 
+// --format usda: one layer a run, DIR/EFFECT.usda, a time sample a frame holding the VDB caches'
+// bits; a run that cannot write it whole (one resumed) refuses before the first tick.
+TEST_F(CliPoints, RunWritesOneUsdaLayerHoldingTheVdbCachesBits) {
+  const Result r = tickfx(
+      "run samples/fireworks.toml --frames 3 --fps 1000/1001 "
+      "--format vdb,usda --out " +
+      path("u"));
+  ASSERT_EQ(r.exit, 0) << r.err;
+  EXPECT_NE(r.out.find("usd layer: " + path("u/fireworks.usda") + " (time codes 1 to 3)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(fs::exists(path("u/fireworks.usda.parts")));
+  EXPECT_EQ(tickfx::io::usdaFrames(path("u/fireworks.usda")), (std::vector<std::int64_t>{1, 2, 3}));
+  std::ifstream in(path("u/fireworks.usda"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("    timeCodesPerSecond = 0.999000999000999\n"), std::string::npos);
+  for (int f = 1; f <= 3; ++f) {
+    const tickfx::io::FrameData vdb =
+        tickfx::io::readVdbPointCache(path("u/frame_000" + std::to_string(f) + ".vdb"));
+    const tickfx::io::FrameData usda = tickfx::io::readUsdaFrame(path("u/fireworks.usda"), f);
+    ASSERT_GT(usda.size(), 0u);
+    EXPECT_EQ(usda.attributeNames, vdb.attributeNames);
+    EXPECT_EQ(tickfx::io::frameHash(usda), tickfx::io::frameHash(vdb)) << "frame " << f;
+  }
+  ASSERT_EQ(tickfx("run samples/burst.toml --frames 2 --format csv --checkpoint-every 1 --out " +
+                   path("k"))
+                .exit,
+            0);
+  const Result resumed = tickfx("run samples/burst.toml --frames 3 --format usda --resume " +
+                                path("k/checkpoint_000002.tfxc") + " --out " + path("k"));
+  EXPECT_EQ(resumed.exit, 2);
+  EXPECT_NE(resumed.err.find("--resume cannot continue a .usda layer"), std::string::npos)
+      << resumed.err;
+  EXPECT_FALSE(fs::exists(path("k/burst.usda")));
+}
+
 TEST_F(CliPoints, UnknownFormatsNameVdb) {
   const Result r = tickfx("run samples/fountain.toml --frames 1 --format vdbs --out " + path("c"));
   EXPECT_EQ(r.exit, 2);
-  EXPECT_NE(r.err.find("unknown format 'vdbs' (expected csv, ply, vdb or none)"), std::string::npos)
+  EXPECT_NE(r.err.find("unknown format 'vdbs' (expected csv, ply, vdb, usda or none)"),
+            std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(path("c")));
   // In the effect file too.

@@ -214,7 +214,7 @@ def test_write_cache_validates(tmp_path):
     tickfx.write_cache(tmp_path / "ok.csv", {**good, "heat": np.ones(3, np.int16),
                                              "age": np.full(3, 0.5, np.float16)})
     assert tickfx.read_cache(tmp_path / "ok.csv")["heat"].dtype == np.float32
-    with pytest.raises(ValueError, match="expected .csv, .ply or .vdb"):
+    with pytest.raises(ValueError, match="expected .csv, .ply, .vdb or .usda"):
         tickfx.write_cache(tmp_path / "x.bgeo", good)
     with pytest.raises(ValueError, match="no commas"):
         tickfx.write_cache(tmp_path / "x.csv", {**good, "a,b": np.zeros(3, np.float32)})
@@ -231,7 +231,7 @@ def test_write_cache_validates(tmp_path):
 
 def test_unreadable_caches_raise_cache_error(tmp_path, cli_frames):
     out, _ = cli_frames
-    with pytest.raises(ValueError, match="expected .csv, .ply or .vdb"):
+    with pytest.raises(ValueError, match="expected .csv, .ply, .vdb or .usda"):
         tickfx.read_cache(tmp_path / "frame.bgeo")
     for fmt in FORMATS:
         missing = tmp_path / f"missing.{fmt}"
@@ -268,3 +268,20 @@ def test_frames_between_ticks_are_the_cli_caches(cli, samples, tmp_path):
         assert_same_bits(tickfx.read_cache(out / f"frame_{number:04d}.csv"), system.capture())
     assert between == 20
     assert system.count > 100
+
+
+def test_a_usda_layer_reads_frame_by_frame_as_the_vdb_caches(cli, samples, tmp_path):
+    # `tickfx run --format usda` writes one layer a run; read_cache(path, frame=N) gives frame N
+    # with the bits of the same run's VDB cache, and usda_frames() lists the time codes.
+    run_cli(cli, "run", samples / "fireworks.toml", "--frames", "3", "--fps", "1",
+            "--format", "vdb,usda", "--out", tmp_path, "--quiet")
+    layer = tmp_path / "fireworks.usda"
+    assert tickfx.usda_frames(layer) == [1, 2, 3]
+    for f in (1, 2, 3):
+        assert_same_bits(tickfx.read_cache(layer, frame=f),
+                         tickfx.read_cache(tmp_path / f"frame_000{f}.vdb"))
+    assert_same_bits(tickfx.read_cache(layer), tickfx.read_cache(tmp_path / "frame_0001.vdb"))
+    with pytest.raises(ValueError, match="frame= picks a frame of a .usda layer"):
+        tickfx.read_cache(tmp_path / "frame_0001.vdb", frame=1)
+    with pytest.raises(tickfx.CacheError, match="has no ids at frame 9"):
+        tickfx.read_cache(layer, frame=9)
