@@ -1,0 +1,79 @@
+# The Blender add-on (tickfx.blender) in Debian's Blender, headless:
+#   blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py -- \
+#       TICKFX_CLI SAMPLES_DIR WORK_DIR
+# The fountain's VDB caches imported as one object: at frames 1, 12 and 24 its vertices and
+# attributes equal tickfx.read_cache of the same files, a frame change updates them, and folders
+# that are not a sequence are refused by name with no object left behind.
+import os
+import shutil
+import subprocess
+import sys
+
+import bpy
+import numpy as np
+
+import tickfx
+import tickfx.blender
+
+cli, samples, work = sys.argv[sys.argv.index("--") + 1:][:3]
+shutil.rmtree(work, ignore_errors=True)
+caches = os.path.join(work, "fountain")
+subprocess.run([cli, "run", os.path.join(samples, "fountain.toml"), "--frames", "24",
+                "--format", "vdb", "--out", caches, "--quiet"], check=True)
+
+tickfx.blender.register()
+scene = bpy.context.scene
+objects_before = set(bpy.data.objects.keys())
+assert bpy.ops.import_scene.tickfx_cache_sequence(directory=caches) == {"FINISHED"}
+obj = bpy.data.objects["fountain"]
+assert (scene.frame_start, scene.frame_end) == (1, 24), (scene.frame_start, scene.frame_end)
+
+
+def attribute(mesh, name, width):
+    a = mesh.attributes[name]
+    key = {"FLOAT_VECTOR": "vector", "FLOAT_COLOR": "color"}.get(a.data_type, "value")
+    dtype = np.int32 if a.data_type == "INT" else np.float32
+    out = np.empty(len(mesh.vertices) * width, dtype=dtype)
+    a.data.foreach_get(key, out)
+    return out.reshape(-1, width) if width > 1 else out
+
+
+counts = {}
+for frame in (1, 12, 24):
+    scene.frame_set(frame)
+    expected = tickfx.read_cache(os.path.join(caches, f"frame_{frame:04d}.vdb"))
+    mesh = obj.data
+    n = len(expected["P"])
+    assert len(mesh.vertices) == n, (frame, len(mesh.vertices), n)
+    co = np.empty(n * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    assert np.array_equal(co.reshape(-1, 3), expected["P"]), frame
+    assert np.array_equal(attribute(mesh, "v", 3), expected["v"]), frame
+    for name in ("age", "life", "mass"):
+        assert np.array_equal(attribute(mesh, name, 1), expected[name]), (frame, name)
+    ids = attribute(mesh, "id", 1).view(np.uint32).astype(np.int64)
+    assert np.array_equal(ids, expected["id"] & 0xFFFFFFFF), frame
+    counts[frame] = n
+    print(f"frame {frame}: {n} points, P, v, id, age, life, mass equal read_cache")
+assert counts[1] < counts[12] < counts[24], counts  # the frame change reloaded the points
+
+# Not a sequence: refused by name, nothing left behind.
+empty = os.path.join(work, "empty")
+os.makedirs(empty)
+gap = os.path.join(work, "gap")
+shutil.copytree(caches, gap)
+os.remove(os.path.join(gap, "frame_0005.vdb"))
+corrupt = os.path.join(work, "corrupt")
+os.makedirs(corrupt)
+with open(os.path.join(corrupt, "frame_0001.vdb"), "wb") as f:
+    f.write(b"not a vdb")
+for folder, message in ((empty, "no tickfx caches"), (gap, "frame_0005.vdb is missing"),
+                        (corrupt, "frame_0001.vdb")):
+    try:
+        bpy.ops.import_scene.tickfx_cache_sequence(directory=folder)
+        raise AssertionError(f"{folder} imported")
+    except RuntimeError as e:
+        assert message in str(e), str(e)
+        print(f"refused {os.path.basename(folder)}: {str(e).strip()}")
+assert set(bpy.data.objects.keys()) == objects_before | {"fountain"}, bpy.data.objects.keys()
+print("tickfx.blender: all checks passed")
