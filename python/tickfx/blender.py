@@ -1,8 +1,9 @@
 """tickfx in Blender: import a folder of tickfx caches as one point object that follows the
 scene's frame, every attribute a point attribute.
 
-Register it with `import tickfx.blender; tickfx.blender.register()` (what the add-on zip's
-__init__ does), or from the command line:
+Register it with `import tickfx.blender; tickfx.blender.register()`, or install the add-on zip
+that `scripts/blender-addon` (write_addon_zip()) makes through Edit > Preferences > Add-ons >
+Install (its __init__ registers this module), or from the command line:
     blender -b --python-expr "import tickfx.blender as b; b.register()"
 File > Import > tickfx cache sequence then reads `frame_N.vdb`, `.ply` or `.csv` (by the first
 of these formats the folder has) through tickfx.read_cache.
@@ -14,27 +15,28 @@ pscale (FLOAT), the hit attributes and custom attributes (FLOAT, INT, FLOAT_VECT
 gives them). Geometry nodes can instance on the points by pscale and colour by Cd. A frame
 handler reloads the frame on every frame change; frames outside the caches show the nearest.
 Memory: one frame's arrays at a time.
+
+The panel in the 3D view's sidebar (tab "tickfx") runs an effect file in Blender: its lint
+warnings are reported, then it runs through tickfx.load_effect and advance() at the scene's frame
+rate, frames at their own time, from frame 1 to the scene's end frame, each frame captured.
+The object shows the captured frame on every frame change, as an imported sequence does.
+Memory: every captured frame, about 40 bytes a particle a frame plus 4 an attribute.
 """
 import os
 import re
+from fractions import Fraction
 
 import numpy as np
 
 import tickfx
 
-bl_info = {
-    "name": "tickfx cache sequence",
-    "author": "tickfx",
-    "version": (0, 1, 0),
-    "blender": (3, 4, 0),
-    "location": "File > Import > tickfx cache sequence",
-    "description": "Point caches of tickfx runs, every attribute, following the frame",
-    "category": "Import-Export",
-}
+from tickfx.blender_addon import bl_info, write_addon_zip  # noqa: F401 (the add-on's face)
 
 _FRAME_FILE = re.compile(r"^frame_(\d+)\.(vdb|ply|csv)$")
 _FORMATS = ("vdb", "ply", "csv")  # the first the folder has is read
 _SEQUENCE_KEY = "tickfx_cache_folder"
+_EFFECT_KEY = "tickfx_effect"
+_runs = {}  # object name → the captured frames of its effect run, frame 1 first
 
 
 class SequenceError(ValueError):
@@ -113,6 +115,42 @@ def _on_frame_change(scene, *args):
     for obj in scene.objects:
         if _SEQUENCE_KEY in obj.keys():
             load_frame(obj, scene.frame_current)
+        elif _EFFECT_KEY in obj.keys() and obj.name in _runs:
+            frames = _runs[obj.name]
+            fill_mesh(obj.data, frames[min(max(scene.frame_current, 1), len(frames)) - 1])
+
+
+def scene_frame(scene):
+    """One frame of `scene` in seconds, exact: 1/24, 1001/30000 for 29.97 (fps_base is a float
+    close to 1.001)."""
+    base = Fraction(scene.render.fps_base).limit_denominator(1001)
+    return base / scene.render.fps
+
+
+def run_effect(context, path, report=None):
+    """Runs the effect file at `path` from frame 1 to the scene's end frame at the scene's frame
+    rate, capturing each frame, and makes the object that shows them. Its lint warnings go to
+    `report(level, text)`. tickfx.EffectError before anything is made for an effect with errors."""
+    import bpy
+
+    for line in tickfx.check(path):
+        if report is not None:
+            report({"WARNING"}, line)
+    system = tickfx.load_effect(path)
+    frame = scene_frame(context.scene)
+    frames = []
+    for _ in range(max(1, context.scene.frame_end)):
+        system.advance(frame)
+        frames.append(system.capture())
+    name = os.path.splitext(os.path.basename(path))[0]
+    mesh = bpy.data.meshes.new(name)
+    fill_mesh(mesh, frames[0])
+    obj = bpy.data.objects.new(name, mesh)
+    obj[_EFFECT_KEY] = os.path.abspath(path)
+    context.scene.collection.objects.link(obj)
+    _runs[obj.name] = frames
+    _on_frame_change(context.scene)
+    return obj
 
 
 def import_sequence(context, folder):
@@ -163,6 +201,46 @@ def _operator_class():
     return ImportCacheSequence
 
 
+def _run_classes():
+    import bpy
+    from bpy.props import StringProperty
+
+    class RunEffect(bpy.types.Operator):
+        """Run a tickfx effect file at the scene's frame rate and show its frames"""
+
+        bl_idname = "object.tickfx_run_effect"
+        bl_label = "Run a tickfx effect"
+        bl_options = {"REGISTER", "UNDO"}
+
+        filepath: StringProperty(subtype="FILE_PATH")
+        filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+
+        def execute(self, context):
+            try:
+                run_effect(context, self.filepath, self.report)
+            except (tickfx.EffectError, tickfx.CacheError, ValueError, OSError) as e:
+                self.report({"ERROR"}, str(e))
+                return {"CANCELLED"}
+            return {"FINISHED"}
+
+        def invoke(self, context, event):
+            context.window_manager.fileselect_add(self)
+            return {"RUNNING_MODAL"}
+
+    class EffectPanel(bpy.types.Panel):
+        bl_idname = "VIEW3D_PT_tickfx"
+        bl_label = "tickfx"
+        bl_space_type = "VIEW_3D"
+        bl_region_type = "UI"
+        bl_category = "tickfx"
+
+        def draw(self, context):
+            self.layout.operator("object.tickfx_run_effect", text="Run an effect file")
+            self.layout.operator("import_scene.tickfx_cache_sequence", text="Import caches")
+
+    return [RunEffect, EffectPanel]
+
+
 _classes = []
 
 
@@ -176,6 +254,7 @@ def register():
     if _classes:
         return
     _classes.append(_operator_class())
+    _classes.extend(_run_classes())
     for cls in _classes:
         bpy.utils.register_class(cls)
     bpy.types.TOPBAR_MT_file_import.append(_menu)

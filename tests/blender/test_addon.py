@@ -76,4 +76,37 @@ for folder, message in ((empty, "no tickfx caches"), (gap, "frame_0005.vdb is mi
         assert message in str(e), str(e)
         print(f"refused {os.path.basename(folder)}: {str(e).strip()}")
 assert set(bpy.data.objects.keys()) == objects_before | {"fountain"}, bpy.data.objects.keys()
+
+# Run the effect in Blender at the scene's rate: frame f shows what a System advanced by f frames
+# of the scene captures, bit for bit.
+scene.render.fps, scene.render.fps_base = 24, 1.0
+scene.frame_end = 12
+effect = os.path.join(samples, "fountain.toml")
+assert bpy.ops.object.tickfx_run_effect(filepath=effect) == {"FINISHED"}
+ran = bpy.data.objects["fountain.001"]
+system = tickfx.load_effect(effect)
+for frame in range(1, 13):
+    system.advance(tickfx.blender.scene_frame(scene))
+    if frame in (1, 12):
+        scene.frame_set(frame)
+        expected = system.capture()
+        co = np.empty(len(ran.data.vertices) * 3, dtype=np.float32)
+        ran.data.vertices.foreach_get("co", co)
+        assert np.array_equal(co.reshape(-1, 3), expected["P"]), frame
+        assert np.array_equal(attribute(ran.data, "age", 1), expected["age"]), frame
+        print(f"run frame {frame}: {len(expected['P'])} points equal capture()")
+scene.render.fps, scene.render.fps_base = 30, 1.001
+assert tickfx.blender.scene_frame(scene) == tickfx.blender.Fraction(1001, 30000)
+
+# The add-on zip, installed and enabled as a user would (into BLENDER_USER_SCRIPTS, which the
+# test points at its own folder), registers the same operators.
+tickfx.blender.unregister()
+assert not hasattr(bpy.types, "IMPORT_SCENE_OT_tickfx_cache_sequence")
+archive = os.path.join(work, "tickfx_blender.zip")
+tickfx.blender.write_addon_zip(archive)
+assert bpy.ops.preferences.addon_install(filepath=archive) == {"FINISHED"}
+assert bpy.ops.preferences.addon_enable(module="tickfx_blender") == {"FINISHED"}
+assert hasattr(bpy.types, "IMPORT_SCENE_OT_tickfx_cache_sequence")
+assert hasattr(bpy.types, "OBJECT_OT_tickfx_run_effect")
+print("add-on zip: installed and enabled")
 print("tickfx.blender: all checks passed")
