@@ -15,9 +15,9 @@ namespace {
 // components when `columns` holds them (hitpos → hitpos_x, _y, _z), else the name itself.
 std::vector<std::string> columnsOfName(const std::string& name,
                                        const std::vector<std::string>& columns) {
-  if (name == "Cd") return LifeAttributeSettings::columnNamesOf(name);
-  if (std::find(columns.begin(), columns.end(), name + "_x") != columns.end()) {
-    return {name + "_x", name + "_y", name + "_z"};
+  const std::array<std::string, 3> vector = vectorColumnNames(name);
+  if (name == "Cd" || std::find(columns.begin(), columns.end(), vector[0]) != columns.end()) {
+    return {vector.begin(), vector.end()};
   }
   return {name};
 }
@@ -160,27 +160,38 @@ EventEmission::EventEmission(const std::vector<Emitter>& emitters,
   }
 }
 
-int EventEmission::listened(const ParticlePool& pool, std::size_t emitterColumn, std::size_t row,
-                            EmitterEvent kind) const {
-  const int e = LifeAttributeSet::emitterOf(pool, emitterColumn, row);
+EventEmission::Rows EventEmission::rowsOf(const ParticlePool& pool) const {
+  Rows rows{pool, LifeAttributeSet::emitterColumn(pool), {}};
+  for (const std::string& c : inherited_) {
+    rows.inherited.push_back(pool.attribute(pool.findAttribute(c)).data());
+  }
+  return rows;
+}
+
+int EventEmission::listened(const Rows& rows, std::size_t row, EmitterEvent kind) const {
+  const int e = LifeAttributeSet::emitterOf(rows.emitters, row);
   return e >= 0 && !listeners(static_cast<std::uint32_t>(e), kind).empty() ? e : -1;
 }
 
-void EventEmission::record(const ParticlePool& pool, std::size_t row, ParticleEvent event,
+void EventEmission::record(const Rows& rows, std::size_t row, ParticleEvent event,
                            std::vector<ParticleEvent>& events, std::vector<float>& values) const {
+  const ParticlePool& pool = rows.pool;
   event.parentId = pool.id()[row];
   events.push_back(event);
   const auto r = static_cast<Eigen::Index>(row);
   for (std::size_t j = 0; j < inherited_.size(); ++j) {
-    values.push_back(inheritedLife_[j] >= 0
-                         ? attributes_->rowValue(inheritedLife_[j], pool, row, pool.age()[r])
-                         : pool.attribute(pool.findAttribute(inherited_[j]))[r]);
+    const float stored = rows.inherited[j][row];
+    values.push_back(
+        inheritedLife_[j] < 0
+            ? stored
+            : attributes_->rowValue(inheritedLife_[j], static_cast<int>(event.parentEmitter),
+                                    event.parentId, pool.age()[r], pool.lifetime()[r], stored));
   }
 }
 
 EventEmission::EventList EventEmission::births(const ParticlePool& pool, std::size_t begin,
                                                std::size_t end) const {
-  const std::size_t emitterColumn = pool.findAttribute(kEmitterColumn);
+  const Rows rows = rowsOf(pool);
   const std::size_t blocks = (end - begin + kParallelBlockRows - 1) / kParallelBlockRows;
   std::vector<std::vector<ParticleEvent>> events(blocks);
   std::vector<std::vector<float>> values(blocks);
@@ -188,8 +199,8 @@ EventEmission::EventList EventEmission::births(const ParticlePool& pool, std::si
     const std::size_t from = begin + b * kParallelBlockRows;
     const std::size_t to = std::min(end, from + kParallelBlockRows);
     for (std::size_t i = from; i < to; ++i) {
-      const int e = listened(pool, emitterColumn, i, EmitterEvent::Birth);
-      if (e >= 0) record(pool, i, rowEvent(pool, i, e, EmitterEvent::Birth), events[b], values[b]);
+      const int e = listened(rows, i, EmitterEvent::Birth);
+      if (e >= 0) record(rows, i, rowEvent(pool, i, e, EmitterEvent::Birth), events[b], values[b]);
     }
   });
   return EventList{join(events), join(values)};
@@ -204,7 +215,7 @@ void EventEmission::gather(const ParticlePool& pool,
   if (!deaths && !hits) return;
   const std::size_t n = pool.size();
   const std::size_t blocks = (n + kParallelBlockRows - 1) / kParallelBlockRows;
-  const std::size_t emitterColumn = pool.findAttribute(kEmitterColumn);
+  const Rows rows = rowsOf(pool);
   const std::uint8_t* dead = pool.dead().data();
   std::vector<std::vector<ParticleEvent>> events(blocks);
   std::vector<std::vector<float>> values(blocks);
@@ -217,7 +228,7 @@ void EventEmission::gather(const ParticlePool& pool,
     const auto contactsThrough = [&](std::size_t row) {
       for (; c < list.size() && list[c].row <= row; ++c) {
         const ContactRecord& k = list[c];
-        const int e = listened(pool, emitterColumn, k.row, EmitterEvent::Collision);
+        const int e = listened(rows, k.row, EmitterEvent::Collision);
         if (e < 0) continue;
         ParticleEvent event;
         event.parentEmitter = static_cast<std::uint32_t>(e);
@@ -226,7 +237,7 @@ void EventEmission::gather(const ParticlePool& pool,
         event.position = k.point;
         event.velocity = k.velocity;
         event.normal = k.normal;
-        record(pool, k.row, event, events[b], values[b]);
+        record(rows, k.row, event, events[b], values[b]);
       }
     };
     if (deaths) {
@@ -242,9 +253,9 @@ void EventEmission::gather(const ParticlePool& pool,
         // A non-finite kill is no death: its state is not a place to emit from.
         if (dead[i] == 0 || (dead[i] & NonfiniteCheck::kFlag) != 0) continue;
         contactsThrough(i);
-        const int e = listened(pool, emitterColumn, i, EmitterEvent::Death);
+        const int e = listened(rows, i, EmitterEvent::Death);
         if (e >= 0)
-          record(pool, i, rowEvent(pool, i, e, EmitterEvent::Death), events[b], values[b]);
+          record(rows, i, rowEvent(pool, i, e, EmitterEvent::Death), events[b], values[b]);
       }
     }
     contactsThrough(end);

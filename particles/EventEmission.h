@@ -75,10 +75,17 @@ class EventEmission {
   const std::vector<Listener>& listeners(std::uint32_t parent, EmitterEvent kind) const {
     return listeners_[static_cast<std::size_t>(kind)][parent];
   }
+  // The columns the events of a tick read, looked up once for all its rows.
+  struct Rows {
+    const ParticlePool& pool;
+    const float* emitters;                // kEmitterColumn
+    std::vector<const float*> inherited;  // inherited_'s columns
+  };
+  Rows rowsOf(const ParticlePool& pool) const;
   // The emitter of row `row` when a sub-emitter listens to its events of `kind`, else −1.
-  int listened(const ParticlePool& pool, std::size_t emitterColumn, std::size_t row,
-               EmitterEvent kind) const;
-  void record(const ParticlePool& pool, std::size_t row, ParticleEvent event,
+  int listened(const Rows& rows, std::size_t row, EmitterEvent kind) const;
+  // Appends `event` of row `row` and the row's inherited values at the event.
+  void record(const Rows& rows, std::size_t row, ParticleEvent event,
               std::vector<ParticleEvent>& events, std::vector<float>& values) const;
   EventList births(const ParticlePool& pool, std::size_t begin, std::size_t end) const;
   void spawnChildren(ParticlePool& pool, std::int64_t tick, const EventList& list) const;

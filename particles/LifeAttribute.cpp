@@ -17,9 +17,15 @@ std::string floatText(float v) {
 
 }  // namespace
 
-std::vector<std::string> LifeAttributeSettings::columnNamesOf(const std::string& name) {
+std::array<std::string, 3> vectorColumnNames(const std::string& name) {
   if (name == "Cd") return {"Cd_r", "Cd_g", "Cd_b"};
-  return {name};
+  return {name + "_x", name + "_y", name + "_z"};
+}
+
+std::vector<std::string> LifeAttributeSettings::columnNamesOf(const std::string& name) {
+  if (name != "Cd") return {name};
+  const std::array<std::string, 3> c = vectorColumnNames(name);
+  return {c.begin(), c.end()};
 }
 
 float LifeAttributeSettings::defaultValue(const std::string& column) {

@@ -59,6 +59,10 @@ struct LifeAttributeSettings {
   SettingProblems validate() const;
 };
 
+/// The three float columns a vector attribute is held in, in the pool and in caches: `Cd_r`,
+/// `Cd_g`, `Cd_b` for Houdini's colour, `<name>_x`, `_y`, `_z` for any other (hitpos).
+std::array<std::string, 3> vectorColumnNames(const std::string& name);
+
 /// A particle's uniform in [0, 1) for an attribute, from 64 random bits: the top 24 bits, exact
 /// in float (no double on the way).
 inline float unitFromBits(std::uint64_t bits) {

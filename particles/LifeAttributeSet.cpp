@@ -41,61 +41,39 @@ int LifeAttributeSet::find(const std::string& column) const {
   return it == columns_.end() ? -1 : static_cast<int>(it - columns_.begin());
 }
 
-int LifeAttributeSet::emitterOf(const ParticlePool& pool, std::size_t emitterColumn,
-                                std::size_t row) {
-  if (emitterColumn == ParticlePool::npos) return 0;
-  return static_cast<int>(pool.attribute(emitterColumn)[static_cast<Eigen::Index>(row)]);
+const float* LifeAttributeSet::emitterColumn(const ParticlePool& pool) {
+  const std::size_t c = pool.findAttribute(kEmitterColumn);
+  return c == ParticlePool::npos ? nullptr : pool.attribute(c).data();
 }
 
-float LifeAttributeSet::value(const Source& s, std::uint32_t emitter, std::uint64_t id, float age,
-                              float lifetime) const {
+float LifeAttributeSet::rowValue(int column, int emitter, std::uint64_t id, float age,
+                                 float lifetime, float stored) const {
+  if (emitter < 0 || static_cast<std::size_t>(emitter) >= lists_.size()) return stored;
+  const Source& s = sources_[static_cast<std::size_t>(column)][static_cast<std::size_t>(emitter)];
+  if (s.settings == nullptr) return stored;
   float u = 0.0f;
   if (s.settings->kind == LifeAttributeSettings::Kind::Random) {
-    u = unitFromBits(ParticleRandom(seed_, emitter, id).bits(s.purpose));
+    u = unitFromBits(
+        ParticleRandom(seed_, static_cast<std::uint32_t>(emitter), id).bits(s.purpose));
   }
   return s.settings->evaluate(s.component, normalisedAge(age, lifetime), u);
-}
-
-float LifeAttributeSet::rowValue(int column, const ParticlePool& pool, std::size_t row,
-                                 float age) const {
-  const std::string& name = columns_[static_cast<std::size_t>(column)];
-  const std::size_t stored = pool.findAttribute(name);
-  const int e = emitterOf(pool, pool.findAttribute(kEmitterColumn), row);
-  const auto r = static_cast<Eigen::Index>(row);
-  if (e >= 0 && static_cast<std::size_t>(e) < lists_.size()) {
-    const Source& s = sources_[static_cast<std::size_t>(column)][static_cast<std::size_t>(e)];
-    if (s.settings != nullptr) {
-      return value(s, static_cast<std::uint32_t>(e), pool.id()[row], age, pool.lifetime()[r]);
-    }
-  }
-  return stored != ParticlePool::npos ? pool.attribute(stored)[r]
-                                      : LifeAttributeSettings::defaultValue(name);
 }
 
 void LifeAttributeSet::evaluate(int column, const ParticlePool& pool, const float* ages,
                                 const FloatDestination& out) const {
   const std::string& name = columns_[static_cast<std::size_t>(column)];
-  const std::vector<Source>& sources = sources_[static_cast<std::size_t>(column)];
   const std::size_t storedColumn = pool.findAttribute(name);
   const float* stored =
       storedColumn == ParticlePool::npos ? nullptr : pool.attribute(storedColumn).data();
   const float fallback = LifeAttributeSettings::defaultValue(name);
-  const std::size_t emitterColumn = pool.findAttribute(kEmitterColumn);
+  const float* emitters = emitterColumn(pool);
   const float* life = pool.lifetime().data();
   const std::uint64_t* ids = pool.id().data();
   parallelForRows(pool.size(), [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      const int source = emitterOf(pool, emitterColumn, i);
-      const Source* s = source >= 0 && static_cast<std::size_t>(source) < sources.size()
-                            ? &sources[static_cast<std::size_t>(source)]
-                            : nullptr;
-      float v = 0.0f;
-      if (s != nullptr && s->settings != nullptr) {
-        v = value(*s, static_cast<std::uint32_t>(source), ids[i], ages[i], life[i]);
-      } else {
-        v = stored != nullptr ? stored[i] : fallback;
-      }
-      *reinterpret_cast<float*>(reinterpret_cast<char*>(out.data) + i * out.rowStride) = v;
+      *reinterpret_cast<float*>(reinterpret_cast<char*>(out.data) + i * out.rowStride) =
+          rowValue(column, emitterOf(emitters, i), ids[i], ages[i], life[i],
+                   stored != nullptr ? stored[i] : fallback);
     }
   });
 }

@@ -48,11 +48,18 @@ class LifeAttributeSet {
   /// depend on the thread count.
   void evaluate(int column, const ParticlePool& pool, const float* ages,
                 const FloatDestination& out) const;
-  /// One row's value of `column` at age `age` (for what children inherit at an event).
-  float rowValue(int column, const ParticlePool& pool, std::size_t row, float age) const;
+  /// One particle's value of `column`: that of its emitter's declaration (emitter −1: none), else
+  /// `stored` (its pool column's value, or defaultValue() where the pool has none). For a frame's
+  /// rows (evaluate()) and for what children inherit at an event.
+  float rowValue(int column, int emitter, std::uint64_t id, float age, float lifetime,
+                 float stored) const;
 
-  /// Which emitter made row `row` (−1: none), from kEmitterColumn or, without it, the only one.
-  static int emitterOf(const ParticlePool& pool, std::size_t emitterColumn, std::size_t row);
+  /// kEmitterColumn's values in `pool`, or null when it has none (every row is then emitter 0).
+  static const float* emitterColumn(const ParticlePool& pool);
+  /// Which emitter made row `row` (−1: none) by emitterColumn()'s values.
+  static int emitterOf(const float* emitters, std::size_t row) {
+    return emitters != nullptr ? static_cast<int>(emitters[row]) : 0;
+  }
 
  private:
   struct Source {
@@ -60,9 +67,6 @@ class LifeAttributeSet {
     int component = 0;
     std::uint32_t purpose = 0;  // the random draw's purpose
   };
-  float value(const Source& s, std::uint32_t emitter, std::uint64_t id, float age,
-              float lifetime) const;
-
   std::vector<std::vector<LifeAttributeSettings>> lists_;  // per emitter; sources point in
   std::uint64_t seed_ = 0;
   bool needsEmitterColumn_ = false;

@@ -1,10 +1,11 @@
 #include "io/cache/AttributeGroups.h"
 
+#include "particles/LifeAttribute.h"
+
 namespace tickfx::io {
 
 std::array<std::string, 3> vectorColumns(const std::string& name) {
-  if (name == "Cd") return {"Cd_r", "Cd_g", "Cd_b"};
-  return {name + "_x", name + "_y", name + "_z"};
+  return vectorColumnNames(name);
 }
 
 bool isIntAttribute(const std::string& name) {

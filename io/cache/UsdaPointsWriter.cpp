@@ -42,9 +42,10 @@ struct UsdaPointsWriter::Stream {
   std::string type;  // "point3f[]", "float[]", ...
   std::string name;  // "points", "primvars:age", ...
   bool primvar = false;
-  // The first column it reads: a FrameData::attributes index, or a marker of a fixed column
-  // (columnOf()); a vector reads three from there.
-  std::vector<std::size_t> attributes;
+  // What it reads of a frame: a fixed column, or the attributes from index `attribute` on (three
+  // for a vector).
+  enum class Column { Position, Velocity, Age, Life, Mass, Attribute } column = Column::Attribute;
+  std::size_t attribute = 0;
   enum class Kind { Float, Int, Vec3, Ids, Width } kind = Kind::Float;
   std::filesystem::path file;
   std::ofstream out;
@@ -73,70 +74,67 @@ void UsdaPointsWriter::removeStreams() {
 
 void UsdaPointsWriter::open(const FrameData& first) {
   attributeNames_ = first.attributeNames;
-  const auto add = [&](std::string type, std::string name, Stream::Kind kind,
-                       std::vector<std::size_t> attributes, bool primvar) {
+  using Column = Stream::Column;
+  const auto add = [&](std::string type, std::string name, Stream::Kind kind, Column column,
+                       std::size_t attribute, bool primvar) {
     auto s = std::make_unique<Stream>();
     s->type = std::move(type);
     s->name = std::move(name);
     s->kind = kind;
-    s->attributes = std::move(attributes);
+    s->column = column;
+    s->attribute = attribute;
     s->primvar = primvar;
     s->file = parts_ / (std::to_string(streams_.size()) + ".samples");
     s->out.open(s->file, std::ios::binary);
     if (!s->out) throw WriteError(s->file, "cannot open");
     streams_.push_back(std::move(s));
   };
-  // The fixed columns take the sizes npos - k (not attribute indices): see columnsOf().
-  constexpr std::size_t kPosition = static_cast<std::size_t>(-1),
-                        kVelocity = static_cast<std::size_t>(-2),
-                        kAge = static_cast<std::size_t>(-3), kLife = static_cast<std::size_t>(-4),
-                        kMass = static_cast<std::size_t>(-5);
-  add("point3f[]", "points", Stream::Kind::Vec3, {kPosition}, false);
-  add("vector3f[]", "velocities", Stream::Kind::Vec3, {kVelocity}, false);
-  add("int64[]", "ids", Stream::Kind::Ids, {}, false);
-  add("float[]", "primvars:age", Stream::Kind::Float, {kAge}, true);
-  add("float[]", "primvars:life", Stream::Kind::Float, {kLife}, true);
-  add("float[]", "primvars:mass", Stream::Kind::Float, {kMass}, true);
+  add("point3f[]", "points", Stream::Kind::Vec3, Column::Position, 0, false);
+  add("vector3f[]", "velocities", Stream::Kind::Vec3, Column::Velocity, 0, false);
+  add("int64[]", "ids", Stream::Kind::Ids, Column::Attribute, 0, false);
+  add("float[]", "primvars:age", Stream::Kind::Float, Column::Age, 0, true);
+  add("float[]", "primvars:life", Stream::Kind::Float, Column::Life, 0, true);
+  add("float[]", "primvars:mass", Stream::Kind::Float, Column::Mass, 0, true);
   // The attributes in the frame's order (a reader rebuilds that order), Houdini's radius, colour
   // and opacity under UsdGeom's names.
   for (const AttributeGroup& g : attributeGroups(first.attributeNames)) {
     if (g.name == "pscale" && g.kind == AttributeKind::Float) {
-      add("float[]", "widths", Stream::Kind::Width, {g.column}, false);
+      add("float[]", "widths", Stream::Kind::Width, Column::Attribute, g.column, false);
     } else if (g.name == "Cd" && g.kind == AttributeKind::Vec3) {
-      add("color3f[]", "primvars:displayColor", Stream::Kind::Vec3, {g.column}, true);
+      add("color3f[]", "primvars:displayColor", Stream::Kind::Vec3, Column::Attribute, g.column,
+          true);
     } else if (g.name == "Alpha" && g.kind == AttributeKind::Float) {
-      add("float[]", "primvars:displayOpacity", Stream::Kind::Float, {g.column}, true);
+      add("float[]", "primvars:displayOpacity", Stream::Kind::Float, Column::Attribute, g.column,
+          true);
     } else if (g.kind == AttributeKind::Vec3) {
-      add("vector3f[]", "primvars:" + g.name, Stream::Kind::Vec3, {g.column}, true);
+      add("vector3f[]", "primvars:" + g.name, Stream::Kind::Vec3, Column::Attribute, g.column,
+          true);
     } else if (g.kind == AttributeKind::Int) {
-      add("int[]", "primvars:" + g.name, Stream::Kind::Int, {g.column}, true);
+      add("int[]", "primvars:" + g.name, Stream::Kind::Int, Column::Attribute, g.column, true);
     } else {
-      add("float[]", "primvars:" + g.name, Stream::Kind::Float, {g.column}, true);
+      add("float[]", "primvars:" + g.name, Stream::Kind::Float, Column::Attribute, g.column, true);
     }
   }
 }
 
-namespace {
-
-// The columns a stream reads from `frame`: the fixed ones by their markers, else attributes.
-const FloatColumn& columnOf(const FrameData& f, std::size_t marker, int component) {
-  switch (marker) {
-    case static_cast<std::size_t>(-1):
+// Component `component` of what stream `s` reads of frame `f`.
+const FloatColumn& UsdaPointsWriter::columnOf(const FrameData& f, const Stream& s, int component) {
+  switch (s.column) {
+    case Stream::Column::Position:
       return f.position[component];
-    case static_cast<std::size_t>(-2):
+    case Stream::Column::Velocity:
       return f.velocity[component];
-    case static_cast<std::size_t>(-3):
+    case Stream::Column::Age:
       return f.age;
-    case static_cast<std::size_t>(-4):
+    case Stream::Column::Life:
       return f.life;
-    case static_cast<std::size_t>(-5):
+    case Stream::Column::Mass:
       return f.mass;
-    default:
-      return f.attributes[marker + static_cast<std::size_t>(component)];
+    case Stream::Column::Attribute:
+      break;
   }
+  return f.attributes[s.attribute + static_cast<std::size_t>(component)];
 }
-
-}  // namespace
 
 void UsdaPointsWriter::write(const FrameData& frame) {
   if (!started_) {
@@ -170,19 +168,19 @@ void UsdaPointsWriter::write(const FrameData& frame) {
           appendInt(line, static_cast<std::int64_t>(frame.id[i]));
           break;
         case Stream::Kind::Int:
-          appendInt(line, static_cast<std::int64_t>(columnOf(frame, s->attributes[0], 0)[r]));
+          appendInt(line, static_cast<std::int64_t>(columnOf(frame, *s, 0)[r]));
           break;
         case Stream::Kind::Float:
-          appendFloat(line, columnOf(frame, s->attributes[0], 0)[r]);
+          appendFloat(line, columnOf(frame, *s, 0)[r]);
           break;
         case Stream::Kind::Width:  // a diameter: twice the radius, exact in float
-          appendFloat(line, 2.0f * columnOf(frame, s->attributes[0], 0)[r]);
+          appendFloat(line, 2.0f * columnOf(frame, *s, 0)[r]);
           break;
         case Stream::Kind::Vec3:
           line += '(';
           for (int c = 0; c < 3; ++c) {
             if (c > 0) line += ", ";
-            appendFloat(line, columnOf(frame, s->attributes[0], c)[r]);
+            appendFloat(line, columnOf(frame, *s, c)[r]);
           }
           line += ')';
           break;

@@ -62,6 +62,7 @@ class UsdaPointsWriter {
  private:
   struct Stream;
   void open(const FrameData& first);
+  static const FloatColumn& columnOf(const FrameData& f, const Stream& s, int component);
   void removeStreams();
 
   std::filesystem::path path_;

@@ -1,6 +1,7 @@
 #include "io/cache/UsdaReader.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -487,8 +488,29 @@ FrameData readUsdaFrame(const std::filesystem::path& path, std::int64_t frame) {
             "a value");
       }
     };
+    // Each attribute column of the frame: the layer's attribute, the component read of its
+    // `width` numbers a point, and whether it is a diameter (widths: pscale is half).
+    struct Source {
+      const Attribute* attribute;
+      int component, width;
+      bool halved;
+    };
     std::vector<std::string> names;
-    std::vector<std::pair<const Attribute*, int>> sources;  // attribute, component (−1: halved)
+    std::vector<Source> sources;
+    const auto add = [&](const Attribute& a, const std::string& column) {
+      const bool vector = a.type == "vector3f[]" || a.type == "float3[]" || a.type == "color3f[]" ||
+                          a.type == "point3f[]" || a.type == "normal3f[]";
+      if (!vector) {
+        names.push_back(column);
+        sources.push_back({&a, 0, 1, a.name == "widths"});
+        return;
+      }
+      const std::array<std::string, 3> components = vectorColumns(column);
+      for (int c = 0; c < 3; ++c) {
+        names.push_back(components[static_cast<std::size_t>(c)]);
+        sources.push_back({&a, c, 3, false});
+      }
+    };
     for (const Attribute& a : layer.attributes) {
       const std::string& name = a.name;
       if (name == "points" || name == "velocities" || name == "ids" || name == "primvars:age" ||
@@ -496,28 +518,13 @@ FrameData readUsdaFrame(const std::filesystem::path& path, std::int64_t frame) {
         continue;
       }
       if (name == "widths") {
-        names.push_back("pscale");
-        sources.emplace_back(&a, -1);
+        add(a, "pscale");
       } else if (name == "primvars:displayColor") {
-        for (int c = 0; c < 3; ++c) {
-          names.push_back(vectorColumns("Cd")[static_cast<std::size_t>(c)]);
-          sources.emplace_back(&a, c);
-        }
+        add(a, "Cd");
       } else if (name == "primvars:displayOpacity") {
-        names.push_back("Alpha");
-        sources.emplace_back(&a, 0);
+        add(a, "Alpha");
       } else if (name.rfind("primvars:", 0) == 0) {
-        const std::string base = name.substr(9);
-        if (a.type == "vector3f[]" || a.type == "float3[]" || a.type == "color3f[]" ||
-            a.type == "point3f[]" || a.type == "normal3f[]") {
-          for (int c = 0; c < 3; ++c) {
-            names.push_back(vectorColumns(base)[static_cast<std::size_t>(c)]);
-            sources.emplace_back(&a, c);
-          }
-        } else {
-          names.push_back(base);
-          sources.emplace_back(&a, 0);
-        }
+        add(a, name.substr(9));
       }
     }
     FrameData data;
@@ -545,19 +552,18 @@ FrameData readUsdaFrame(const std::filesystem::path& path, std::int64_t frame) {
     floats(sampleOf(required("primvars:life"), 1), 0, 1, data.life);
     floats(sampleOf(required("primvars:mass"), 1), 0, 1, data.mass);
     for (std::size_t k = 0; k < sources.size(); ++k) {
-      const auto [a, component] = sources[k];
-      const bool vector = component > 0 || (component == 0 && a->sample && a->sample->width == 3);
-      const int width = vector ? 3 : 1;
-      const Flat& f = sampleOf(*a, width);
+      const Source& s = sources[k];
+      const Attribute& a = *s.attribute;
+      const Flat& f = sampleOf(a, s.width);
       FloatColumn& out = data.attributes[k];
-      if (a->type == "int[]") {
+      if (a.type == "int[]") {
         for (std::size_t i = 0; i < n; ++i) {
           out[static_cast<Eigen::Index>(i)] =
-              static_cast<float>(number<std::int64_t>(f.scalars[i], a->name));
+              static_cast<float>(number<std::int64_t>(f.scalars[i], a.name));
         }
       } else {
-        floats(f, std::max(component, 0), width, out);
-        if (component < 0) out *= 0.5f;  // widths are diameters: halved exactly
+        floats(f, s.component, s.width, out);
+        if (s.halved) out *= 0.5f;  // widths are diameters: halved exactly
       }
     }
     return data;

@@ -238,42 +238,8 @@ void readLifeAttributes(Context& cx, TableReader& r, EmitterSettings& e) {
 }
 
 void checkSubEmitters(Context& cx, const EffectSettings& effect) {
-  std::vector<std::string> names;
-  for (const EmitterSettings& e : effect.emitters) names.push_back(e.name);
-  for (const StructureSettings& s : effect.structures) names.push_back(s.name);
-  const auto at = [&](std::size_t emitter, const std::string& key) {
-    const std::string path = childPath(emitterKeyPath(effect, emitter), key);
-    return std::make_pair(path, cx.sources().find(path));
-  };
-  bool unknown = false;
-  for (std::size_t i = 0; i < effect.emitters.size(); ++i) {
-    const std::string& parent = effect.emitters[i].sub.parent;
-    if (parent.empty() || std::find(names.begin(), names.end(), parent) != names.end()) {
-      continue;
-    }
-    unknown = true;
-    std::vector<std::string> emitters(
-        names.begin(), names.begin() + static_cast<std::ptrdiff_t>(effect.emitters.size()));
-    const std::optional<std::string> guess = closestMatch(parent, emitters);
-    const auto [path, where] = at(i, "parent");
-    cx.error(where, path,
-             quote(parent) + " is not the name of an emitter" +
-                 (guess ? "; did you mean " + quote(*guess) + "?" : "") +
-                 " (expected the name of another [[emitters]] entry)");
-  }
-  if (unknown) return;
-  for (std::size_t s = 0; s < effect.structures.size(); ++s) {
-    for (std::size_t i = 0; i < effect.emitters.size(); ++i) {
-      if (effect.emitters[i].sub.parent == effect.structures[s].name) {
-        const auto [path, where] = at(i, "parent");
-        cx.error(where, path,
-                 quote(effect.structures[s].name) +
-                     " is a structure (expected a particle emitter: structures have no events)");
-        unknown = true;
-      }
-    }
-  }
-  if (unknown) return;
+  std::vector<std::string> emitters;
+  for (const EmitterSettings& e : effect.emitters) emitters.push_back(e.name);
   std::vector<std::string> columns;
   bool hits = effect.output.hits;
   for (const ColliderSettings& c : effect.colliders) hits |= c.recordHits;
@@ -281,11 +247,28 @@ void checkSubEmitters(Context& cx, const EffectSettings& effect) {
   for (const EmitterSettings& e : effect.emitters) {
     if (e.sub.on == EmitterEvent::Collision) columns.push_back(kContactsColumn);
   }
+  // The core's check, placed at the entries' keys; a parent that names no emitter is told apart
+  // here from one that names a structure, and gets a suggestion.
   for (const SettingProblem& p : validateSubEmitters(effect.emitters, columns)) {
     const std::size_t dot = p.key.find('.');
     const std::size_t emitter = std::stoul(p.key.substr(0, dot));
-    const auto [path, where] = at(emitter, p.key.substr(dot + 1));
-    cx.error(where, path, p.message + " (expected " + p.expected + ")");
+    const std::string key = p.key.substr(dot + 1);
+    const std::string path = childPath(emitterKeyPath(effect, emitter), key);
+    std::string text = p.message + " (expected " + p.expected + ")";
+    const std::string& parent = effect.emitters[emitter].sub.parent;
+    if (key == "parent" && std::find(emitters.begin(), emitters.end(), parent) == emitters.end()) {
+      const bool structure =
+          std::any_of(effect.structures.begin(), effect.structures.end(),
+                      [&](const StructureSettings& st) { return st.name == parent; });
+      const std::optional<std::string> guess = closestMatch(parent, emitters);
+      text = structure ? quote(parent) +
+                             " is a structure (expected a particle emitter: "
+                             "structures have no events)"
+             : guess
+                 ? p.message + "; did you mean " + quote(*guess) + "? (expected " + p.expected + ")"
+                 : text;
+    }
+    cx.error(cx.sources().find(path), path, text);
   }
 }
 

@@ -131,8 +131,6 @@ def run_effect(context, path, report=None):
     """Runs the effect file at `path` from frame 1 to the scene's end frame at the scene's frame
     rate, capturing each frame, and makes the object that shows them. Its lint warnings go to
     `report(level, text)`. tickfx.EffectError before anything is made for an effect with errors."""
-    import bpy
-
     for line in tickfx.check(path):
         if report is not None:
             report({"WARNING"}, line)
@@ -142,14 +140,22 @@ def run_effect(context, path, report=None):
     for _ in range(max(1, context.scene.frame_end)):
         system.advance(frame)
         frames.append(system.capture())
-    name = os.path.splitext(os.path.basename(path))[0]
-    mesh = bpy.data.meshes.new(name)
-    fill_mesh(mesh, frames[0])
-    obj = bpy.data.objects.new(name, mesh)
-    obj[_EFFECT_KEY] = os.path.abspath(path)
-    context.scene.collection.objects.link(obj)
+    obj = _points_object(context, os.path.splitext(os.path.basename(path))[0], frames[0],
+                         _EFFECT_KEY, os.path.abspath(path))
     _runs[obj.name] = frames
     _on_frame_change(context.scene)
+    return obj
+
+
+def _points_object(context, name, columns, key, source):
+    """A new object in the scene whose mesh shows `columns`, marked with `key` = `source`."""
+    import bpy
+
+    mesh = bpy.data.meshes.new(name)
+    fill_mesh(mesh, columns)
+    obj = bpy.data.objects.new(name, mesh)
+    obj[key] = source
+    context.scene.collection.objects.link(obj)
     return obj
 
 
@@ -157,75 +163,60 @@ def import_sequence(context, folder):
     """Makes the object of the cache sequence in `folder`, at the scene's frame, and sets the
     scene's frame range to the caches'. SequenceError or tickfx.CacheError before anything is
     made when the folder or its first frame cannot be read (no half-built object)."""
-    import bpy
-
     fmt, frames = scan_sequence(folder)
     first = tickfx.read_cache(frames[min(frames)])  # fails before anything is made
-    name = os.path.basename(os.path.normpath(folder)) or "tickfx"
-    mesh = bpy.data.meshes.new(name)
-    fill_mesh(mesh, first)
-    obj = bpy.data.objects.new(name, mesh)
-    obj[_SEQUENCE_KEY] = os.path.abspath(folder)
-    context.scene.collection.objects.link(obj)
+    obj = _points_object(context, os.path.basename(os.path.normpath(folder)) or "tickfx", first,
+                         _SEQUENCE_KEY, os.path.abspath(folder))
     context.scene.frame_start = min(frames)
     context.scene.frame_end = max(frames)
     load_frame(obj, context.scene.frame_current)
     return obj
 
 
-def _operator_class():
+def _blender_classes():
     import bpy
     from bpy.props import StringProperty
 
-    class ImportCacheSequence(bpy.types.Operator):
+    class PickThenAct:
+        """A file browser, then act(): an error is reported in Blender's UI and nothing is
+        left made (each action fails before it makes anything)."""
+
+        bl_options = {"REGISTER", "UNDO"}
+
+        def execute(self, context):
+            try:
+                self.act(context)
+            except (tickfx.CacheError, ValueError, OSError) as e:  # EffectError, SequenceError
+                self.report({"ERROR"}, str(e))
+                return {"CANCELLED"}
+            return {"FINISHED"}
+
+        def invoke(self, context, event):
+            context.window_manager.fileselect_add(self)
+            return {"RUNNING_MODAL"}
+
+    class ImportCacheSequence(PickThenAct, bpy.types.Operator):
         """Import a folder of tickfx caches as points that follow the frame"""
 
         bl_idname = "import_scene.tickfx_cache_sequence"
         bl_label = "tickfx cache sequence"
-        bl_options = {"REGISTER", "UNDO"}
 
         directory: StringProperty(subtype="DIR_PATH")
 
-        def execute(self, context):
-            try:
-                import_sequence(context, self.directory)
-            except (SequenceError, tickfx.CacheError, ValueError) as e:
-                self.report({"ERROR"}, str(e))
-                return {"CANCELLED"}
-            return {"FINISHED"}
+        def act(self, context):
+            import_sequence(context, self.directory)
 
-        def invoke(self, context, event):
-            context.window_manager.fileselect_add(self)
-            return {"RUNNING_MODAL"}
-
-    return ImportCacheSequence
-
-
-def _run_classes():
-    import bpy
-    from bpy.props import StringProperty
-
-    class RunEffect(bpy.types.Operator):
+    class RunEffect(PickThenAct, bpy.types.Operator):
         """Run a tickfx effect file at the scene's frame rate and show its frames"""
 
         bl_idname = "object.tickfx_run_effect"
         bl_label = "Run a tickfx effect"
-        bl_options = {"REGISTER", "UNDO"}
 
         filepath: StringProperty(subtype="FILE_PATH")
         filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
 
-        def execute(self, context):
-            try:
-                run_effect(context, self.filepath, self.report)
-            except (tickfx.EffectError, tickfx.CacheError, ValueError, OSError) as e:
-                self.report({"ERROR"}, str(e))
-                return {"CANCELLED"}
-            return {"FINISHED"}
-
-        def invoke(self, context, event):
-            context.window_manager.fileselect_add(self)
-            return {"RUNNING_MODAL"}
+        def act(self, context):
+            run_effect(context, self.filepath, self.report)
 
     class EffectPanel(bpy.types.Panel):
         bl_idname = "VIEW3D_PT_tickfx"
@@ -238,7 +229,7 @@ def _run_classes():
             self.layout.operator("object.tickfx_run_effect", text="Run an effect file")
             self.layout.operator("import_scene.tickfx_cache_sequence", text="Import caches")
 
-    return [RunEffect, EffectPanel]
+    return [ImportCacheSequence, RunEffect, EffectPanel]
 
 
 _classes = []
@@ -253,8 +244,7 @@ def register():
 
     if _classes:
         return
-    _classes.append(_operator_class())
-    _classes.extend(_run_classes())
+    _classes.extend(_blender_classes())
     for cls in _classes:
         bpy.utils.register_class(cls)
     bpy.types.TOPBAR_MT_file_import.append(_menu)
