@@ -13,6 +13,11 @@ TICKFX_PACKAGES=(
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libpng-dev libgif-dev
 )
 
+# What scripts/test adds for the Blender add-on's tests: Debian's Blender (3.4.1, headless with
+# -b), which runs Debian's python3 and so imports the tickfx module. scripts/demo does without it.
+# shellcheck disable=SC2034 # scripts/test installs them with the rest
+TICKFX_TEST_PACKAGES=(blender)
+
 # What scripts/test's aarch64 stage adds: Debian's cross compiler, qemu-user, and the arm64 builds
 # of the libraries (Multi-Arch: same, installed beside the amd64 ones). OpenVDB comes as its
 # runtime package only: its -dev package is not Multi-Arch (cmake/toolchains/aarch64-linux-gnu.cmake

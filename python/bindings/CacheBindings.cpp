@@ -236,6 +236,36 @@ void bindCaches(py::module_& m) {
       },
       py::arg("path"), py::arg("frame") = py::none());
   m.def(
+      "_cache_info",
+      [](const std::string& path) {
+        const Format format = formatOf(path);
+        if (format == Format::Usda)
+          throw py::value_error(path + ": a .usda layer is a whole run: usda_frames() lists it");
+        io::VdbCacheContents contents;
+        const io::FrameData frame = guardedIo([&] {
+          if (format == Format::Csv) return io::readCsvCache(path);
+          if (format == Format::Ply) return io::readPlyCache(path);
+          return io::readVdbPointCache(path, &contents);
+        });
+        // What the file records and nothing more: a CSV cache records no frame or time, a PLY
+        // cache no run.
+        py::dict out;
+        py::object none = py::none();
+        const bool timed = format != Format::Csv;
+        out["frame"] = timed ? py::object(py::int_(frame.frame)) : none;
+        out["time"] = timed ? py::object(py::float_(frame.timeSeconds)) : none;
+        out["points"] = frame.size();
+        const io::VdbCacheMetadata& meta = contents.metadata;
+        const bool run = format == Format::Vdb && !meta.effectHash.empty();
+        out["effect_hash"] = run ? py::object(py::str(meta.effectHash)) : none;
+        out["seed"] = run ? py::object(py::int_(meta.seed)) : none;
+        out["step_rate"] = run ? py::object(py::int_(meta.stepRateHz)) : none;
+        out["integrator"] = run ? py::object(py::str(meta.integrator)) : none;
+        out["version"] = run ? py::object(py::str(meta.tickfxVersion)) : none;
+        return out;
+      },
+      py::arg("path"));
+  m.def(
       "_usda_frames",
       [](const std::string& path) { return guardedIo([&] { return io::usdaFrames(path); }); },
       py::arg("path"));

@@ -29,6 +29,7 @@ from ._tickfx import FLICKS_PER_SECOND, CacheError, NonfiniteEvent, System, __ve
 __all__ = [
     "AdvanceResult",
     "CacheError",
+    "cache_info",
     "EffectError",
     "FLICKS_PER_SECOND",
     "NonfiniteEvent",
@@ -250,6 +251,18 @@ def read_cache(path, frame=None):
     OSError) with tickfx's message, naming the file, when it is missing, truncated or malformed.
     """
     return _tickfx._read_cache(_path_text(path), frame)
+
+
+def cache_info(path):
+    """What one frame cache (.csv, .ply or .vdb) records besides its rows, as a dict:
+        "frame": the frame number, "time": its time in seconds (None for CSV, which records
+            neither; a .vdb of another tool without them reads 0),
+        "points": the row count,
+        "effect_hash", "seed", "step_rate" (ticks per second), "integrator", "version": the run
+            that wrote a .vdb (None for PLY and CSV, and for a .vdb tickfx did not write).
+    The file is read whole, so a truncated or malformed file raises CacheError as read_cache does.
+    """
+    return _tickfx._cache_info(_path_text(path))
 
 
 def usda_frames(path):

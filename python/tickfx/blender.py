@@ -14,6 +14,9 @@ Blender has no 64-bit integer attribute), age, life, mass (FLOAT), Cd (FLOAT_COL
 pscale (FLOAT), the hit attributes and custom attributes (FLOAT, INT, FLOAT_VECTOR as read_cache
 gives them). Geometry nodes can instance on the points by pscale and colour by Cd. A frame
 handler reloads the frame on every frame change; frames outside the caches show the nearest.
+Import reads every file once first, so a corrupt file or caches of different effects (VDB
+caches record the effect's hash) are refused before anything is made, and sets the scene's
+frame range and frame rate from the caches (the times VDB and PLY caches record).
 Memory: one frame's arrays at a time.
 
 The panel in the 3D view's sidebar (tab "tickfx") runs an effect file in Blender: its lint
@@ -159,16 +162,52 @@ def _points_object(context, name, columns, key, source):
     return obj
 
 
+def check_sequence(folder):
+    """(format, {frame: path}, rate) of the cache sequence in `folder` once every file has been
+    read (tickfx.cache_info): its frames per second as a Fraction (None when the files record no
+    time: CSV, or a single frame). SequenceError naming the file when the files come from
+    different effects (their tickfx_effect_hash differs: VDB caches record it) or a file's own
+    frame number is not its name's; tickfx.CacheError naming the file when one is corrupt."""
+    fmt, frames = scan_sequence(folder)
+    infos = {f: tickfx.cache_info(path) for f, path in sorted(frames.items())}
+    first = min(frames)
+    for f, info in infos.items():
+        name = os.path.basename(frames[f])
+        hashes = (infos[first]["effect_hash"], info["effect_hash"])
+        if hashes[0] != hashes[1]:
+            raise SequenceError(f"{frames[f]}: another effect's cache (effect hash {hashes[1]}; "
+                                f"{os.path.basename(frames[first])} has {hashes[0]})")
+        if info["frame"] is not None and info["frame"] != f:
+            raise SequenceError(f"{frames[f]}: holds frame {info['frame']}, not {f} ({name})")
+    rate = None
+    last = max(frames)
+    if last > first and infos[first]["time"] is not None:
+        span = Fraction(infos[last]["time"]) - Fraction(infos[first]["time"])
+        if span > 0:  # the times were written as doubles: 1/24, 1001/30000 within 1e-12
+            rate = (Fraction(last - first) / span).limit_denominator(1001)
+    return fmt, frames, rate
+
+
+def set_scene_rate(scene, rate):
+    """Sets `scene`'s frame rate to `rate` frames per second (a Fraction) as Blender spells it:
+    24 as fps 24, base 1; 30000/1001 as fps 30, base 1.001."""
+    fps = -(-rate.numerator // rate.denominator)  # the whole rate at or above it
+    scene.render.fps = fps
+    scene.render.fps_base = float(Fraction(fps) / rate)
+
+
 def import_sequence(context, folder):
     """Makes the object of the cache sequence in `folder`, at the scene's frame, and sets the
-    scene's frame range to the caches'. SequenceError or tickfx.CacheError before anything is
-    made when the folder or its first frame cannot be read (no half-built object)."""
-    fmt, frames = scan_sequence(folder)
-    first = tickfx.read_cache(frames[min(frames)])  # fails before anything is made
+    scene's frame range and frame rate to the caches'. Every file is read first (check_sequence):
+    SequenceError or tickfx.CacheError before anything is made (no half-built object)."""
+    fmt, frames, rate = check_sequence(folder)
+    first = tickfx.read_cache(frames[min(frames)])
     obj = _points_object(context, os.path.basename(os.path.normpath(folder)) or "tickfx", first,
                          _SEQUENCE_KEY, os.path.abspath(folder))
     context.scene.frame_start = min(frames)
     context.scene.frame_end = max(frames)
+    if rate is not None:
+        set_scene_rate(context.scene, rate)
     load_frame(obj, context.scene.frame_current)
     return obj
 

@@ -2,8 +2,9 @@
 #   blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py -- \
 #       TICKFX_CLI SAMPLES_DIR WORK_DIR
 # The fountain's VDB caches imported as one object: at frames 1, 12 and 24 its vertices and
-# attributes equal tickfx.read_cache of the same files, a frame change updates them, and folders
-# that are not a sequence are refused by name with no object left behind.
+# attributes equal tickfx.read_cache of the same files, a frame change updates them, the scene
+# takes the caches' frame range and rate, and folders that are not one sequence (empty, a gap,
+# a corrupt file, caches of two effects) are refused by name with no object left behind.
 import os
 import shutil
 import subprocess
@@ -27,6 +28,9 @@ objects_before = set(bpy.data.objects.keys())
 assert bpy.ops.import_scene.tickfx_cache_sequence(directory=caches) == {"FINISHED"}
 obj = bpy.data.objects["fountain"]
 assert (scene.frame_start, scene.frame_end) == (1, 24), (scene.frame_start, scene.frame_end)
+assert (scene.render.fps, scene.render.fps_base) == (24, 1.0), scene.render.fps
+print(f"imported {obj.name}: frames {scene.frame_start} to {scene.frame_end} at "
+      f"{scene.render.fps} fps")
 
 
 def attribute(mesh, name, width):
@@ -67,8 +71,23 @@ corrupt = os.path.join(work, "corrupt")
 os.makedirs(corrupt)
 with open(os.path.join(corrupt, "frame_0001.vdb"), "wb") as f:
     f.write(b"not a vdb")
+# Frame 3 of the same effect with another seed: another effect hash.
+mixed = os.path.join(work, "mixed")
+shutil.copytree(caches, mixed)
+other = os.path.join(work, "other")
+subprocess.run([cli, "run", os.path.join(samples, "fountain.toml"), "--frames", "3",
+                "--format", "vdb", "--out", other, "--set", "simulation.seed=2", "--quiet"],
+               check=True)
+shutil.copy(os.path.join(other, "frame_0003.vdb"), os.path.join(mixed, "frame_0003.vdb"))
+# A corrupt file past the first frame is found at import too, before anything is made.
+late = os.path.join(work, "late")
+shutil.copytree(caches, late)
+with open(os.path.join(late, "frame_0020.vdb"), "r+b") as f:
+    f.truncate(200)
 for folder, message in ((empty, "no tickfx caches"), (gap, "frame_0005.vdb is missing"),
-                        (corrupt, "frame_0001.vdb")):
+                        (corrupt, "frame_0001.vdb"),
+                        (mixed, "frame_0003.vdb: another effect's cache"),
+                        (late, "frame_0020.vdb")):
     try:
         bpy.ops.import_scene.tickfx_cache_sequence(directory=folder)
         raise AssertionError(f"{folder} imported")
@@ -97,6 +116,16 @@ for frame in range(1, 13):
         print(f"run frame {frame}: {len(expected['P'])} points equal capture()")
 scene.render.fps, scene.render.fps_base = 30, 1.001
 assert tickfx.blender.scene_frame(scene) == tickfx.blender.Fraction(1001, 30000)
+
+# Caches written at 30000/1001 fps set the scene to Blender's 29.97: fps 30, base 1.001.
+ntsc = os.path.join(work, "ntsc")
+subprocess.run([cli, "run", os.path.join(samples, "fountain.toml"), "--frames", "5",
+                "--fps", "30000/1001", "--format", "vdb", "--out", ntsc, "--quiet"], check=True)
+scene.render.fps, scene.render.fps_base = 24, 1.0
+assert bpy.ops.import_scene.tickfx_cache_sequence(directory=ntsc) == {"FINISHED"}
+assert scene.render.fps == 30 and abs(scene.render.fps_base - 1.001) < 1e-6  # a float32
+assert tickfx.blender.scene_frame(scene) == tickfx.blender.Fraction(1001, 30000)
+print(f"imported ntsc: {scene.render.fps} fps, base {scene.render.fps_base:.3f}")
 
 # The add-on zip, installed and enabled as a user would (into BLENDER_USER_SCRIPTS, which the
 # test points at its own folder), registers the same operators.

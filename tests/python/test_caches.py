@@ -252,6 +252,25 @@ def test_unreadable_caches_raise_cache_error(tmp_path, cli_frames):
                            {"P": np.zeros((1, 3), np.float32), "id": np.zeros(1, np.int64)})
 
 
+def test_cache_info_gives_what_each_format_records(cli_frames, tmp_path):
+    out, system = cli_frames
+    vdb = tickfx.cache_info(out / "frame_0036.vdb")
+    assert vdb["frame"] == 36 and vdb["time"] == 1.5 and vdb["points"] == system.count
+    assert len(vdb["effect_hash"]) == 16 and vdb["seed"] == 7 and vdb["step_rate"] == 120
+    assert vdb["integrator"] == "semi_implicit_euler" and vdb["version"] == tickfx.__version__
+    ply = tickfx.cache_info(out / "frame_0036.ply")
+    assert (ply["frame"], ply["time"], ply["points"]) == (36, 1.5, system.count)
+    assert ply["effect_hash"] is None and ply["seed"] is None
+    csv = tickfx.cache_info(out / "frame_0036.csv")
+    assert csv["frame"] is None and csv["time"] is None and csv["points"] == system.count
+    cut = tmp_path / "cut.vdb"
+    cut.write_bytes((out / "frame_0036.vdb").read_bytes()[:300])
+    with pytest.raises(tickfx.CacheError, match="cut.vdb"):
+        tickfx.cache_info(cut)
+    with pytest.raises(ValueError, match="usda_frames"):
+        tickfx.cache_info(tmp_path / "run.usda")
+
+
 def test_frames_between_ticks_are_the_cli_caches(cli, samples, tmp_path):
     """The fountain ticks at 120 Hz; at 50 fps four frames in five fall between two ticks and show
     interpolated positions, velocities and ages. Each frame Python captures equals the CLI's
