@@ -20,6 +20,7 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   particles/RenderDestination.h
   particles/RowViews.h
   particles/SettingProblem.h
+  particles/Shard.h
   particles/Spring.h
   particles/StateHash.h
   particles/Structure.h

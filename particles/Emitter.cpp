@@ -184,12 +184,14 @@ std::uint64_t Emitter::serialBefore(std::int64_t tick) const {
   return serial;
 }
 
-std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick) const {
+std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick,
+                            const Shard& shard) const {
   const std::uint64_t first = serialBefore(tick);
   const std::uint64_t last = serialBefore(tick + 1);
   // Serials are counted from tick 0, so a later tick never has made fewer particles.
   TICKFX_ASSERT(first <= last, "an emitter's serials going backwards");
   TICKFX_ASSERT(pool.size() <= pool.maxParticles(), "a pool past its maxParticles");
+  if (!shard.whole()) return emitShard(pool, seed, first, last, tick, shard);
   // Particles the pool has no room for are counted, not sampled.
   const std::uint64_t room = pool.maxParticles() - pool.size();
   const std::uint64_t tried = std::min<std::uint64_t>(last - first, room);
@@ -201,6 +203,21 @@ std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t
     for (std::size_t k = begin; k < end; ++k) pool.setRow(firstRow + k, sample(seed, first + k));
   });
   pool.refuseSpawns(last - first - tried);
+  return last - first;
+}
+
+std::uint64_t Emitter::emitShard(ParticlePool& pool, std::uint64_t seed, std::uint64_t first,
+                                 std::uint64_t last, std::int64_t tick, const Shard& shard) const {
+  // The shard's serials of [first, last): every count-th from the first it owns.
+  const std::uint64_t own = shard.firstOwnedSerial(index_, first);
+  const std::uint64_t owned = own < last ? (last - 1 - own) / shard.count + 1 : 0;
+  TICKFX_ASSERT(owned <= pool.maxParticles() - pool.size(), "a shard's pool reaching its cap");
+  const std::size_t firstRow = pool.appendRowsStrided(static_cast<std::size_t>(owned), tick,
+                                                      own - first, shard.count, last - first);
+  parallelForRows(static_cast<std::size_t>(owned), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k)
+      pool.setRow(firstRow + k, sample(seed, own + k * shard.count));
+  });
   return last - first;
 }
 

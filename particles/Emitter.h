@@ -14,6 +14,7 @@
 #include "particles/ParticlePool.h"
 #include "particles/Random.h"
 #include "particles/SettingProblem.h"
+#include "particles/Shard.h"
 
 namespace tickfx {
 
@@ -116,8 +117,12 @@ class Emitter {
   std::uint64_t serialBefore(std::int64_t tick) const;
 
   /// Spawns the particles of tick `tick` into `pool`; returns how many were attempted (spawns the
-  /// pool refused are counted there).
-  std::uint64_t emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick) const;
+  /// pool refused are counted there). A shard's pool gets its own particles of the tick
+  /// (Shard::ownerOfSerial) with the ids the whole run gives them; the ids of the others are
+  /// counted as handed out. The caller keeps a shard's pool from reaching maxParticles: a cap is
+  /// a count over every shard.
+  std::uint64_t emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick,
+                     const Shard& shard = {}) const;
 
   /// The particle with serial `serial` as it is born (pure function of seed, index and serial).
   ParticleInit sample(std::uint64_t seed, std::uint64_t serial) const;
@@ -134,6 +139,8 @@ class Emitter {
   const EmitterSettings& settings() const { return s_; }
 
  private:
+  std::uint64_t emitShard(ParticlePool& pool, std::uint64_t seed, std::uint64_t first,
+                          std::uint64_t last, std::int64_t tick, const Shard& shard) const;
   std::uint64_t rateCountBefore(std::int64_t tick) const;
   // A particle of `random` at `origin` plus the shape's offset, going along `dir` (unit) within the
   // spread around it (b1, b2 completing it to a basis).

@@ -132,7 +132,15 @@ std::size_t ParticlePool::spawn(const ParticleInit& init, std::int64_t tick) {
 }
 
 std::size_t ParticlePool::appendRows(std::size_t count, std::int64_t tick) {
+  return appendRowsStrided(count, tick, 0, 1, count);
+}
+
+std::size_t ParticlePool::appendRowsStrided(std::size_t count, std::int64_t tick,
+                                            std::uint64_t firstOffset, std::uint64_t stride,
+                                            std::uint64_t idsUsed) {
   TICKFX_ASSERT(count <= maxParticles_ - size_, "rows appended past maxParticles");
+  TICKFX_ASSERT(stride >= 1 && (count == 0 || firstOffset + (count - 1) * stride < idsUsed),
+                "strided ids past the ids handed out");
   const std::size_t first = size_;
   if (first + count > storageRows_) {
     // Geometric growth as one spawn at a time would make it, or room for the whole burst.
@@ -142,10 +150,11 @@ std::size_t ParticlePool::appendRows(std::size_t count, std::int64_t tick) {
   size_ += count;
   TICKFX_ASSERT(size_ <= storageRows_, "rows appended past the pool's storage");
   for (std::size_t i = first; i < size_; ++i) {
-    id_[i] = nextId_++;
+    id_[i] = nextId_ + firstOffset + (i - first) * stride;
     birthTick_[i] = tick;
     dead_[i] = 0;
   }
+  nextId_ += idsUsed;
   const auto head = static_cast<Eigen::Index>(first), n = static_cast<Eigen::Index>(count);
   for (NamedColumn& a : attributes_) a.values.segment(head, n).setConstant(a.initial);
   return first;

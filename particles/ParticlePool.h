@@ -67,6 +67,14 @@ class ParticlePool {
   /// maxParticles(). With every row set, the same rows, ids and bits as `count` spawn() calls in
   /// order: an emitter fills the rows of a burst in parallel.
   std::size_t appendRows(std::size_t count, std::int64_t tick);
+  /// Appends `count` rows born at `tick` whose ids are nextId() + firstOffset + k · stride
+  /// (k = 0 .. count − 1), then counts `idsUsed` ids as handed out: a shard's rows of a burst whose
+  /// other ids are other shards' (particles/Shard.h). The ids stay rising and below nextId().
+  /// appendRows(count, tick) is appendRowsStrided(count, tick, 0, 1, count).
+  std::size_t appendRowsStrided(std::size_t count, std::int64_t tick, std::uint64_t firstOffset,
+                                std::uint64_t stride, std::uint64_t idsUsed);
+  /// Counts `count` ids as handed out to particles this pool does not hold (another shard's).
+  void skipIds(std::uint64_t count) { nextId_ += count; }
   /// Gives row `row` (appended, not yet stepped) its particle: position (and previous position),
   /// velocity, lifetime and mass; acceleration (when kept) and age 0. Different rows may be set at
   /// once from different threads.

@@ -3,6 +3,8 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <climits>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #if defined(__SSE2__)
@@ -88,7 +90,8 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     StructureBuild build =
         buildStructure(structures[i], settings.seed, static_cast<std::uint32_t>(i));
     const std::int64_t tick = exact::tickAtOrAfter(structures[i].time, settings.stepRateHz);
-    structures_.push_back(PendingStructure{std::move(build), tick});
+    const std::size_t particles = build.particles.size();
+    structures_.push_back(PendingStructure{std::move(build), tick, particles});
   }
   if (!colliders.empty()) {
     colliders.addHitColumns(pool_);
@@ -292,7 +295,7 @@ void ParticleSystem::emitTick(std::int64_t tick) {
   const std::size_t tag = pool_.findAttribute(kEmitterColumn);
   for (const Emitter& e : emitters_) {
     const std::size_t before = pool_.size();
-    e.emit(pool_, settings_.seed, tick);
+    e.emit(pool_, settings_.seed, tick, shard_);
     if (tag != ParticlePool::npos && pool_.size() > before) {
       pool_.attribute(tag)
           .segment(static_cast<Eigen::Index>(before),
@@ -305,8 +308,15 @@ void ParticleSystem::emitTick(std::int64_t tick) {
 
 void ParticleSystem::runTick(bool keepVelocities) {
   emitTick(tick_);
-  for (PendingStructure& p : structures_) {
-    if (p.tick == tick_) spawnStructure(p.build);
+  for (std::size_t k = 0; k < structures_.size(); ++k) {
+    PendingStructure& p = structures_[k];
+    if (p.tick == tick_) {
+      // Another shard's structure takes its ids all the same (the cap never binds a shard).
+      if (shard_.ownerOfStructure(k) == shard_.index)
+        spawnStructure(p.build);
+      else
+        pool_.skipIds(p.particles);
+    }
     if (p.tick <= tick_) p.build = {};  // born (or before a restored tick): not needed again
   }
   if (keepVelocities) {
@@ -398,6 +408,49 @@ void ParticleSystem::restoreClock(std::int64_t tick, const Vec3Column* tickStart
   frameOffset_ = driver_.frameOffset();
   velocitiesTick_ = tickStartVelocities != nullptr ? tick : -1;
   if (tickStartVelocities != nullptr) previousVelocity_ = *tickStartVelocities;
+}
+
+void ParticleSystem::setShard(const Shard& shard) {
+  if (const std::optional<std::string> p = shard.problem())
+    throw std::invalid_argument("shard " + shard.text() + ": " + *p);
+  if (!shard.whole() && events_) {
+    throw std::invalid_argument("shard " + shard.text() +
+                                ": a system with sub-emitters cannot be sharded");
+  }
+  shard_ = shard;
+}
+
+std::uint64_t ParticleSystem::particleBound(std::int64_t ticks) const {
+  // At tick k's births, a particle of emitter e born at tick b is alive only if b > k − L_e:
+  // L_e ticks cover its longest lifetime, with one to spare for the tick its age reaches it.
+  std::vector<std::int64_t> window;
+  for (const Emitter& e : emitters_) {
+    const EmitterSettings& es = e.settings();
+    const double longest = es.lifetime * (1.0 + es.lifetimeJitter);
+    const double span = std::ceil(longest * static_cast<double>(settings_.stepRateHz)) + 2.0;
+    window.push_back(std::isfinite(span) && span < 9.0e18 ? static_cast<std::int64_t>(span)
+                                                          : INT64_MAX);
+  }
+  std::uint64_t peak = pool_.size(), structures = 0;
+  std::size_t nextStructure = 0;
+  std::vector<std::size_t> byTick(structures_.size());
+  for (std::size_t k = 0; k < byTick.size(); ++k) byTick[k] = k;
+  // Structures born before tickCount() are among the rows already.
+  std::erase_if(byTick, [&](std::size_t k) { return structures_[k].tick < tick_; });
+  std::sort(byTick.begin(), byTick.end(), [&](std::size_t a, std::size_t b) {
+    return structures_[a].tick < structures_[b].tick;
+  });
+  for (std::int64_t k = tick_; k < ticks; ++k) {
+    while (nextStructure < byTick.size() && structures_[byTick[nextStructure]].tick <= k)
+      structures += structures_[byTick[nextStructure++]].particles;
+    std::uint64_t alive = pool_.size() + structures;
+    for (std::size_t i = 0; i < emitters_.size(); ++i) {
+      const std::int64_t from = window[i] > k - tick_ ? tick_ : k + 1 - window[i];
+      alive += emitters_[i].serialBefore(k + 1) - emitters_[i].serialBefore(from);
+    }
+    peak = std::max(peak, alive);
+  }
+  return peak;
 }
 
 void ParticleSystem::spawnStructure(const StructureBuild& build) {

@@ -16,6 +16,7 @@
 #include "particles/NonfiniteState.h"
 #include "particles/ParticlePool.h"
 #include "particles/RenderDestination.h"
+#include "particles/Shard.h"
 #include "particles/Structure.h"
 
 namespace tickfx {
@@ -206,6 +207,19 @@ class ParticleSystem {
   /// pool and driver(): with them a saved state is complete, render copies included.
   void restoreClock(std::int64_t tick, const Vec3Column* tickStartVelocities);
 
+  /// Makes this system simulate shard `shard` of the run only (particles/Shard.h): its rows, ids
+  /// and bits are the whole run's rows of that shard, provided the whole run never reaches
+  /// maxParticles (see particleBound()). Set before the first tick, or before a shard's
+  /// checkpoint is restored. Throws std::invalid_argument for an invalid shard, or a sharded
+  /// system with sub-emitters: a child's id counts the events of every shard before it.
+  void setShard(const Shard& shard);
+  const Shard& shard() const { return shard_; }
+  /// At least as many particles as the whole run (every shard) holds at any tick from
+  /// tickCount() to `ticks` − 1, from the emission schedule and the longest lifetimes alone (the
+  /// rows alive now counted as never dying). A run whose bound is within maxParticles never
+  /// refuses a spawn, which is what lets shards count each other's ids.
+  std::uint64_t particleBound(std::int64_t ticks) const;
+
  private:
   struct PendingStructure;
   void runTicks(std::int64_t ticks, bool keepVelocities);
@@ -237,6 +251,7 @@ class ParticleSystem {
   struct PendingStructure {
     StructureBuild build;  // built (so validated) once, by the constructor; born at `tick`
     std::int64_t tick;
+    std::size_t particles;  // build.particles.size(), kept once the build is dropped
   };
   std::vector<PendingStructure> structures_;
   SpringNetwork* springs_ = nullptr;  // owned by *forces_
@@ -247,6 +262,7 @@ class ParticleSystem {
   template <typename F>
   void runParallel(F&& f) const;
   std::function<void(const ParticleSystem&)> tickObserver_;
+  Shard shard_;  // the whole run unless setShard()
   std::int64_t tick_ = 0;
   std::int64_t fusedTicks_ = 0;
   float alpha_ = 1.0f;
