@@ -5,7 +5,9 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -23,6 +25,9 @@ namespace {
 constexpr std::string_view kCheckpointMagic = "TICKFXCK";
 // Header flag: the pending events of sub-emitters follow the springs.
 constexpr std::uint32_t kPendingEventsFlag = 1;
+// Header flag: the state is one shard's (particles/Shard.h): u32 index, u32 count end the payload.
+constexpr std::uint32_t kShardFlag = 2;
+constexpr std::uint32_t kKnownFlags = kPendingEventsFlag | kShardFlag;
 constexpr std::size_t kHeaderBytes = 32;  // magic, version, flags, length, effect hash
 constexpr std::size_t kTrailerBytes = 8;  // checksum
 constexpr std::size_t kMinimumBytes = kHeaderBytes + kTrailerBytes;
@@ -151,13 +156,13 @@ class CheckpointReader {
   std::size_t pos_ = 0;
 };
 
-// Everything the file says, parsed and checked but not yet applied; the columns still point
-// into the file's bytes.
 // A spring on file: ids a and b, then rest length, stiffness, damping and break ratio as float
 // bits.
 constexpr std::size_t kSpringBytes = 8 + 8 + 4 * 4;
 
-struct Parsed {
+// The scalars of a state (settings, clock, driver, counters), whoever holds the columns: every
+// shard of a run has the same ones.
+struct StateScalars {
   std::int64_t stepRateHz = 0;
   std::string_view integrator;
   std::uint64_t maxParticles = 0;
@@ -166,7 +171,13 @@ struct Parsed {
   std::int64_t tick = 0;
   std::int64_t ticksIssued = 0, ticksDropped = 0, ticksDue = 0, remainder = 0;
   CheckpointInfo info;
-  std::uint64_t size = 0, nextId = 0, droppedSpawns = 0;
+  std::uint64_t nextId = 0, droppedSpawns = 0;
+};
+
+// Everything the file says, parsed and checked but not yet applied; the columns still point
+// into the file's bytes.
+struct Parsed : StateScalars {
+  std::uint64_t size = 0;
   const char* floats[kFloatColumns] = {};
   const char* ids = nullptr;
   const char* births = nullptr;
@@ -177,6 +188,10 @@ struct Parsed {
   std::uint32_t inheritedColumns = 0;
   std::vector<ParticleEvent> events;
   std::vector<float> eventValues;
+  Shard shard;  // the whole run without the shard flag
+  // The file's bytes, which the column pointers above point into (a unique_ptr: they stay put
+  // when a Parsed moves).
+  std::unique_ptr<const std::string> file;
 };
 
 // A pending event on file: u64 parent id, u32 emitter, u32 kind, u32 ordinal, f32 × 9.
@@ -216,7 +231,8 @@ void readPendingEvents(CheckpointReader& r, Parsed& p) {
   for (float& v : p.eventValues) v = f32("an inherited value");
 }
 
-Parsed parsePayload(std::string_view payload, bool pendingEvents) {
+Parsed parsePayload(std::string_view payload, std::uint32_t flags) {
+  const bool pendingEvents = (flags & kPendingEventsFlag) != 0;
   CheckpointReader r(payload);
   Parsed p;
   p.stepRateHz = r.i64("the step rate");
@@ -262,9 +278,17 @@ Parsed parsePayload(std::string_view payload, bool pendingEvents) {
     std::memcpy(&spring.breakRatio, &fields[3], 4);
   }
   if (pendingEvents) readPendingEvents(r, p);
+  if ((flags & kShardFlag) != 0) {
+    p.shard.index = r.u32("the shard");
+    p.shard.count = r.u32("the shard");
+    if (const std::optional<std::string> problem = p.shard.problem())
+      throw Malformed{"shard " + p.shard.text() + ": " + *problem};
+  }
   if (r.remaining() != 0) {
     throw Malformed{std::to_string(r.remaining()) + " bytes follow the last " +
-                    (pendingEvents ? "pending event" : "spring")};
+                    ((flags & kShardFlag) != 0 ? "section"
+                     : pendingEvents           ? "pending event"
+                                               : "spring")};
   }
   if (p.tick < 0) throw Malformed{"negative tick count"};
   if (p.overrunPolicy > 1)
@@ -296,6 +320,12 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
     return "checkpoint was written with simulation." + std::string(key) + " " + text(found) +
            " (expected " + text(expected) + ")";
   };
+  if (p.shard.index != system.shard().index || p.shard.count != system.shard().count) {
+    const auto name = [](const Shard& s) {
+      return s.whole() ? std::string("the whole run") : "shard " + s.text();
+    };
+    return "checkpoint is of " + name(p.shard) + " (expected " + name(system.shard()) + ")";
+  }
   if (p.stepRateHz != system.settings().stepRateHz) {
     return written("step_rate", p.stepRateHz, system.settings().stepRateHz);
   }
@@ -431,102 +461,11 @@ std::string readWholeFile(const std::filesystem::path& path) {
   return bytes;
 }
 
-}  // namespace
-
-void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,
-                     const CheckpointInfo& info) {
-  const ParticlePool& pool = system.pool();
-  const FixedStepDriver& driver = system.driver();
-  const std::size_t n = pool.size();
-  Writer w;
-  w.bytes().append(kCheckpointMagic);
-  w.u32(kCheckpointVersion);
-  const EventEmission* events = system.events();
-  const bool pending = events != nullptr && !events->pending().empty();
-  w.u32(pending ? kPendingEventsFlag : 0u);
-  w.u64(0);  // the file length, patched below
-  w.u64(info.effectHash);
-
-  w.i64(system.settings().stepRateHz);
-  w.str(system.integrator().name());
-  w.u64(pool.maxParticles());
-  w.i64(driver.maxTicksPerAdvance());
-  w.u32(policyCode(driver.policy()));
-  w.i64(system.tickCount());
-  w.i64(driver.ticksIssued());
-  w.i64(driver.ticksDroppedTotal());
-  w.i64(driver.ticksDue());
-  w.i64(driver.remainder());
-  w.i64(info.frame);
-  w.i64(info.elapsed);
-  w.u64(n);
-  w.u64(pool.nextId());
-  w.u64(pool.droppedSpawns());
-  w.u32(static_cast<std::uint32_t>(pool.attributeCount()));
-  const FloatColumn zeros =
-      pool.keepsAcceleration() ? FloatColumn() : FloatColumn::Zero(static_cast<Eigen::Index>(n));
-  forEachFloatColumn(pool, [&](const FloatColumn* column) {
-    w.column(column != nullptr ? column->data() : zeros.data(), n);
-  });
-  w.column(pool.id().data(), n);
-  w.column(pool.birthTick().data(), n);
-  // What render copies interpolate velocities from, so that a resumed run's caches match.
-  const Vec3Column* velocities = system.tickStartVelocities();
-  w.u32(velocities != nullptr ? 1 : 0);
-  if (velocities != nullptr) {
-    for (int c = 0; c < 3; ++c) w.column((*velocities)[c].data(), n);
-  }
-  for (std::size_t a = 0; a < pool.attributeCount(); ++a) {
-    w.str(pool.attributeName(a));
-    w.column(pool.attribute(a).data(), n);
-  }
-  const std::vector<Spring> none;
-  const std::vector<Spring>& springs = system.springs() ? system.springs()->springs() : none;
-  w.u64(springs.size());
-  w.u64(system.springs() ? system.springs()->brokenCount() : 0);
-  for (const Spring& spring : springs) {
-    w.u64(spring.a);
-    w.u64(spring.b);
-    for (float value : {spring.restLength, spring.stiffness, spring.damping, spring.breakRatio}) {
-      std::uint32_t bits = 0;
-      std::memcpy(&bits, &value, 4);
-      w.u32(bits);
-    }
-  }
-
-  if (pending) {
-    w.u64(events->pending().size());
-    w.u32(static_cast<std::uint32_t>(events->inheritedColumns().size()));
-    const auto bitsOf = [](float f) {
-      std::uint32_t bits = 0;
-      std::memcpy(&bits, &f, 4);
-      return bits;
-    };
-    for (const ParticleEvent& e : events->pending()) {
-      w.u64(e.parentId);
-      w.u32(e.parentEmitter);
-      w.u32(static_cast<std::uint32_t>(e.kind));
-      w.u32(e.ordinal);
-      for (const Eigen::Vector3f* v : {&e.position, &e.velocity, &e.normal}) {
-        for (int c = 0; c < 3; ++c) w.u32(bitsOf((*v)[c]));
-      }
-    }
-    for (const float v : events->pendingValues()) w.u32(bitsOf(v));
-  }
-
-  w.patchU64(kLengthOffset, w.bytes().size() + kTrailerBytes);
-  w.u64(fingerprint(w.bytes()));
-  writeFileAtomically(
-      path,
-      [&](std::ostream& out) {
-        out.write(w.bytes().data(), static_cast<std::streamsize>(w.bytes().size()));
-      },
-      Durability::Synced);
-}
-
-CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
-                              std::uint64_t expectedEffectHash) {
-  const std::string bytes = readWholeFile(path);
+// The file at `path` read whole and checked (magic, version, flags, length, checksum) and its
+// payload parsed; throws std::runtime_error "PATH: error: ..." otherwise.
+Parsed loadCheckpointFile(const std::filesystem::path& path) {
+  auto file = std::make_unique<const std::string>(readWholeFile(path));
+  const std::string& bytes = *file;
   const std::size_t found = bytes.size();
   auto truncated = [&](const std::string& expected) {
     fail(path, "checkpoint is truncated (expected " + expected + " bytes, found " +
@@ -547,9 +486,9 @@ CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem&
   }
   if (found < kEffectHashOffset) truncated("at least " + std::to_string(kMinimumBytes));
   const std::uint32_t flags = loadU32(bytes.data() + kFlagsOffset);
-  if ((flags & ~kPendingEventsFlag) != 0) {
-    fail(path, "checkpoint has unknown flags " + std::to_string(flags & ~kPendingEventsFlag) +
-                   " (this build reads files with flags 0 and 1)");
+  if ((flags & ~kKnownFlags) != 0) {
+    fail(path, "checkpoint has unknown flags " + std::to_string(flags & ~kKnownFlags) +
+                   " (this build reads files with flags 0 to 3)");
   }
   const std::uint64_t length = loadU64(bytes.data() + kLengthOffset);
   if (length < kMinimumBytes) {
@@ -565,22 +504,380 @@ CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem&
   if (fingerprint(covered) != loadU64(bytes.data() + found - kTrailerBytes)) {
     fail(path, "checksum mismatch (the file is corrupted)");
   }
-  const std::uint64_t effectHash = loadU64(bytes.data() + kEffectHashOffset);
-  if (effectHash != expectedEffectHash) {
-    fail(path, "checkpoint was written for another effect (effect hash " + hashToHex(effectHash) +
-                   ", expected " + hashToHex(expectedEffectHash) + ")");
-  }
-
   Parsed parsed;
   try {
-    parsed = parsePayload(covered.substr(kHeaderBytes), (flags & kPendingEventsFlag) != 0);
+    parsed = parsePayload(covered.substr(kHeaderBytes), flags);
   } catch (const Malformed& m) {
     fail(path, "checkpoint is malformed (" + m.what + ")");
   }
-  parsed.info.effectHash = effectHash;
+  parsed.info.effectHash = loadU64(bytes.data() + kEffectHashOffset);
+  parsed.file = std::move(file);
+  return parsed;
+}
+
+// A state as a checkpoint holds it, borrowed from a system or from merged shards: what
+// serialize() writes. A null float column is written as zeros (an acceleration the pool does not
+// keep).
+struct StateView : StateScalars {
+  std::size_t size = 0;
+  const float* floats[kFloatColumns] = {};
+  const std::uint64_t* ids = nullptr;
+  const std::int64_t* births = nullptr;
+  bool hasVelocities = false;       // tick-start velocities ...
+  const float* velocities[3] = {};  // ... these (null for no rows)
+  std::vector<std::pair<std::string_view, const float*>> attributes;
+  std::span<const Spring> springs;
+  std::uint64_t springsBroken = 0;
+  std::span<const ParticleEvent> events;
+  std::span<const float> eventValues;
+  std::uint32_t inheritedColumns = 0;
+  Shard shard;
+};
+
+std::uint32_t bitsOf(float f) {
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &f, 4);
+  return bits;
+}
+
+// The whole file, header to checksum, in the layout writeCheckpoint() documents.
+std::string serialize(const StateView& v) {
+  const std::size_t n = v.size;
+  Writer w;
+  w.bytes().append(kCheckpointMagic);
+  w.u32(kCheckpointVersion);
+  w.u32((v.events.empty() ? 0u : kPendingEventsFlag) | (v.shard.whole() ? 0u : kShardFlag));
+  w.u64(0);  // the file length, patched below
+  w.u64(v.info.effectHash);
+
+  w.i64(v.stepRateHz);
+  w.str(v.integrator);
+  w.u64(v.maxParticles);
+  w.i64(v.maxTicksPerFrame);
+  w.u32(v.overrunPolicy);
+  w.i64(v.tick);
+  w.i64(v.ticksIssued);
+  w.i64(v.ticksDropped);
+  w.i64(v.ticksDue);
+  w.i64(v.remainder);
+  w.i64(v.info.frame);
+  w.i64(v.info.elapsed);
+  w.u64(n);
+  w.u64(v.nextId);
+  w.u64(v.droppedSpawns);
+  w.u32(static_cast<std::uint32_t>(v.attributes.size()));
+  const std::vector<float> zeros(n, 0.0f);
+  for (const float* column : v.floats) w.column(column != nullptr ? column : zeros.data(), n);
+  w.column(v.ids, n);
+  w.column(v.births, n);
+  w.u32(v.hasVelocities ? 1 : 0);
+  if (v.hasVelocities) {
+    for (const float* column : v.velocities) w.column(column, n);
+  }
+  for (const auto& [name, values] : v.attributes) {
+    w.str(name);
+    w.column(values, n);
+  }
+  w.u64(v.springs.size());
+  w.u64(v.springsBroken);
+  for (const Spring& spring : v.springs) {
+    w.u64(spring.a);
+    w.u64(spring.b);
+    for (float value : {spring.restLength, spring.stiffness, spring.damping, spring.breakRatio})
+      w.u32(bitsOf(value));
+  }
+  if (!v.events.empty()) {
+    w.u64(v.events.size());
+    w.u32(v.inheritedColumns);
+    for (const ParticleEvent& e : v.events) {
+      w.u64(e.parentId);
+      w.u32(e.parentEmitter);
+      w.u32(static_cast<std::uint32_t>(e.kind));
+      w.u32(e.ordinal);
+      for (const Eigen::Vector3f* vec : {&e.position, &e.velocity, &e.normal}) {
+        for (int c = 0; c < 3; ++c) w.u32(bitsOf((*vec)[c]));
+      }
+    }
+    for (const float value : v.eventValues) w.u32(bitsOf(value));
+  }
+  if (!v.shard.whole()) {
+    w.u32(v.shard.index);
+    w.u32(v.shard.count);
+  }
+  w.patchU64(kLengthOffset, w.bytes().size() + kTrailerBytes);
+  w.u64(fingerprint(w.bytes()));
+  return std::move(w.bytes());
+}
+
+void writeBytes(const std::filesystem::path& path, const std::string& bytes) {
+  writeFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      },
+      Durability::Synced);
+}
+
+}  // namespace
+
+void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,
+                     const CheckpointInfo& info) {
+  const ParticlePool& pool = system.pool();
+  const FixedStepDriver& driver = system.driver();
+  const std::size_t n = pool.size();
+  StateView v;
+  v.stepRateHz = system.settings().stepRateHz;
+  v.integrator = system.integrator().name();
+  v.maxParticles = pool.maxParticles();
+  v.maxTicksPerFrame = driver.maxTicksPerAdvance();
+  v.overrunPolicy = policyCode(driver.policy());
+  v.tick = system.tickCount();
+  v.ticksIssued = driver.ticksIssued();
+  v.ticksDropped = driver.ticksDroppedTotal();
+  v.ticksDue = driver.ticksDue();
+  v.remainder = driver.remainder();
+  v.info = info;
+  v.size = n;
+  v.nextId = pool.nextId();
+  v.droppedSpawns = pool.droppedSpawns();
+  int c = 0;
+  forEachFloatColumn(pool, [&](const FloatColumn* column) {
+    v.floats[c++] = column != nullptr ? column->data() : nullptr;
+  });
+  v.ids = pool.id().data();
+  v.births = pool.birthTick().data();
+  // What render copies interpolate velocities from, so that a resumed run's caches match.
+  if (const Vec3Column* velocities = system.tickStartVelocities()) {
+    v.hasVelocities = true;
+    for (int k = 0; k < 3; ++k) v.velocities[k] = (*velocities)[k].data();
+  }
+  for (std::size_t a = 0; a < pool.attributeCount(); ++a)
+    v.attributes.emplace_back(pool.attributeName(a), pool.attribute(a).data());
+  if (system.springs() != nullptr) {
+    v.springs = system.springs()->springs();
+    v.springsBroken = system.springs()->brokenCount();
+  }
+  if (const EventEmission* events = system.events(); events != nullptr) {
+    v.events = events->pending();
+    v.eventValues = events->pendingValues();
+    v.inheritedColumns = static_cast<std::uint32_t>(events->inheritedColumns().size());
+  }
+  v.shard = system.shard();
+  writeBytes(path, serialize(v));
+}
+
+CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
+                              std::uint64_t expectedEffectHash) {
+  const Parsed parsed = loadCheckpointFile(path);
+  if (parsed.info.effectHash != expectedEffectHash) {
+    fail(path, "checkpoint was written for another effect (effect hash " +
+                   hashToHex(parsed.info.effectHash) + ", expected " +
+                   hashToHex(expectedEffectHash) + ")");
+  }
   if (const std::optional<std::string> why = mismatch(parsed, system)) fail(path, *why);
   apply(parsed, system);
   return parsed.info;
+}
+
+namespace {
+
+// The first field in which shard checkpoint `p` differs from `first` (of the same run: every
+// shard runs the whole schedule, so all but the rows, springs and broken springs agree), or
+// nothing.
+std::optional<std::string> shardMismatch(const Parsed& p, const Parsed& first) {
+  const auto differs = [](const char* what) { return std::optional<std::string>(what); };
+  if (p.info.effectHash != first.info.effectHash) {
+    return "a shard of another effect (effect hash " + hashToHex(p.info.effectHash) + ", not " +
+           hashToHex(first.info.effectHash) + ")";
+  }
+  if (p.shard.count != first.shard.count) {
+    return "a shard of " + std::to_string(p.shard.count) + " (not " +
+           std::to_string(first.shard.count) + ")";
+  }
+  if (p.stepRateHz != first.stepRateHz || p.integrator != first.integrator ||
+      p.maxParticles != first.maxParticles || p.maxTicksPerFrame != first.maxTicksPerFrame ||
+      p.overrunPolicy != first.overrunPolicy) {
+    return differs("other simulation settings");
+  }
+  if (p.tick != first.tick || p.info.frame != first.info.frame ||
+      p.info.elapsed != first.info.elapsed) {
+    return "another frame (frame " + std::to_string(p.info.frame) + ", tick " +
+           std::to_string(p.tick) + "; not frame " + std::to_string(first.info.frame) + ", tick " +
+           std::to_string(first.tick) + ")";
+  }
+  if (p.ticksIssued != first.ticksIssued || p.ticksDropped != first.ticksDropped ||
+      p.ticksDue != first.ticksDue || p.remainder != first.remainder) {
+    return differs("another driver state");
+  }
+  if (p.nextId != first.nextId || p.droppedSpawns != first.droppedSpawns) {
+    return differs("other id counters");
+  }
+  bool sameAttributes = p.attributes.size() == first.attributes.size();
+  for (std::size_t a = 0; sameAttributes && a < p.attributes.size(); ++a)
+    sameAttributes = p.attributes[a].first == first.attributes[a].first;
+  if (!sameAttributes) return differs("other attributes");
+  if ((p.tickStartVelocities == nullptr) != (first.tickStartVelocities == nullptr))
+    return differs("tick-start velocities where the first has none, or none where it has");
+  return std::nullopt;
+}
+
+// A column of each shard (little-endian values of T), gathered in `order` into `out`.
+template <typename T, typename Column>
+void gather(const std::vector<Parsed>& shards, Column column,
+            const std::vector<std::pair<std::uint32_t, std::uint64_t>>& order, T* out) {
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const Parsed& p = shards[order[i].first];
+    loadLittleEndian(column(p) + order[i].second * sizeof(T), out + i, 1);
+  }
+}
+
+}  // namespace
+
+MergedCheckpoint mergeShardCheckpoints(const std::vector<std::filesystem::path>& shards,
+                                       const std::filesystem::path& out) {
+  if (shards.empty()) throw std::invalid_argument("mergeShardCheckpoints: no shards");
+  std::vector<Parsed> parsed;
+  std::vector<const std::filesystem::path*> byIndex;
+  for (const std::filesystem::path& path : shards) {
+    Parsed p = loadCheckpointFile(path);
+    if (!p.events.empty()) fail(path, "a shard's checkpoint with pending events");
+    if (!parsed.empty()) {
+      if (const std::optional<std::string> why = shardMismatch(p, parsed.front())) {
+        fail(path, "checkpoint is " + *why + " beside " + shards.front().string());
+      }
+    }
+    byIndex.resize(p.shard.count, nullptr);
+    if (byIndex[p.shard.index] != nullptr) {
+      fail(path,
+           "checkpoint of shard " + p.shard.text() + ", as is " + byIndex[p.shard.index]->string());
+    }
+    byIndex[p.shard.index] = &path;
+    parsed.push_back(std::move(p));
+  }
+  const Parsed& first = parsed.front();
+  for (std::uint32_t i = 0; i < first.shard.count; ++i) {
+    if (byIndex[i] == nullptr) {
+      fail(shards.front(), "the checkpoint of shard " + Shard{i, first.shard.count}.text() +
+                               " is missing (" + std::to_string(shards.size()) + " of " +
+                               std::to_string(first.shard.count) + " given)");
+    }
+  }
+
+  // The rows in id order: each shard's are rising, no id is in two shards.
+  std::vector<std::pair<std::uint32_t, std::uint64_t>> order;  // (shard, row)
+  std::vector<std::uint64_t> next(parsed.size(), 0);
+  std::uint64_t total = 0;
+  for (const Parsed& p : parsed) total += p.size;
+  order.reserve(static_cast<std::size_t>(total));
+  const auto idAt = [&](std::size_t s, std::uint64_t row) {
+    std::uint64_t id = 0;
+    loadLittleEndian(parsed[s].ids + row * 8, &id, 1);
+    return id;
+  };
+  for (std::uint64_t k = 0; k < total; ++k) {
+    std::size_t best = parsed.size();
+    std::uint64_t bestId = 0;
+    for (std::size_t s = 0; s < parsed.size(); ++s) {
+      if (next[s] == parsed[s].size) continue;
+      const std::uint64_t id = idAt(s, next[s]);
+      if (best == parsed.size() || id < bestId) {
+        best = s;
+        bestId = id;
+      } else if (id == bestId) {
+        fail(shards[s], "checkpoint holds particle " + std::to_string(id) + ", as does " +
+                            shards[best].string());
+      }
+    }
+    order.emplace_back(static_cast<std::uint32_t>(best), next[best]++);
+  }
+
+  // The merged rows go straight into a pool (which also gives the state hash); the shards' files
+  // are let go before the merged file is serialised: at most the files and the pool, then the
+  // pool and the merged file, are in memory at once.
+  ParticlePool pool(static_cast<std::size_t>(first.maxParticles));
+  for (const auto& [name, values] : first.attributes) pool.addAttribute(std::string(name));
+  const std::size_t n = order.size();
+  for (const Parsed& p : parsed) {
+    for (int c = kFirstAccelerationColumn; c < kFirstAccelerationColumn + 3; ++c) {
+      const char* bytes = p.floats[c];
+      if (std::any_of(bytes, bytes + 4 * p.size, [](char b) { return b != 0; }))
+        pool.keepAcceleration();
+    }
+  }
+  pool.reserve(n);
+  pool.resizeForRestore(n, first.nextId, first.droppedSpawns);
+  int c = 0;
+  forEachFloatColumn(pool, [&](FloatColumn* column) {
+    if (column != nullptr) {
+      gather(
+          parsed, [c](const Parsed& p) { return p.floats[c]; }, order, column->data());
+    }
+    ++c;
+  });
+  gather(
+      parsed, [](const Parsed& p) { return p.ids; }, order, pool.id().data());
+  gather(
+      parsed, [](const Parsed& p) { return p.births; }, order, pool.birthTick().data());
+  for (std::size_t a = 0; a < first.attributes.size(); ++a) {
+    gather(
+        parsed, [a](const Parsed& p) { return p.attributes[a].second; }, order,
+        pool.attribute(a).data());
+  }
+  Vec3Column velocities;
+  const bool hasVelocities = first.tickStartVelocities != nullptr;
+  if (hasVelocities) {
+    velocities.resize(static_cast<Eigen::Index>(n));
+    for (std::size_t k = 0; k < 3; ++k) {
+      // Shard s's component k starts at k · 4 · (its rows).
+      gather(
+          parsed, [k](const Parsed& p) { return p.tickStartVelocities + k * 4 * p.size; }, order,
+          velocities[static_cast<int>(k)].data());
+    }
+  }
+
+  // Springs in the whole run's order: structures in the order of their ids (each structure's ids
+  // a block of their own, all in one shard), each structure's springs in its shard's order.
+  std::vector<Spring> springs;
+  std::uint64_t springsBroken = 0;
+  std::vector<std::size_t> nextSpring(parsed.size(), 0);
+  const auto key = [](const Spring& s) { return std::min(s.a, s.b); };
+  for (;;) {
+    std::size_t best = parsed.size();
+    for (std::size_t s = 0; s < parsed.size(); ++s) {
+      if (nextSpring[s] == parsed[s].springs.size()) continue;
+      if (best == parsed.size() ||
+          key(parsed[s].springs[nextSpring[s]]) < key(parsed[best].springs[nextSpring[best]]))
+        best = s;
+    }
+    if (best == parsed.size()) break;
+    springs.push_back(parsed[best].springs[nextSpring[best]++]);
+  }
+  for (const Parsed& p : parsed) springsBroken += p.springsBroken;
+
+  StateView v;
+  static_cast<StateScalars&>(v) = first;
+  const std::string integrator(first.integrator);  // first's bytes go below
+  v.integrator = integrator;
+  v.size = n;
+  parsed.erase(parsed.begin() + 1, parsed.end());
+  parsed.front().file.reset();  // the bytes the views above pointed into (copied by now)
+  c = 0;
+  forEachFloatColumn(pool, [&](const FloatColumn* column) {
+    v.floats[c++] = column != nullptr ? column->data() : nullptr;
+  });
+  v.ids = pool.id().data();
+  v.births = pool.birthTick().data();
+  v.hasVelocities = hasVelocities;
+  if (hasVelocities) {
+    for (int k = 0; k < 3; ++k) v.velocities[k] = velocities[k].data();
+  }
+  for (std::size_t a = 0; a < pool.attributeCount(); ++a)
+    v.attributes.emplace_back(pool.attributeName(a), pool.attribute(a).data());
+  v.springs = springs;
+  v.springsBroken = springsBroken;
+  writeBytes(out, serialize(v));
+  const MergedCheckpoint merged{stateHash(pool), v.tick, v.info};
+  return merged;
 }
 
 }  // namespace tickfx::io

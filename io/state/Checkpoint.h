@@ -58,6 +58,8 @@ inline constexpr std::uint32_t kCheckpointVersion = 2;
 ///              e × (u64 parent id, u32 parent emitter, u32 kind (1 birth, 2 death, 3 collision),
 ///                   u32 ordinal, f32 × 9: position, velocity, normal)
 ///              f32[e · k]: each event's inherited values
+///              with flag 2 (one shard's state, particles/Shard.h; else nothing):
+///              u32 shard index   u32 shard count
 ///     trailer  u64 checksum: fingerprint() of every byte before it
 ///
 /// where str is a u32 byte count followed by that many UTF-8 bytes.
@@ -80,5 +82,22 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
 /// left exactly as it was.
 CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
                               std::uint64_t expectedEffectHash);
+
+/// What mergeShardCheckpoints() made.
+struct MergedCheckpoint {
+  std::uint64_t stateHash = 0;  // stateHash() of the merged state: what the whole run prints
+  std::int64_t ticks = 0;       // its tick count
+  CheckpointInfo info;          // the frame and time the shards' checkpoints were written at
+};
+
+/// Merges the checkpoints that every shard of a run (`tickfx run --shard I/N`) wrote at the same
+/// frame, one a shard in any order, into `out`: byte for byte the checkpoint the unsharded run
+/// writes there (rows merged by id, the shards' springs in the whole run's order, their broken
+/// springs summed). Streams nothing: memory holds every shard's file and the merged state.
+/// Throws std::runtime_error "PATH: error: ..." naming the file for a checkpoint that does not
+/// read (as readCheckpoint), is not a shard's, is of another effect, shard count, frame or
+/// settings than the first, repeats a shard or a particle, or when a shard is missing.
+MergedCheckpoint mergeShardCheckpoints(const std::vector<std::filesystem::path>& shards,
+                                       const std::filesystem::path& out);
 
 }  // namespace tickfx::io

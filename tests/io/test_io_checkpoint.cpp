@@ -486,13 +486,13 @@ TEST_F(ioCheckpointRefusal, AFlippedHeaderBitNamesTheField) {
       const std::uint32_t version = kCheckpointVersion ^ (1u << (8 * (at - 8) + bit));
       expectRefused(bad, "checkpoint format version " + std::to_string(version) +
                              " (this build reads " + std::to_string(kCheckpointVersion) + ")");
-    } else if (at == 12 && bit == 0) {
-      // Flag 1 (pending events) is known: the checksum then finds the change.
+    } else if (at == 12 && bit <= 1) {
+      // Flags 1 (pending events) and 2 (a shard) are known: the checksum then finds the change.
       expectRefused(bad, "checksum mismatch (the file is corrupted)");
     } else if (at < 16) {
       expectRefused(bad, "checkpoint has unknown flags " +
                              std::to_string(1ull << (8 * (at - 12) + bit)) +
-                             " (this build reads files with flags 0 and 1)");
+                             " (this build reads files with flags 0 to 3)");
     } else {
       const std::uint64_t said = length ^ (1ull << (8 * (at - 16) + bit));
       if (said < 40) {
