@@ -56,6 +56,11 @@ std::vector<std::string> Arguments::positionals(std::size_t count, const std::st
   return args_;
 }
 
+std::vector<std::string> Arguments::positionalList(const std::string& what) {
+  if (args_.empty()) throw UsageError(command_ + ": expected " + what);
+  return positionals(args_.size(), what);
+}
+
 long long parseInteger(const std::string& text, const std::string& option, long long min,
                        long long max) {
   long long value = 0;

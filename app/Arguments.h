@@ -30,6 +30,8 @@ class Arguments {
   std::vector<std::string> values(const std::string& name);
   /// The remaining arguments, which must not look like options; exactly `count` of them.
   std::vector<std::string> positionals(std::size_t count, const std::string& what);
+  /// The remaining arguments, which must not look like options; at least one of them.
+  std::vector<std::string> positionalList(const std::string& what);
 
   const std::string& command() const { return command_; }
 

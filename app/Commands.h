@@ -11,6 +11,7 @@ inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
 
 int runCommand(Arguments& args);
+int mergeCommand(Arguments& args);
 int checkCommand(Arguments& args);
 int studyCommand(Arguments& args);
 int determinismCommand(Arguments& args);

@@ -22,6 +22,7 @@
 #include "io/cache/BackgroundWriter.h"
 #include "io/cache/FrameCaches.h"
 #include "io/cache/FrameData.h"
+#include "io/cache/ShardManifest.h"
 #include "io/cache/UsdaPointsWriter.h"
 #include "io/effect/EffectBuilder.h"
 #include "io/effect/EffectLint.h"
@@ -29,6 +30,7 @@
 #include "io/state/Checkpoint.h"
 #include "io/state/StateDump.h"
 #include "io/util/AtomicFile.h"
+#include "particles/Clock.h"
 #include "particles/ParticleSystem.h"
 #include "particles/StateHash.h"
 
@@ -64,6 +66,10 @@ constexpr const char* kRunHelp =
     "  --checkpoint-dir D    ... into D/checkpoint_<frame>.tfxc (default: the cache directory)\n"
     "  --resume FILE         continue from a checkpoint of this effect (same --set and frame\n"
     "                        options as the run that wrote it); reaches the same state hash\n"
+    "Shards (one run split over processes or machines; docs/sharding.md):\n"
+    "  --shard I/N           simulate shard I (from 0) of N only, into DIR/shard_I_of_N unless\n"
+    "                        --out says where, with the shard's final state and shard.toml;\n"
+    "                        `tickfx merge` makes the whole run's files of every shard's\n"
     "  Ctrl-C (SIGINT) or SIGTERM finishes the frame in hand, writes its checkpoint (with\n"
     "  --checkpoint-every), says how to resume and exits 130 or 143; a second one stops at once.\n"
     "Simulation:\n"
@@ -134,11 +140,66 @@ bool resumeRun(PreparedRun& run, const std::string& checkpoint) {
   return true;
 }
 
+// Makes the run's system simulate its shard. False after printing why the effect cannot be
+// sharded exactly (bad input: exit 2): the rules are particles/Shard.h's and docs/sharding.md's.
+bool shardRun(PreparedRun& run, const RunSettings& s) {
+  const auto refuse = [&](const std::string& why) {
+    std::fprintf(stderr, "%s: error: cannot shard: %s\n", s.effectPath.c_str(), why.c_str());
+    return false;
+  };
+  for (const EmitterSettings& e : run.effect.emitters) {
+    if (!e.sub.parent.empty()) {
+      return refuse("emitter '" + e.name + "' emits at the events of '" + e.sub.parent +
+                    "': a child's id counts the events of every shard before it, which no "
+                    "shard knows alone (run this effect unsharded)");
+    }
+  }
+  // The bound covers every tick the run's frames reach.
+  const __int128 flicks =
+      static_cast<__int128>(run.schedule.total()) * run.effect.simulation.stepRateHz;
+  const auto ticks =
+      static_cast<std::int64_t>((flicks + kFlicksPerSecond - 1) / kFlicksPerSecond) + 1;
+  const std::uint64_t bound = run.system->particleBound(ticks);
+  const std::size_t cap = run.system->pool().maxParticles();
+  if (bound > cap) {
+    return refuse("simulation.max_particles = " + std::to_string(cap) + " may bind: up to " +
+                  std::to_string(bound) +
+                  " particles may be alive at once (from the emitters' schedules and longest "
+                  "lifetimes), and a cap is a count over every shard (give max_particles >= " +
+                  std::to_string(bound) + " to shard)");
+  }
+  run.system->setShard(*s.shard);
+  return true;
+}
+
+// A shard's end: its final state, then its manifest, which says the folder is whole.
+void finishShard(const RunSettings& s, const PreparedRun& run, std::int64_t lastFrame) {
+  io::writeCheckpoint(s.finalStatePath(), *run.system,
+                      io::CheckpointInfo{run.effectHash, lastFrame, run.elapsed});
+  io::ShardManifest m;
+  m.effect = s.effectPath;
+  m.effectHash = hashToHex(run.effectHash);
+  m.seed = run.effect.simulation.seed;
+  m.stepRateHz = run.effect.simulation.stepRateHz;
+  m.integrator = run.effect.simulation.integrator;
+  m.shard = *s.shard;
+  m.formats = s.caches.formats;
+  m.vdb = s.caches.vdbOptions;
+  m.framesPerSecond = s.framesPerSecond;
+  m.lastFrame = lastFrame;
+  m.ticks = run.system->tickCount();
+  if (std::find(m.formats.begin(), m.formats.end(), io::CacheFormat::Usda) != m.formats.end())
+    m.usdaName = s.usdaPath().filename().string();
+  io::writeShardManifest(m, s.caches.directory);
+}
+
 // Every output is checked before the first tick: an unwritable --dump must not turn up after
 // hours of caches. False after printing why.
 bool checkOutputs(const RunSettings& s, std::int64_t firstFrame) {
   try {
-    if (s.writesCaches()) std::filesystem::create_directories(s.caches.directory);
+    if (s.writesCaches() || s.shard) std::filesystem::create_directories(s.caches.directory);
+    // A shard's folder is whole once its manifest is written again at its end.
+    if (s.shard) std::filesystem::remove(io::shardManifestPath(s.caches.directory));
     if (s.checkpointEvery > 0) std::filesystem::create_directories(s.checkpointDir);
     if (s.writesCaches())
       io::requireWritable(io::cacheFilePath(s.caches.directory, firstFrame, "tmp"));
@@ -169,6 +230,7 @@ std::unique_ptr<PreparedRun> prepareRun(const RunSettings& s, const io::EffectSe
   }
   run->lint = io::lintEffect(effect, &run->system->forces(), run->system->colliders());
   for (const io::Diagnostic& d : run->lint) std::fprintf(stderr, "%s\n", d.format().c_str());
+  if (s.shard && !shardRun(*run, s)) return nullptr;
   if (s.resume && !resumeRun(*run, *s.resume)) return nullptr;
   if (!checkOutputs(s, run->firstFrame)) return nullptr;
   if (s.trace) {
@@ -464,6 +526,7 @@ int runCommand(Arguments& args) {
   FrameLoop frames(*settings, *run);
   if (const std::optional<int> stopped = frames.run()) return *stopped;
   writeEndFiles(*settings, *run, frames.lastFrame());
+  if (settings->shard) finishShard(*settings, *run, frames.lastFrame());
   if (!settings->quiet) printRunSummary(*settings, *run, frames);
   if (settings->printHash) {
     std::printf("state-hash: %s\n", hashToHex(stateHash(*run->system)).c_str());

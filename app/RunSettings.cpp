@@ -142,6 +142,7 @@ RunArguments readRunArguments(Arguments& args) {
   a.threads = args.value("--threads");
   a.vdbCompression = args.value("--vdb-compression");
   a.vdbPositions = args.value("--vdb-positions");
+  a.shard = args.value("--shard");
   a.durable = args.flag("--durable");
   a.overlap = !args.flag("--no-overlap");
   a.printHash = args.flag("--hash");
@@ -172,7 +173,20 @@ std::optional<RunSettings> resolveRunSettings(const RunArguments& a, const io::L
     every = parseInteger(*a.checkpointEvery, "run: --checkpoint-every", 1, 1'000'000'000);
   if (a.checkpointDir && !a.checkpointEvery)
     throw UsageError("run: --checkpoint-dir needs --checkpoint-every");
+  std::optional<Shard> shard;
+  if (a.shard) {
+    try {
+      shard = Shard::parse(*a.shard);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("run: --shard: ") + e.what());
+    }
+  }
   io::CacheTargets caches = cacheTargets(a, load, std::move(formats));
+  // A shard's files go to a folder of their own unless --out names one.
+  if (shard && !a.out) {
+    caches.directory /=
+        "shard_" + std::to_string(shard->index) + "_of_" + std::to_string(shard->count);
+  }
   FrameRate rate = effect.output.fps;
   if (a.fps) rate = parseFrameRate(*a.fps);  // planFrames() took it
   std::filesystem::path checkpointDir =
@@ -189,12 +203,17 @@ std::optional<RunSettings> resolveRunSettings(const RunArguments& a, const io::L
                      .overlap = a.overlap,
                      .printHash = a.printHash,
                      .quiet = a.quiet,
+                     .shard = shard,
                      .framesPerSecond = static_cast<double>(rate.numerator) /
                                         static_cast<double>(rate.denominator)};
 }
 
 std::filesystem::path RunSettings::usdaPath() const {
   return caches.directory / (std::filesystem::path(effectPath).stem().string() + ".usda");
+}
+
+std::filesystem::path RunSettings::finalStatePath() const {
+  return caches.directory / "final.tfxc";
 }
 
 std::filesystem::path RunSettings::checkpointPath(std::int64_t frame) const {

@@ -12,6 +12,7 @@
 #include "app/FrameTimes.h"
 #include "io/cache/FrameCaches.h"
 #include "io/effect/EffectParser.h"
+#include "particles/Shard.h"
 
 namespace tickfx::app {
 
@@ -24,6 +25,7 @@ struct RunArguments {
   std::optional<std::string> out, format, dump, trace;
   std::optional<std::string> checkpointEvery, checkpointDir, resume;
   std::optional<std::string> threads, vdbCompression, vdbPositions;
+  std::optional<std::string> shard;
   bool durable = false;
   bool overlap = true;  // not --no-overlap
   bool printHash = false;
@@ -53,6 +55,9 @@ struct RunSettings {
   bool overlap = true;
   bool printHash = false;
   bool quiet = false;
+  /// --shard I/N: the part of the run this one simulates (0/1 is the whole run, as a shard). A
+  /// shard writes its final state (finalStatePath()) and manifest beside its caches.
+  std::optional<Shard> shard;
 
   /// Frames a second of the run's frame rate (--fps, else the effect's): a USD layer's time
   /// codes per second.
@@ -63,6 +68,8 @@ struct RunSettings {
   std::filesystem::path usdaPath() const;
   /// DIR/checkpoint_000012.tfxc: the checkpoint written after `frame`.
   std::filesystem::path checkpointPath(std::int64_t frame) const;
+  /// DIR/final.tfxc: a shard's state at the run's end, which `tickfx merge` merges.
+  std::filesystem::path finalStatePath() const;
 };
 
 /// Checks `arguments` against `load`'s effect (loaded) and resolves the defaults it leaves to

@@ -19,6 +19,8 @@ constexpr const char* kUsage =
     "\n"
     "commands:\n"
     "  run EFFECT.toml    simulate an effect and write per-frame caches\n"
+    "  merge SHARD_DIR... --out DIR  merge the shards of a run (run --shard I/N) into the\n"
+    "                     whole run's files\n"
     "  check EFFECT.toml  validate an effect and print lint warnings\n"
     "  study              the integrator study: three experiments against exact solutions\n"
     "  determinism EFFECT.toml  run an effect under many frame rates and thread counts and\n"
@@ -55,6 +57,7 @@ int main(int argc, char** argv) {
   Arguments args(command, std::vector<std::string>(argv + 2, argv + argc));
   try {
     if (command == "run") return runCommand(args);
+    if (command == "merge") return mergeCommand(args);
     if (command == "check") return checkCommand(args);
     if (command == "study") return studyCommand(args);
     if (command == "determinism") return determinismCommand(args);

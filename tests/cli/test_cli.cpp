@@ -32,11 +32,6 @@ class Cli : public tickfx::cli_test::CliFixture {
 
   // `tickfx ARGS` from the source tree, stdin closed.
   Result run(const std::string& args) const { return runProgram(TICKFX_CLI, args); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string writeFile(const std::string& name, const std::string& text) const {
-    std::ofstream(dir_ / name) << text;
-    return path(name);
-  }
   // "HASH@TICKS" from the two lines --hash prints.
   static std::string hashOf(const Result& r) {
     const std::size_t at = r.out.find("state-hash: ");

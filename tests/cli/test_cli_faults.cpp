@@ -33,8 +33,6 @@ class CliFaults : public tickfx::cli_test::CliFixture {
  protected:
   CliFaults() : CliFixture("tickfx_faults") {}
 
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
   // The fountain sample from its first frame, caches of `format` into `out`.
   static std::vector<std::string> fountain(const std::string& format, const std::string& out,
                                            const std::string& seconds = "5") {

@@ -22,7 +22,6 @@ class HashLog : public tickfx::cli_test::CliFixture {
   HashLog() : CliFixture("tickfx_hash_log") {}
 
   Result run(const std::string& args) const { return runProgram(TICKFX_CLI, args); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   static std::vector<std::string> lines(const std::string& text) {
     std::vector<std::string> out;

@@ -32,7 +32,6 @@ class CliPoints : public tickfx::cli_test::CliFixture {
     return runProgram(program, args);
   }
   Result tickfx(const std::string& args) const { return run(TICKFX_CLI, args); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
 };
 
 TEST_F(CliPoints, RunWritesVdbCachesHoldingTheCsvCachesBits) {

@@ -24,7 +24,6 @@ class PreviewPixels : public CliFixture {
  protected:
   PreviewPixels() : CliFixture("tickfx_preview_pixels") {}
   Result run(const std::string& args) const { return runProgram(TICKFX_CLI, args); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
 };
 
 struct Particle {

@@ -46,6 +46,14 @@ class CliFixture : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
+  /// dir_/name as a string, for command lines.
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  /// Writes `text` to dir_/name; its path.
+  std::string writeFile(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name) << text;
+    return path(name);
+  }
+
   /// Runs `program args` from the source tree (so samples/... resolve), stdin closed; stdout and
   /// stderr go through files in dir_.
   Result runProgram(const std::string& program, const std::string& args) const {
