@@ -13,10 +13,12 @@ TICKFX_PACKAGES=(
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib libpng-dev libgif-dev
 )
 
-# What scripts/test adds for the Blender add-on's tests: Debian's Blender (3.4.1, headless with
-# -b), which runs Debian's python3 and so imports the tickfx module. scripts/demo does without it.
+# What scripts/test adds for the tests: Debian's Blender (3.4.1, headless with -b) for the
+# add-on's, which runs Debian's python3 and so imports the tickfx module; Dask's distributed
+# (python3-distributed, 2022.12) for tickfx.distributed's, on a local cluster. scripts/demo does
+# without them.
 # shellcheck disable=SC2034 # scripts/test installs them with the rest
-TICKFX_TEST_PACKAGES=(blender)
+TICKFX_TEST_PACKAGES=(blender python3-distributed)
 
 # What scripts/test's aarch64 stage adds: Debian's cross compiler, qemu-user, and the arm64 builds
 # of the libraries (Multi-Arch: same, installed beside the amd64 ones). OpenVDB comes as its
