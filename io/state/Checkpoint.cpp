@@ -1,5 +1,10 @@
 #include "io/state/Checkpoint.h"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cerrno>
@@ -93,30 +98,58 @@ void loadLittleEndian(const char* in, T* values, std::size_t count) {
   }
 }
 
+// Writes a checkpoint's bytes to a stream as they are made, fingerprinting them on the way (the
+// trailer's checksum); without a stream it only counts them (the header's file length). A file
+// of 10⁸ particles is 9 GB: it is never held whole in memory.
 class Writer {
  public:
+  explicit Writer(std::ostream* out) : out_(out) {}
+
   void u32(std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+    char b[4];
+    for (int i = 0; i < 4; ++i) b[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    put(b, 4);
   }
   void u64(std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes_.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+    char b[8];
+    for (int i = 0; i < 8; ++i) b[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    put(b, 8);
   }
   void i64(std::int64_t v) { u64(static_cast<std::uint64_t>(v)); }
+  void bytes(std::string_view s) { put(s.data(), s.size()); }
   void str(std::string_view s) {
     u32(static_cast<std::uint32_t>(s.size()));
-    bytes_.append(s);
+    bytes(s);
   }
   template <typename T>
   void column(const T* values, std::size_t count) {
-    appendLittleEndian(bytes_, values, count);
+    if (out_ == nullptr) {
+      size_ += count * sizeof(T);
+      return;
+    }
+    // A block at a time, in little-endian order whatever the host's.
+    constexpr std::size_t kBlock = 1 << 16;
+    std::string block;
+    for (std::size_t done = 0; done < count; done += kBlock) {
+      block.clear();
+      appendLittleEndian(block, values + done, std::min(kBlock, count - done));
+      put(block.data(), block.size());
+    }
   }
-  void patchU64(std::size_t offset, std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes_[offset + i] = static_cast<char>((v >> (8 * i)) & 0xff);
-  }
-  std::string& bytes() { return bytes_; }
+  std::uint64_t size() const { return size_; }
+  std::uint64_t checksum() const { return checksum_.value(); }
 
  private:
-  std::string bytes_;
+  void put(const char* p, std::size_t n) {
+    size_ += n;
+    if (out_ == nullptr) return;
+    checksum_.add(std::string_view(p, n));
+    out_->write(p, static_cast<std::streamsize>(n));
+  }
+
+  std::ostream* out_;
+  std::uint64_t size_ = 0;
+  Fingerprinter checksum_;
 };
 
 // Only ever reached for a file whose checksum matched, i.e. one a writer of this version got
@@ -160,6 +193,54 @@ class CheckpointReader {
 // bits.
 constexpr std::size_t kSpringBytes = 8 + 8 + 4 * 4;
 
+[[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
+  throw std::runtime_error(path.string() + ": error: " + what);
+}
+
+// A checkpoint file's bytes, mapped read-only: the pages are the kernel's to drop and read again,
+// so merging shards larger than the memory left stays within it. Checkpoints are replaced by
+// renaming a new file over them (writeFileAtomically), which leaves a mapped file's bytes as
+// they were: the bytes checked are the bytes read.
+class FileBytes {
+ public:
+  explicit FileBytes(const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::filesystem::file_status status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status)) fail(path, "cannot open checkpoint (no such file)");
+    if (std::filesystem::is_directory(status))
+      fail(path, "cannot read checkpoint (it is a directory)");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) fail(path, std::string("cannot open checkpoint (") + std::strerror(errno) + ")");
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || st.st_size < 0) {
+      ::close(fd);
+      fail(path, "cannot read checkpoint (cannot tell its size)");
+    }
+    size_ = static_cast<std::size_t>(st.st_size);
+    if (size_ > 0) {
+      void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
+      if (mapped == MAP_FAILED) {
+        const int error = errno;
+        ::close(fd);
+        fail(path, std::string("cannot read checkpoint (") + std::strerror(error) + ")");
+      }
+      data_ = static_cast<const char*>(mapped);
+    }
+    ::close(fd);
+  }
+  ~FileBytes() {
+    if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
+  }
+  FileBytes(const FileBytes&) = delete;
+  FileBytes& operator=(const FileBytes&) = delete;
+
+  std::string_view view() const { return {data_ != nullptr ? data_ : "", size_}; }
+
+ private:
+  const char* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
 // The scalars of a state (settings, clock, driver, counters), whoever holds the columns: every
 // shard of a run has the same ones.
 struct StateScalars {
@@ -191,7 +272,7 @@ struct Parsed : StateScalars {
   Shard shard;  // the whole run without the shard flag
   // The file's bytes, which the column pointers above point into (a unique_ptr: they stay put
   // when a Parsed moves).
-  std::unique_ptr<const std::string> file;
+  std::unique_ptr<const FileBytes> file;
 };
 
 // A pending event on file: u64 parent id, u32 emitter, u32 kind, u32 ordinal, f32 × 9.
@@ -439,33 +520,11 @@ void apply(const Parsed& p, ParticleSystem& system) {
   system.restoreClock(p.tick, p.tickStartVelocities != nullptr ? &velocities : nullptr);
 }
 
-[[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
-  throw std::runtime_error(path.string() + ": error: " + what);
-}
-
-std::string readWholeFile(const std::filesystem::path& path) {
-  std::error_code ec;
-  const std::filesystem::file_status status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) fail(path, "cannot open checkpoint (no such file)");
-  if (std::filesystem::is_directory(status))
-    fail(path, "cannot read checkpoint (it is a directory)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, std::string("cannot open checkpoint (") + std::strerror(errno) + ")");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  in.seekg(0, std::ios::beg);
-  if (size < 0 || !in) fail(path, "cannot read checkpoint (cannot tell its size)");
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  in.read(bytes.data(), size);
-  if (in.gcount() != size) fail(path, "cannot read checkpoint (read error)");
-  return bytes;
-}
-
 // The file at `path` read whole and checked (magic, version, flags, length, checksum) and its
 // payload parsed; throws std::runtime_error "PATH: error: ..." otherwise.
 Parsed loadCheckpointFile(const std::filesystem::path& path) {
-  auto file = std::make_unique<const std::string>(readWholeFile(path));
-  const std::string& bytes = *file;
+  auto file = std::make_unique<const FileBytes>(path);
+  const std::string_view bytes = file->view();
   const std::size_t found = bytes.size();
   auto truncated = [&](const std::string& expected) {
     fail(path, "checkpoint is truncated (expected " + expected + " bytes, found " +
@@ -516,7 +575,7 @@ Parsed loadCheckpointFile(const std::filesystem::path& path) {
 }
 
 // A state as a checkpoint holds it, borrowed from a system or from merged shards: what
-// serialize() writes. A null float column is written as zeros (an acceleration the pool does not
+// writeState() writes. A null float column is written as zeros (an acceleration the pool does not
 // keep).
 struct StateView : StateScalars {
   std::size_t size = 0;
@@ -540,14 +599,13 @@ std::uint32_t bitsOf(float f) {
   return bits;
 }
 
-// The whole file, header to checksum, in the layout writeCheckpoint() documents.
-std::string serialize(const StateView& v) {
+// Everything but the trailer, in the layout writeCheckpoint() documents; `length` is the file's.
+void writeState(const StateView& v, Writer& w, std::uint64_t length) {
   const std::size_t n = v.size;
-  Writer w;
-  w.bytes().append(kCheckpointMagic);
+  w.bytes(kCheckpointMagic);
   w.u32(kCheckpointVersion);
   w.u32((v.events.empty() ? 0u : kPendingEventsFlag) | (v.shard.whole() ? 0u : kShardFlag));
-  w.u64(0);  // the file length, patched below
+  w.u64(length);
   w.u64(v.info.effectHash);
 
   w.i64(v.stepRateHz);
@@ -604,16 +662,22 @@ std::string serialize(const StateView& v) {
     w.u32(v.shard.index);
     w.u32(v.shard.count);
   }
-  w.patchU64(kLengthOffset, w.bytes().size() + kTrailerBytes);
-  w.u64(fingerprint(w.bytes()));
-  return std::move(w.bytes());
 }
 
-void writeBytes(const std::filesystem::path& path, const std::string& bytes) {
+// Writes the checkpoint of `v` to `path` (atomically, synced), streaming: a first pass counts
+// the bytes for the header's length, the second writes them and their checksum.
+void writeStateFile(const std::filesystem::path& path, const StateView& v) {
+  Writer counter(nullptr);
+  writeState(v, counter, 0);
+  const std::uint64_t length = counter.size() + kTrailerBytes;
   writeFileAtomically(
       path,
       [&](std::ostream& out) {
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+        Writer w(&out);
+        writeState(v, w, length);
+        const std::uint64_t checksum = w.checksum();
+        Writer trailer(&out);
+        trailer.u64(checksum);
       },
       Durability::Synced);
 }
@@ -663,7 +727,7 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
     v.inheritedColumns = static_cast<std::uint32_t>(events->inheritedColumns().size());
   }
   v.shard = system.shard();
-  writeBytes(path, serialize(v));
+  writeStateFile(path, v);
 }
 
 CheckpointInfo readCheckpoint(const std::filesystem::path& path, ParticleSystem& system,
@@ -875,7 +939,7 @@ MergedCheckpoint mergeShardCheckpoints(const std::vector<std::filesystem::path>&
     v.attributes.emplace_back(pool.attributeName(a), pool.attribute(a).data());
   v.springs = springs;
   v.springsBroken = springsBroken;
-  writeBytes(out, serialize(v));
+  writeStateFile(out, v);
   const MergedCheckpoint merged{stateHash(pool), v.tick, v.info};
   return merged;
 }

@@ -1,5 +1,6 @@
 #include "io/util/Fingerprint.h"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -25,16 +26,37 @@ std::uint64_t littleEndianWord(const char* p) {
 }  // namespace
 
 std::uint64_t fingerprint(std::string_view bytes) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
+  Fingerprinter f;
+  f.add(bytes);
+  return f.value();
+}
+
+void Fingerprinter::add(std::string_view bytes) {
+  count_ += bytes.size();
   std::size_t i = 0;
-  for (; i + 8 <= bytes.size(); i += 8) h = mix(h, littleEndianWord(bytes.data() + i));
-  if (i < bytes.size()) {
+  if (pendingSize_ > 0) {
+    const std::size_t take = std::min(bytes.size(), 8 - pendingSize_);
+    std::memcpy(pending_ + pendingSize_, bytes.data(), take);
+    pendingSize_ += take;
+    i = take;
+    if (pendingSize_ < 8) return;
+    h_ = mix(h_, littleEndianWord(pending_));
+    pendingSize_ = 0;
+  }
+  for (; i + 8 <= bytes.size(); i += 8) h_ = mix(h_, littleEndianWord(bytes.data() + i));
+  pendingSize_ = bytes.size() - i;
+  if (pendingSize_ > 0) std::memcpy(pending_, bytes.data() + i, pendingSize_);
+}
+
+std::uint64_t Fingerprinter::value() const {
+  std::uint64_t h = h_;
+  if (pendingSize_ > 0) {
     char tail[8] = {};
-    std::memcpy(tail, bytes.data() + i, bytes.size() - i);
+    std::memcpy(tail, pending_, pendingSize_);
     h = mix(h, littleEndianWord(tail));
   }
   // Without the length, inputs that differ only by trailing zero bytes would collide.
-  return mix(h, bytes.size());
+  return mix(h, count_);
 }
 
 std::uint64_t effectFingerprint(std::string_view effectText,

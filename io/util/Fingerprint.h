@@ -19,6 +19,20 @@ namespace tickfx::io {
 /// step is a bijection of h, so any change confined to one word always changes the result.
 std::uint64_t fingerprint(std::string_view bytes);
 
+/// fingerprint() of bytes given a piece at a time: add() the pieces in order, then value() is
+/// fingerprint() of them all joined (for files written as they are made).
+class Fingerprinter {
+ public:
+  void add(std::string_view bytes);
+  std::uint64_t value() const;
+
+ private:
+  std::uint64_t h_ = 0xcbf29ce484222325ULL;
+  std::uint64_t count_ = 0;  // bytes added
+  char pending_[8] = {};     // the bytes of an unfinished word
+  std::size_t pendingSize_ = 0;
+};
+
 /// The effect as a checkpoint, a VDB cache and a hash log know it: fingerprint() of the effect
 /// file's bytes and every override, in order, each after a zero byte. loadEffectFile() and
 /// parseEffect() give it for the text they parsed (LoadResult::fingerprint).

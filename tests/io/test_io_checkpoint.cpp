@@ -825,6 +825,21 @@ TEST(ioFingerprint, EveryBitAndTheLengthCount) {
   EXPECT_NE(fingerprint(std::string(8, '\0')), fingerprint(std::string(16, '\0')));
 }
 
+// A fingerprint made a piece at a time, however the bytes are cut, is the fingerprint of them all.
+TEST(ioFingerprint, PiecesGiveTheWholesFingerprint) {
+  std::string bytes;
+  for (int i = 0; i < 100; ++i) bytes += static_cast<char>(i * 37 + 11);
+  for (std::size_t length : {0u, 1u, 7u, 8u, 9u, 64u, 100u}) {
+    const std::string_view whole(bytes.data(), length);
+    for (std::size_t cut : {1u, 3u, 8u, 13u}) {
+      Fingerprinter f;
+      for (std::size_t at = 0; at < length; at += cut) f.add(whole.substr(at, cut));
+      EXPECT_EQ(f.value(), fingerprint(whole)) << length << " in pieces of " << cut;
+    }
+  }
+  EXPECT_EQ(Fingerprinter().value(), fingerprint(""));
+}
+
 }  // namespace
 }  // namespace tickfx::io
 
