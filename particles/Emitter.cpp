@@ -191,33 +191,26 @@ std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t
   // Serials are counted from tick 0, so a later tick never has made fewer particles.
   TICKFX_ASSERT(first <= last, "an emitter's serials going backwards");
   TICKFX_ASSERT(pool.size() <= pool.maxParticles(), "a pool past its maxParticles");
-  if (!shard.whole()) return emitShard(pool, seed, first, last, tick, shard);
-  // Particles the pool has no room for are counted, not sampled.
-  const std::uint64_t room = pool.maxParticles() - pool.size();
-  const std::uint64_t tried = std::min<std::uint64_t>(last - first, room);
-  // Every particle is a pure function of its serial: the rows are reserved in serial order, then
-  // filled in parallel blocks, with the bits of one spawn() after another.
-  const std::size_t firstRow = pool.appendRows(static_cast<std::size_t>(tried), tick);
-  TICKFX_ASSERT(firstRow + tried == pool.size(), "an emitter's rows not at the pool's end");
-  parallelForRows(static_cast<std::size_t>(tried), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) pool.setRow(firstRow + k, sample(seed, first + k));
-  });
-  pool.refuseSpawns(last - first - tried);
-  return last - first;
-}
-
-std::uint64_t Emitter::emitShard(ParticlePool& pool, std::uint64_t seed, std::uint64_t first,
-                                 std::uint64_t last, std::int64_t tick, const Shard& shard) const {
-  // The shard's serials of [first, last): every count-th from the first it owns.
+  // This pool's serials of [first, last): every count-th from the first it owns (all of them for
+  // the whole run).
   const std::uint64_t own = shard.firstOwnedSerial(index_, first);
   const std::uint64_t owned = own < last ? (last - 1 - own) / shard.count + 1 : 0;
-  TICKFX_ASSERT(owned <= pool.maxParticles() - pool.size(), "a shard's pool reaching its cap");
-  const std::size_t firstRow = pool.appendRowsStrided(static_cast<std::size_t>(owned), tick,
-                                                      own - first, shard.count, last - first);
-  parallelForRows(static_cast<std::size_t>(owned), [&](std::size_t begin, std::size_t end) {
+  // Particles the pool has no room for are counted, not sampled (a shard never lacks room: a cap
+  // that may bind is refused before a run is sharded).
+  const std::uint64_t tried = std::min<std::uint64_t>(owned, pool.maxParticles() - pool.size());
+  TICKFX_ASSERT(shard.whole() || tried == owned, "a shard's pool reaching its cap");
+  // Every particle is a pure function of its serial: the rows are reserved in serial order, then
+  // filled in parallel blocks, with the bits of one spawn() after another. Ids go to the rows
+  // made and to the other shards' particles; refused spawns take none.
+  const std::size_t firstRow =
+      pool.appendRowsStrided(static_cast<std::size_t>(tried), tick, own - first, shard.count,
+                             tried + (last - first - owned));
+  TICKFX_ASSERT(firstRow + tried == pool.size(), "an emitter's rows not at the pool's end");
+  parallelForRows(static_cast<std::size_t>(tried), [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k)
       pool.setRow(firstRow + k, sample(seed, own + k * shard.count));
   });
+  pool.refuseSpawns(owned - tried);
   return last - first;
 }
 

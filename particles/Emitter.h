@@ -139,8 +139,6 @@ class Emitter {
   const EmitterSettings& settings() const { return s_; }
 
  private:
-  std::uint64_t emitShard(ParticlePool& pool, std::uint64_t seed, std::uint64_t first,
-                          std::uint64_t last, std::int64_t tick, const Shard& shard) const;
   std::uint64_t rateCountBefore(std::int64_t tick) const;
   // A particle of `random` at `origin` plus the shape's offset, going along `dir` (unit) within the
   // spread around it (b1, b2 completing it to a basis).

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/util/MergeOrder.h"
+
 namespace tickfx::io {
 namespace {
 
@@ -42,26 +44,21 @@ FrameData mergeShardFrames(const std::vector<FrameData>& shards,
       refuse(sources[s], "other attributes than " + sources.front().string());
     total += f.size();
   }
+  // Each shard's rows rise by id: a k-way merge gives the whole run's order.
+  std::vector<std::uint64_t> sizes;
+  for (const FrameData& f : shards) sizes.push_back(f.size());
+  const auto order = mergeOrder(
+      sizes, [&](std::size_t s, std::uint64_t row) { return shards[s].id[row]; },
+      [&](std::size_t s, std::size_t t, std::uint64_t id) {
+        refuse(sources[s],
+               "particle " + std::to_string(id) + " is in " + sources[t].string() + " too");
+      });
   FrameData out;
   out.frame = first.frame;
   out.timeSeconds = first.timeSeconds;
   out.resize(total, first.attributeNames);
-  // A k-way merge by id: each shard's rows rise.
-  std::vector<std::size_t> next(shards.size(), 0);
-  for (std::size_t row = 0; row < total; ++row) {
-    std::size_t best = shards.size();
-    for (std::size_t s = 0; s < shards.size(); ++s) {
-      if (next[s] == shards[s].size()) continue;
-      const std::uint64_t id = shards[s].id[next[s]];
-      if (best == shards.size() || id < shards[best].id[next[best]]) {
-        best = s;
-      } else if (id == shards[best].id[next[best]]) {
-        refuse(sources[s],
-               "particle " + std::to_string(id) + " is in " + sources[best].string() + " too");
-      }
-    }
-    copyRow(shards[best], next[best]++, out, row);
-  }
+  for (std::size_t row = 0; row < order.size(); ++row)
+    copyRow(shards[order[row].first], order[row].second, out, row);
   return out;
 }
 

@@ -22,6 +22,7 @@
 #include "fields/SpringNetwork.h"
 #include "integrators/Integrator.h"
 #include "io/util/AtomicFile.h"
+#include "io/util/MergeOrder.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::io {
@@ -828,32 +829,19 @@ MergedCheckpoint mergeShardCheckpoints(const std::vector<std::filesystem::path>&
   }
 
   // The rows in id order: each shard's are rising, no id is in two shards.
-  std::vector<std::pair<std::uint32_t, std::uint64_t>> order;  // (shard, row)
-  std::vector<std::uint64_t> next(parsed.size(), 0);
-  std::uint64_t total = 0;
-  for (const Parsed& p : parsed) total += p.size;
-  order.reserve(static_cast<std::size_t>(total));
-  const auto idAt = [&](std::size_t s, std::uint64_t row) {
-    std::uint64_t id = 0;
-    loadLittleEndian(parsed[s].ids + row * 8, &id, 1);
-    return id;
-  };
-  for (std::uint64_t k = 0; k < total; ++k) {
-    std::size_t best = parsed.size();
-    std::uint64_t bestId = 0;
-    for (std::size_t s = 0; s < parsed.size(); ++s) {
-      if (next[s] == parsed[s].size) continue;
-      const std::uint64_t id = idAt(s, next[s]);
-      if (best == parsed.size() || id < bestId) {
-        best = s;
-        bestId = id;
-      } else if (id == bestId) {
-        fail(shards[s], "checkpoint holds particle " + std::to_string(id) + ", as does " +
-                            shards[best].string());
-      }
-    }
-    order.emplace_back(static_cast<std::uint32_t>(best), next[best]++);
-  }
+  std::vector<std::uint64_t> sizes;
+  for (const Parsed& p : parsed) sizes.push_back(p.size);
+  const auto order = mergeOrder(
+      sizes,
+      [&](std::size_t s, std::uint64_t row) {
+        std::uint64_t id = 0;
+        loadLittleEndian(parsed[s].ids + row * 8, &id, 1);
+        return id;
+      },
+      [&](std::size_t s, std::size_t t, std::uint64_t id) {
+        fail(shards[s],
+             "checkpoint holds particle " + std::to_string(id) + ", as does " + shards[t].string());
+      });
 
   // The merged rows go straight into a pool (which also gives the state hash); the shards' files
   // are let go before the merged file is serialised: at most the files and the pool, then the
@@ -901,21 +889,17 @@ MergedCheckpoint mergeShardCheckpoints(const std::vector<std::filesystem::path>&
 
   // Springs in the whole run's order: structures in the order of their ids (each structure's ids
   // a block of their own, all in one shard), each structure's springs in its shard's order.
+  std::vector<std::uint64_t> springCounts;
+  for (const Parsed& p : parsed) springCounts.push_back(p.springs.size());
   std::vector<Spring> springs;
+  const auto springKey = [&](std::size_t s, std::uint64_t k) {
+    const Spring& spring = parsed[s].springs[k];
+    return std::min(spring.a, spring.b);
+  };
+  const auto noTie = [](std::size_t, std::size_t, std::uint64_t) {};  // shards share no particle
+  for (const auto& [s, k] : mergeOrder(springCounts, springKey, noTie))
+    springs.push_back(parsed[s].springs[k]);
   std::uint64_t springsBroken = 0;
-  std::vector<std::size_t> nextSpring(parsed.size(), 0);
-  const auto key = [](const Spring& s) { return std::min(s.a, s.b); };
-  for (;;) {
-    std::size_t best = parsed.size();
-    for (std::size_t s = 0; s < parsed.size(); ++s) {
-      if (nextSpring[s] == parsed[s].springs.size()) continue;
-      if (best == parsed.size() ||
-          key(parsed[s].springs[nextSpring[s]]) < key(parsed[best].springs[nextSpring[best]]))
-        best = s;
-    }
-    if (best == parsed.size()) break;
-    springs.push_back(parsed[best].springs[nextSpring[best]++]);
-  }
   for (const Parsed& p : parsed) springsBroken += p.springsBroken;
 
   StateView v;
