@@ -84,7 +84,8 @@ io::FrameData stateAfterTick(const io::EffectSettings& effect, const DriveCase& 
       state.position[c] = pool.position()[c].head(n);
       state.velocity[c] = pool.velocity()[c].head(n);
     }
-    state.age = pool.age().head(n);
+    state.age.resize(n);
+    pool.ages(0, pool.size(), state.age.data());
     state.life = pool.lifetime().head(n);
     state.mass = pool.mass().head(n);
     reached = true;

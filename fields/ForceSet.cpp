@@ -1,7 +1,6 @@
 #include "fields/ForceSet.h"
 
 #include <algorithm>
-#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -14,24 +13,10 @@ namespace {
 // A pinned particle (infinite mass) does not move: no force accelerates it, gravity included, and
 // no flow carries it.
 void holdPinned(const ForceInput& in, RowRange rows, Vec3Rows& value) {
-  const auto pinned = in.pool.inverseMass().segment(rows.offset(), rows.count()) == 0.0f;
+  const auto pinned = in.pool.mass().segment(rows.offset(), rows.count()).isInf();
   value.x = pinned.select(0.0f, value.x);
   value.y = pinned.select(0.0f, value.y);
   value.z = pinned.select(0.0f, value.z);
-}
-
-// Whether any of the first n inverse masses is 0. Every tick, since a host may change masses
-// between ticks: in parallel blocks, each a branch-free loop the compiler vectorises (Eigen's
-// (column == 0).any() ran serially at about a tenth of memory speed: 6 % of a 10⁶-particle tick).
-bool anyZero(const FloatColumn& inverseMass, std::size_t n) {
-  std::atomic<bool> found{false};
-  const float* values = inverseMass.data();
-  parallelForRows(n, [&](std::size_t begin, std::size_t end) {
-    int zero = 0;
-    for (std::size_t i = begin; i < end; ++i) zero |= static_cast<int>(values[i] == 0.0f);
-    if (zero != 0) found.store(true, std::memory_order_relaxed);
-  });
-  return found.load(std::memory_order_relaxed);
 }
 
 }  // namespace
@@ -69,7 +54,9 @@ bool ForceSet::interleavesTicks() const {
 
 void ForceSet::beginTick(const ParticlePool& pool, std::int64_t tick) {
   for (auto& m : modules_) m->beginTick(pool, tick);
-  anyPinned_ = anyZero(pool.inverseMass(), pool.size());
+  // A scan only when a spawn or a host's write may have pinned a particle since the last one
+  // found none (ParticlePool::mayHavePinned).
+  anyPinned_ = pool.anyPinned();
 }
 
 std::size_t ForceSet::uniformPrefix(const ForceInput& in, Eigen::Vector3f& uniform) const {

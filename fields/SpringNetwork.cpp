@@ -121,7 +121,7 @@ void SpringNetwork::rebuild(const ParticlePool& pool) {
 void SpringNetwork::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acc) const {
   const Vec3View& p = in.position;
   const Vec3View& v = in.velocity;
-  const FloatColumn& invMass = in.pool.inverseMass();
+  const FloatColumn& mass = in.pool.mass();
   for (std::size_t i = rows.begin; i < rows.end; ++i) {
     if (i + 1 >= first_.size()) break;  // rows spawned after beginTick (none within a tick)
     float fx = 0.0f, fy = 0.0f, fz = 0.0f;
@@ -142,7 +142,7 @@ void SpringNetwork::accumulate(const ForceInput& in, RowRange rows, Vec3Rows& ac
       fy += f * uy;
       fz += f * uz;
     }
-    const float w = invMass[static_cast<Eigen::Index>(i)];
+    const float w = inverseMassOf(mass[static_cast<Eigen::Index>(i)]);
     const auto k = static_cast<Eigen::Index>(i - rows.begin);
     acc.x[k] += fx * w;
     acc.y[k] += fy * w;

@@ -185,7 +185,7 @@ void EventEmission::record(const Rows& rows, std::size_t row, ParticleEvent even
         inheritedLife_[j] < 0
             ? stored
             : attributes_->rowValue(inheritedLife_[j], static_cast<int>(event.parentEmitter),
-                                    event.parentId, pool.age()[r], pool.lifetime()[r], stored));
+                                    event.parentId, pool.age(row), pool.lifetime()[r], stored));
   }
 }
 

@@ -98,8 +98,8 @@ void ParticlePool::reserve(std::size_t rows) {
 
 std::size_t ParticlePool::bytesPerRow() const {
   constexpr std::size_t kVec3 = 3 * sizeof(float);
-  return (keepsAcceleration_ ? 4 : 3) * kVec3 + 4 * sizeof(float) + sizeof(std::uint64_t) +
-         sizeof(std::int64_t) + sizeof(std::uint8_t) + attributes_.size() * sizeof(float);
+  return (keepsAcceleration_ ? 4 : 3) * kVec3 + 2 * sizeof(float) + sizeof(std::uint64_t) +
+         sizeof(std::uint32_t) + sizeof(std::uint8_t) + attributes_.size() * sizeof(float);
 }
 
 void ParticlePool::keepAcceleration() {
@@ -113,7 +113,7 @@ void ParticlePool::grow(std::size_t rows) {
   const auto n = static_cast<Eigen::Index>(rows);
   for (Vec3Column* c : {&position_, &velocity_, &previous_}) c->conservativeResize(n);
   if (keepsAcceleration_) acceleration_.conservativeResize(n);
-  for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_}) c->conservativeResize(n);
+  for (FloatColumn* c : {&lifetime_, &mass_}) c->conservativeResize(n);
   id_.resize(rows);
   birthTick_.resize(rows);
   dead_.resize(rows);
@@ -139,6 +139,7 @@ std::size_t ParticlePool::appendRowsStrided(std::size_t count, std::int64_t tick
                                             std::uint64_t firstOffset, std::uint64_t stride,
                                             std::uint64_t idsUsed) {
   TICKFX_ASSERT(count <= maxParticles_ - size_, "rows appended past maxParticles");
+  TICKFX_ASSERT(tick >= 0 && tick <= kMaxBirthTick, "a birth tick past 32 bits");
   TICKFX_ASSERT(stride >= 1 && (count == 0 || firstOffset + (count - 1) * stride < idsUsed),
                 "strided ids past the ids handed out");
   const std::size_t first = size_;
@@ -151,7 +152,7 @@ std::size_t ParticlePool::appendRowsStrided(std::size_t count, std::int64_t tick
   TICKFX_ASSERT(size_ <= storageRows_, "rows appended past the pool's storage");
   for (std::size_t i = first; i < size_; ++i) {
     id_[i] = nextId_ + firstOffset + (i - first) * stride;
-    birthTick_[i] = tick;
+    birthTick_[i] = static_cast<std::uint32_t>(tick);
     dead_[i] = 0;
   }
   nextId_ += idsUsed;
@@ -177,14 +178,14 @@ void ParticlePool::setRow(std::size_t row, const ParticleInit& init) {
     acceleration_.y[r] = 0.0f;
     acceleration_.z[r] = 0.0f;
   }
-  age_[r] = 0.0f;
   lifetime_[r] = init.lifetime;
   mass_[r] = init.mass;
-  inverseMass_[r] = std::isinf(init.mass) ? 0.0f : 1.0f / init.mass;
+  if (!std::isinf(init.lifetime)) mayExpire_.raise();
+  if (std::isinf(init.mass)) mayPin_.raise();
 }
 
 std::optional<std::string> ParticlePool::restoreProblem(std::span<const std::uint64_t> ids,
-                                                        std::span<const std::int64_t> births,
+                                                        std::span<const std::uint32_t> births,
                                                         std::uint64_t nextId, std::int64_t tick) {
   for (std::size_t i = 0; i < ids.size(); ++i) {
     if (ids[i] >= nextId || (i > 0 && ids[i] <= ids[i - 1])) {
@@ -193,8 +194,12 @@ std::optional<std::string> ParticlePool::restoreProblem(std::span<const std::uin
              ")";
     }
   }
+  if (tick > kMaxBirthTick + 1) {
+    return "tick " + std::to_string(tick) + " is past the last a run can have (" +
+           std::to_string(kMaxBirthTick + 1) + ": birth ticks are 32 bits)";
+  }
   for (std::size_t i = 0; i < births.size(); ++i) {
-    if (births[i] < 0 || births[i] > tick) {
+    if (births[i] > tick) {
       return "row " + std::to_string(i) + " was born at tick " + std::to_string(births[i]) +
              " (expected 0 to " + std::to_string(tick) + ")";
     }
@@ -202,34 +207,72 @@ std::optional<std::string> ParticlePool::restoreProblem(std::span<const std::uin
   return std::nullopt;
 }
 
-void ParticlePool::updateAges(std::int64_t tick, std::int64_t stepRateHz) {
-  // A product with the reciprocal rather than a division per row, and the integer converted by
-  // the exponent trick (exact for counts below 2^52) because SSE2 has no int64-to-double
-  // instruction: both keep this pass vectorised, where it used to cost as much as the physics.
+void ParticlePool::ages(std::size_t begin, std::size_t end, float* out) const {
+  // A product with the reciprocal rather than a division per row: the loop vectorises.
+  const double secondsPerTick = 1.0 / static_cast<double>(stepRateHz_);
+  const std::uint32_t* birth = birthTick_.data();
+  const std::int64_t tick = clockTick_;
+  for (std::size_t i = begin; i < end; ++i)
+    out[i - begin] = ageSeconds(tick - birth[i], secondsPerTick);
+}
+
+void ParticlePool::setClock(std::int64_t tick, std::int64_t stepRateHz) {
+  TICKFX_ASSERT(stepRateHz > 0, "a clock of no ticks a second");
+  clockTick_ = tick;
+  stepRateHz_ = stepRateHz;
+}
+
+void ParticlePool::advanceClock(std::int64_t tick, std::int64_t stepRateHz) {
+  setClock(tick, stepRateHz);
+  if (!mayExpire_.get()) return;
   const double secondsPerTick = 1.0 / static_cast<double>(stepRateHz);
-  const std::int64_t* birth = birthTick_.data();
+  const std::uint32_t* birth = birthTick_.data();
   const float* life = lifetime_.data();
-  float* age = age_.data();
   std::uint8_t* dead = dead_.data();
-  parallelForRows(size_, [=](std::size_t b, std::size_t e) {
+  // Whether any row has a finite lifetime: when none has, the next ticks skip this scan.
+  RelaxedFlag finite, expired;
+  parallelForRows(size_, [&](std::size_t b, std::size_t e) {
+    // Ages in registers, compared and dropped: a vectorised test first, the byte flags only for
+    // a block where some particle died (rare, or a run at the front).
+    int anyExpired = 0, anyFinite = 0;
     for (std::size_t i = b; i < e; ++i) {
-      const auto lived = static_cast<std::uint64_t>(tick - birth[i]);
-      age[i] = static_cast<float>((std::bit_cast<double>(lived | 0x4330000000000000ULL) - 0x1p52) *
-                                  secondsPerTick);
+      anyExpired |= static_cast<int>(ageSeconds(tick - birth[i], secondsPerTick) >= life[i]);
+      anyFinite |= static_cast<int>(life[i] < std::numeric_limits<float>::infinity());
     }
-    // Deaths are rare in any one block: a vectorised test first, the byte flags only if needed.
-    int expired = 0;
-    for (std::size_t i = b; i < e; ++i) expired |= static_cast<int>(age[i] >= life[i]);
-    if (expired == 0) return;
-    for (std::size_t i = b; i < e; ++i)
-      dead[i] = static_cast<std::uint8_t>(dead[i] | (age[i] >= life[i] ? 1 : 0));
+    if (anyFinite != 0) finite.raise();
+    if (anyExpired == 0) return;
+    expired.raise();
+    for (std::size_t i = b; i < e; ++i) {
+      const bool over = ageSeconds(tick - birth[i], secondsPerTick) >= life[i];
+      dead[i] = static_cast<std::uint8_t>(dead[i] | (over ? 1 : 0));
+    }
   });
+  if (expired.get()) mayDie_.raise();
+  if (!finite.get()) mayExpire_.clear();
+}
+
+bool ParticlePool::anyPinned() const {
+  if (!mayPin_.get()) return false;
+  // In parallel blocks, each a branch-free loop the compiler vectorises.
+  const float* m = mass_.data();
+  RelaxedFlag found;
+  parallelForRows(size_, [&](std::size_t b, std::size_t e) {
+    int pinned = 0;
+    for (std::size_t i = b; i < e; ++i)
+      pinned |= static_cast<int>(std::fabs(m[i]) == std::numeric_limits<float>::infinity());
+    if (pinned != 0) found.raise();
+  });
+  if (!found.get()) mayPin_.clear();
+  return found.get();
 }
 
 std::size_t ParticlePool::firstDeadRow() const { return firstFlagged(dead_.data(), 0, size_); }
 
 std::size_t ParticlePool::removeDead() {
-  // Most ticks nobody dies: find that out with one byte scan and touch nothing else.
+  // Most ticks nobody dies: find that out with no scan when nothing can have flagged a row, else
+  // with one byte scan, and touch nothing else.
+  if (!mayDie_.get()) return 0;
+  mayDie_.clear();
   const std::size_t first = firstDeadRow();
   if (first == size_) return 0;
   const std::vector<KeptRun> runs = keptRuns(dead_, first, size_);
@@ -239,7 +282,7 @@ std::size_t ParticlePool::removeDead() {
     if (c == &acceleration_ && !keepsAcceleration_) continue;
     for (int k = 0; k < 3; ++k) floats.push_back((*c)[k].data());
   }
-  for (FloatColumn* c : {&age_, &lifetime_, &mass_, &inverseMass_}) floats.push_back(c->data());
+  for (FloatColumn* c : {&lifetime_, &mass_}) floats.push_back(c->data());
   for (NamedColumn& a : attributes_) floats.push_back(a.values.data());
   parallelForTasks(floats.size() + 2, [&](std::size_t c) {
     if (c < floats.size()) {
@@ -273,6 +316,7 @@ void ParticlePool::dropNewest(std::size_t size, std::uint64_t nextId) {
 void ParticlePool::applyRemovalTo(Vec3Column& column) const {
   TICKFX_ASSERT(static_cast<std::size_t>(column.x.size()) >= size_,
                 "a column shorter than the pool it follows");
+  if (!mayDie_.get()) return;
   const std::size_t first = firstDeadRow();
   if (first == size_) return;
   const std::vector<KeptRun> runs = keptRuns(dead_, first, size_);

@@ -2,6 +2,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
+#include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -31,6 +34,30 @@ struct Vec3Column {
   void copyRows(const Vec3Column& from, std::size_t begin, std::size_t end);
 };
 
+/// A flag threads may set at once (relaxed: read only after the parallel loop that sets it has
+/// joined). Copyable, so the pool stays a value.
+class RelaxedFlag {
+ public:
+  RelaxedFlag() = default;
+  RelaxedFlag(const RelaxedFlag& other) : value_(other.get()) {}
+  RelaxedFlag& operator=(const RelaxedFlag& other) {
+    value_.store(other.get(), std::memory_order_relaxed);
+    return *this;
+  }
+  bool get() const { return value_.load(std::memory_order_relaxed); }
+  /// Sets it, without writing the shared line when it is set already.
+  void raise() {
+    if (!get()) value_.store(true, std::memory_order_relaxed);
+  }
+  void clear() { value_.store(false, std::memory_order_relaxed); }
+
+ private:
+  std::atomic<bool> value_{false};
+};
+
+/// The inverse mass of a particle of `mass` kilograms: 0 for an infinite mass (pinned).
+inline float inverseMassOf(float mass) { return std::isinf(mass) ? 0.0f : 1.0f / mass; }
+
 /// Everything a new particle starts with. Units: metres, metres per second, seconds, kilograms.
 struct ParticleInit {
   Eigen::Vector3f position = Eigen::Vector3f::Zero();
@@ -42,6 +69,11 @@ struct ParticleInit {
 };
 
 /// The particle pool: one column per attribute, rows [0, size()) live, in the order of their ids.
+///
+/// A tick reads and writes only what it needs: ages are not stored but worked out from the birth
+/// tick where they are read (age(), ages()), the inverse mass from the mass (inverseMassOf()), and
+/// the scans for expired, pinned and flagged rows run only when a row may be one (the may*()
+/// flags, raised by spawns and by any mutable access to the column concerned).
 ///
 /// Ownership: the pool owns all columns. References to columns stay valid until the next spawn
 /// (which may grow the storage) or removeDead() (which moves rows). Spawning appends; deaths are
@@ -58,6 +90,11 @@ class ParticlePool {
   std::uint64_t droppedSpawns() const { return droppedSpawns_; }
   /// The id the next spawned particle gets; ids are never reused.
   std::uint64_t nextId() const { return nextId_; }
+
+  /// The last tick a particle can be born in: birth ticks are 32 bits, counted from the run's
+  /// start (tick 0), which at 240 ticks a second is 207 days of simulated time. A system refuses
+  /// to run past it (ParticleSystem::kMaxTicks).
+  static constexpr std::int64_t kMaxBirthTick = std::numeric_limits<std::uint32_t>::max();
 
   /// Appends a particle born at `tick`; returns its row, or npos when the pool is full.
   std::size_t spawn(const ParticleInit& init, std::int64_t tick);
@@ -76,8 +113,8 @@ class ParticlePool {
   /// Counts `count` ids as handed out to particles this pool does not hold (another shard's).
   void skipIds(std::uint64_t count) { nextId_ += count; }
   /// Gives row `row` (appended, not yet stepped) its particle: position (and previous position),
-  /// velocity, lifetime and mass; acceleration (when kept) and age 0. Different rows may be set at
-  /// once from different threads.
+  /// velocity, lifetime and mass; acceleration (when kept) 0. Different rows may be set at once
+  /// from different threads.
   void setRow(std::size_t row, const ParticleInit& init);
   /// Counts `count` spawns refused without trying them (the caller saw the pool was full).
   void refuseSpawns(std::uint64_t count) { droppedSpawns_ += count; }
@@ -91,13 +128,44 @@ class ParticlePool {
   std::size_t firstUnstepped() const { return firstUnstepped_; }
   void markAllStepped() { firstUnstepped_ = size_; }
 
-  /// Recomputes every age from the integer tick count (never accumulated),
-  /// age = float((tick − birth) · (1/rate)) with the product in double, and flags the particles
-  /// whose age reached their lifetime as dead.
-  void updateAges(std::int64_t tick, std::int64_t stepRateHz);
-  /// Removes the particles flagged dead (by a module, or by updateAges at the end of their
-  /// life), keeping the order of the rest. Returns how many were removed.
+  /// Sets the clock the ages refer to: ticks completed and ticks a second. Ages are worked out
+  /// from the integer tick count (never accumulated), age = float((tick − birth) · (1/rate)) with
+  /// the product in double. Then flags the particles whose age reached their lifetime as dead,
+  /// reading the birth ticks and lifetimes only when a row may have a finite lifetime.
+  void advanceClock(std::int64_t tick, std::int64_t stepRateHz);
+  /// Sets the clock alone, flagging nothing (a restored state, whose expired rows are gone).
+  void setClock(std::int64_t tick, std::int64_t stepRateHz);
+  /// The clock set by advanceClock() (0 ticks at 60 Hz until then).
+  std::int64_t clockTick() const { return clockTick_; }
+  std::int64_t stepRateHz() const { return stepRateHz_; }
+  /// Age in seconds of row `row` at clockTick().
+  float age(std::size_t row) const {
+    return ageSeconds(clockTick_ - birthTick_[row], 1.0 / static_cast<double>(stepRateHz_));
+  }
+  /// The ages of rows [begin, end) into out[0, end − begin): age(row) for each, vectorised.
+  void ages(std::size_t begin, std::size_t end, float* out) const;
+  /// float(ticks · secondsPerTick) with the product in double, 0 for ticks <= 0 (a row born
+  /// at or after the clock's tick: spawned in the tick under way); the integer converted by the
+  /// exponent trick (exact below 2^52) because SSE2 has no int64-to-double instruction.
+  static float ageSeconds(std::int64_t ticks, double secondsPerTick) {
+    const auto lived = static_cast<std::uint64_t>(ticks > 0 ? ticks : 0);
+    const double whole = std::bit_cast<double>(lived | 0x4330000000000000ULL) - 0x1p52;
+    return static_cast<float>(whole * secondsPerTick);
+  }
+  /// Removes the particles flagged dead (by a module, or by advanceClock at the end of their
+  /// life), keeping the order of the rest. Returns how many were removed. Reads no flag when none
+  /// can be set (mayHaveDead()).
   std::size_t removeDead();
+
+  /// Whether some row may have a finite lifetime, be pinned (infinite mass) or be flagged dead.
+  /// False means none is: the scans that look for them are skipped. Spawns raise the first two
+  /// for what they spawn; a mutable access to lifetime(), mass() or dead() raises its own.
+  bool mayHaveFiniteLifetimes() const { return mayExpire_.get(); }
+  bool mayHavePinned() const { return mayPin_.get(); }
+  bool mayHaveDead() const { return mayDie_.get(); }
+  /// Whether any of rows [0, size()) is pinned (inverse mass 0): a scan when mayHavePinned(),
+  /// which clears that flag when it finds none.
+  bool anyPinned() const;
   /// Applies to `column` (a caller's copy, rows matching the pool's) the removal removeDead()
   /// is about to make, so the copy keeps matching the rows after it.
   void applyRemovalTo(Vec3Column& column) const;
@@ -114,26 +182,34 @@ class ParticlePool {
   /// Gives the pool its acceleration column, every row 0, if it has none yet.
   void keepAcceleration();
   bool keepsAcceleration() const { return keepsAcceleration_; }
-  FloatColumn& age() { return age_; }
-  FloatColumn& lifetime() { return lifetime_; }
-  FloatColumn& mass() { return mass_; }
-  FloatColumn& inverseMass() { return inverseMass_; }
+  /// Seconds the particle lives (+∞: never). Mutable access counts as writing a finite one.
+  FloatColumn& lifetime() {
+    mayExpire_.raise();
+    return lifetime_;
+  }
+  /// Kilograms (+∞: pinned). Mutable access counts as writing an infinite one.
+  FloatColumn& mass() {
+    mayPin_.raise();
+    return mass_;
+  }
   std::vector<std::uint64_t>& id() { return id_; }
-  std::vector<std::int64_t>& birthTick() { return birthTick_; }
+  /// The tick each particle was born in (0 to kMaxBirthTick).
+  std::vector<std::uint32_t>& birthTick() { return birthTick_; }
   /// Nonzero marks a particle for removal at the end of the tick (written by force modules that
-  /// kill, each for its own rows only).
-  std::vector<std::uint8_t>& dead() { return dead_; }
+  /// kill, each for its own rows only). Mutable access counts as flagging one.
+  std::vector<std::uint8_t>& dead() {
+    mayDie_.raise();
+    return dead_;
+  }
 
   const Vec3Column& position() const { return position_; }
   const Vec3Column& velocity() const { return velocity_; }
   const Vec3Column& previousPosition() const { return previous_; }
   const Vec3Column& acceleration() const { return acceleration_; }
-  const FloatColumn& age() const { return age_; }
   const FloatColumn& lifetime() const { return lifetime_; }
   const FloatColumn& mass() const { return mass_; }
-  const FloatColumn& inverseMass() const { return inverseMass_; }
   const std::vector<std::uint64_t>& id() const { return id_; }
-  const std::vector<std::int64_t>& birthTick() const { return birthTick_; }
+  const std::vector<std::uint32_t>& birthTick() const { return birthTick_; }
   const std::vector<std::uint8_t>& dead() const { return dead_; }
 
   /// Adds a named float attribute, every row set to `initial` (new particles get it too).
@@ -165,7 +241,7 @@ class ParticlePool {
   /// `nextId` ids handed out (ids strictly rising, below nextId; births in [0, tick]), or
   /// nothing when they are one. For saved states, before anything is restored.
   static std::optional<std::string> restoreProblem(std::span<const std::uint64_t> ids,
-                                                   std::span<const std::int64_t> births,
+                                                   std::span<const std::uint32_t> births,
                                                    std::uint64_t nextId, std::int64_t tick);
 
  private:
@@ -186,11 +262,15 @@ class ParticlePool {
   std::uint64_t droppedSpawns_ = 0;
   std::uint64_t rowsVersion_ = 0;
   bool keepsAcceleration_ = false;
+  std::int64_t clockTick_ = 0;
+  std::int64_t stepRateHz_ = 60;
+  RelaxedFlag mayExpire_, mayDie_;
+  mutable RelaxedFlag mayPin_;  // cleared by a const scan that found nothing
 
   Vec3Column position_, velocity_, previous_, acceleration_;
-  FloatColumn age_, lifetime_, mass_, inverseMass_;
+  FloatColumn lifetime_, mass_;
   std::vector<std::uint64_t> id_;
-  std::vector<std::int64_t> birthTick_;
+  std::vector<std::uint32_t> birthTick_;
   std::vector<std::uint8_t> dead_;
   std::vector<NamedColumn> attributes_;
 };

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -78,6 +79,7 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
       arena_(std::make_unique<ThreadArena>(settings.threads)) {
   nonfiniteCheck_.setSteppedRowsFinite(true);  // no rows yet: the first tick's are all spawned
   if (settings.threads < 0) throw std::invalid_argument("threads must be >= 0");
+  pool_.setClock(0, settings.stepRateHz);  // the driver has refused a rate of 0 or less
   for (std::size_t i = 0; i < forces_->size() && springs_ == nullptr; ++i) {
     springs_ = dynamic_cast<SpringNetwork*>(&forces_->module(i));
   }
@@ -131,6 +133,11 @@ void ParticleSystem::stepTicks(std::int64_t ticks) {
 
 void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
   if (ticks <= 0 || nonfiniteStop_) return;
+  if (ticks > kMaxTicks - tick_) {
+    throw std::overflow_error("tick " + std::to_string(tick_ + ticks - 1) +
+                              " is past the last tick a run can have, " +
+                              std::to_string(kMaxTicks - 1) + " (birth ticks are 32 bits)");
+  }
   runParallel([&] {
     if (fusesTicks(ticks) && runFusedTicks(ticks, keepVelocities)) return;
     for (std::int64_t i = 0; i < ticks && !nonfiniteStop_; ++i) {
@@ -366,7 +373,7 @@ void ParticleSystem::endTicks(std::int64_t tick, bool keepVelocities) {
   // Checked and not stopped, the rows left are finite: a kill removes the rows found below.
   nonfiniteCheck_.setSteppedRowsFinite(settings_.nonfinite != NonfinitePolicy::Keep &&
                                        !nonfiniteStop_);
-  pool_.updateAges(tick_, settings_.stepRateHz);
+  pool_.advanceClock(tick_, settings_.stepRateHz);
   if (events_) {
     events_->gather(pool_, colliders_ ? colliders_->contactBlocks()
                                       : std::span<const std::vector<ContactRecord>>{});
@@ -403,6 +410,7 @@ void ParticleSystem::takeNonfinite() {
 
 void ParticleSystem::restoreClock(std::int64_t tick, const Vec3Column* tickStartVelocities) {
   tick_ = tick;
+  pool_.setClock(tick, settings_.stepRateHz);
   pathsTick_ = -1;  // a restored state has no collision paths: frames follow straight lines
   alpha_ = driver_.alpha();
   frameOffset_ = driver_.frameOffset();
@@ -573,14 +581,21 @@ CopyResult ParticleSystem::copyRenderVelocities(const Vec3Destination& out) cons
 CopyResult ParticleSystem::copyRenderAges(const FloatDestination& out) const {
   const std::size_t n = pool_.size();
   if (out.capacity < n) return {n, false};
-  const float* tickAge = pool_.age().data();
   if (frameOffset_ == kFlicksPerSecond) {
-    for (std::size_t i = 0; i < n; ++i) rowOf(out.data, out.rowStride, i) = tickAge[i];
+    runParallel([&] {
+      parallelForRows(n, [&](std::size_t b, std::size_t e) {
+        if (out.rowStride == sizeof(float)) {
+          pool_.ages(b, e, out.data + b);
+          return;
+        }
+        for (std::size_t i = b; i < e; ++i) rowOf(out.data, out.rowStride, i) = pool_.age(i);
+      });
+    });
     return {n, true};
   }
   // age = ((tick − 1 − birth) · F + offset) / (F · H) seconds: an exact integer numerator, one
   // division in double, one rounding to float. No float time is read back.
-  const std::int64_t* birth = pool_.birthTick().data();
+  const std::uint32_t* birth = pool_.birthTick().data();
   const double unitsPerSecond =
       static_cast<double>(kFlicksPerSecond) * static_cast<double>(settings_.stepRateHz);
   const std::int64_t last = tick_ - 1, offset = frameOffset_;
@@ -614,14 +629,10 @@ std::optional<CopyResult> ParticleSystem::copyColumn(std::string_view name,
   } else if (const int life = lifeAttributes_.find(std::string(name)); life >= 0) {
     const std::size_t n = pool_.size();
     if (out.capacity < n) return CopyResult{n, false};
-    // On a tick the ages are the pool's own; between ticks they are worked out once here.
-    const float* ages = pool_.age().data();
+    // The shown ages, worked out once here.
     FloatColumn shown;
-    if (frameOffset_ != kFlicksPerSecond) {
-      renderAges(shown);
-      ages = shown.data();
-    }
-    runParallel([&] { lifeAttributes_.evaluate(life, pool_, ages, out); });
+    renderAges(shown);
+    runParallel([&] { lifeAttributes_.evaluate(life, pool_, shown.data(), out); });
     return CopyResult{n, true};
   } else {
     const std::size_t a = pool_.findAttribute(std::string(name));

@@ -98,6 +98,11 @@ class ParticleSystem {
   /// copies below then show the frame's time (see FrameTiming).
   AdvanceResult advance(Flicks frame);
 
+  /// The most ticks a system runs (birth ticks are 32 bits: ParticlePool::kMaxBirthTick): 207
+  /// days of simulated time at 240 ticks a second. advance(), step() and stepTicks() throw
+  /// std::overflow_error rather than run past it, before running any tick of the call.
+  static constexpr std::int64_t kMaxTicks = ParticlePool::kMaxBirthTick + 1;
+
   /// Runs exactly one tick, bypassing the driver's clock (tests, offline baking). Render copies
   /// then show the state after that tick.
   void step();

@@ -1,5 +1,7 @@
 #include "particles/StateHash.h"
 
+#include <algorithm>
+#include <bit>
 #include <cstdio>
 #include <cstring>
 #include <utility>
@@ -11,6 +13,37 @@ namespace {
 
 // Word-at-a-time mixing: every input word passes a full avalanche, so a single flipped bit in
 // any column changes the result.
+// A float column stateHash() covers: one the pool stores, one it does not keep (acceleration
+// before velocity Verlet: all +0.0f), or one worked out from others (ages from birth ticks at the
+// pool's clock, inverse masses from masses), which hashes as the column it replaced did.
+struct HashedColumn {
+  enum class Kind { Stored, Zero, Age, InverseMass };
+  std::string name;
+  Kind kind = Kind::Stored;
+  const FloatColumn* stored = nullptr;
+
+  // Rows [begin, end) into out[0, end − begin).
+  void values(const ParticlePool& pool, std::size_t begin, std::size_t end, float* out) const {
+    switch (kind) {
+      case Kind::Stored:
+        std::memcpy(out, stored->data() + begin, (end - begin) * sizeof(float));
+        break;
+      case Kind::Zero:
+        std::fill(out, out + (end - begin), 0.0f);
+        break;
+      case Kind::Age:
+        pool.ages(begin, end, out);
+        break;
+      case Kind::InverseMass:
+        for (std::size_t i = begin; i < end; ++i)
+          out[i - begin] = inverseMassOf(pool.mass()[static_cast<Eigen::Index>(i)]);
+        break;
+    }
+  }
+};
+
+// Word-at-a-time mixing: every input word passes a full avalanche, so a single flipped bit in
+// any column changes the result.
 class Hasher {
  public:
   void add(std::uint64_t word) {
@@ -19,16 +52,14 @@ class Hasher {
     h_ *= 0xbf58476d1ce4e5b9ULL;
     h_ ^= h_ >> 32;
   }
-  // A null column is rows zeros (+0.0f): a column the pool does not keep.
-  void addFloats(const FloatColumn* column, std::size_t rows) {
-    if (column == nullptr) {
-      for (std::size_t i = 0; i < rows; ++i) add(0);
-      return;
-    }
-    for (std::size_t i = 0; i < rows; ++i) {
-      std::uint32_t bits = 0;
-      std::memcpy(&bits, &(*column)[static_cast<Eigen::Index>(i)], sizeof bits);
-      add(bits);
+  // Each value's 32 bits, in chunks: a worked-out column never exists whole.
+  void addFloats(const ParticlePool& pool, const HashedColumn& column, std::size_t rows) {
+    constexpr std::size_t kChunk = 4096;
+    float chunk[kChunk];
+    for (std::size_t b = 0; b < rows; b += kChunk) {
+      const std::size_t e = std::min(rows, b + kChunk);
+      column.values(pool, b, e, chunk);
+      for (std::size_t i = 0; i < e - b; ++i) add(std::bit_cast<std::uint32_t>(chunk[i]));
     }
   }
   std::uint64_t value() const { return h_; }
@@ -37,10 +68,10 @@ class Hasher {
   std::uint64_t h_ = 0xcbf29ce484222325ULL;
 };
 
-// The float columns in stateHash()'s order, with their names; null for a column the pool does not
-// keep (acceleration before velocity Verlet), whose values are all zero.
-std::vector<std::pair<std::string, const FloatColumn*>> floatColumns(const ParticlePool& pool) {
-  std::vector<std::pair<std::string, const FloatColumn*>> columns;
+// The float columns in stateHash()'s order.
+std::vector<HashedColumn> floatColumns(const ParticlePool& pool) {
+  using Kind = HashedColumn::Kind;
+  std::vector<HashedColumn> columns;
   const std::pair<const char*, const Vec3Column*> vectors[] = {
       {"position", &pool.position()},
       {"velocity", &pool.velocity()},
@@ -48,16 +79,17 @@ std::vector<std::pair<std::string, const FloatColumn*>> floatColumns(const Parti
       {"acceleration", pool.keepsAcceleration() ? &pool.acceleration() : nullptr}};
   for (const auto& [name, column] : vectors) {
     for (int k = 0; k < 3; ++k) {
-      columns.emplace_back(std::string(name) + "." + "xyz"[k],
-                           column != nullptr ? &(*column)[k] : nullptr);
+      columns.push_back({std::string(name) + "." + "xyz"[k],
+                         column != nullptr ? Kind::Stored : Kind::Zero,
+                         column != nullptr ? &(*column)[k] : nullptr});
     }
   }
-  columns.emplace_back("age", &pool.age());
-  columns.emplace_back("lifetime", &pool.lifetime());
-  columns.emplace_back("mass", &pool.mass());
-  columns.emplace_back("inverse_mass", &pool.inverseMass());
+  columns.push_back({"age", Kind::Age});
+  columns.push_back({"lifetime", Kind::Stored, &pool.lifetime()});
+  columns.push_back({"mass", Kind::Stored, &pool.mass()});
+  columns.push_back({"inverse_mass", Kind::InverseMass});
   for (std::size_t a = 0; a < pool.attributeCount(); ++a)
-    columns.emplace_back("attribute." + pool.attributeName(a), &pool.attribute(a));
+    columns.push_back({"attribute." + pool.attributeName(a), Kind::Stored, &pool.attribute(a)});
   return columns;
 }
 
@@ -104,14 +136,14 @@ void addPool(Hasher& h, const ParticlePool& pool) {
   h.add(pool.droppedSpawns());
   for (std::size_t i = 0; i < n; ++i) h.add(pool.id()[i]);
   for (std::size_t i = 0; i < n; ++i) h.add(static_cast<std::uint64_t>(pool.birthTick()[i]));
-  for (const auto& column : floatColumns(pool)) h.addFloats(column.second, n);
+  for (const HashedColumn& column : floatColumns(pool)) h.addFloats(pool, column, n);
 }
 
 }  // namespace
 
 std::vector<std::string> stateColumnNames(const ParticlePool& pool) {
   std::vector<std::string> names = {"counters", "id", "birth_tick"};
-  for (const auto& column : floatColumns(pool)) names.push_back(column.first);
+  for (const HashedColumn& column : floatColumns(pool)) names.push_back(column.name);
   return names;
 }
 
@@ -130,10 +162,10 @@ std::vector<std::uint64_t> stateColumnHashes(const ParticlePool& pool) {
   for (std::size_t i = 0; i < n; ++i) births.add(static_cast<std::uint64_t>(pool.birthTick()[i]));
   hashes.push_back(ids.value());
   hashes.push_back(births.value());
-  for (const auto& column : floatColumns(pool)) {
+  for (const HashedColumn& column : floatColumns(pool)) {
     Hasher h;
     h.add(n);
-    h.addFloats(column.second, n);
+    h.addFloats(pool, column, n);
     hashes.push_back(h.value());
   }
   return hashes;
@@ -142,11 +174,10 @@ std::vector<std::uint64_t> stateColumnHashes(const ParticlePool& pool) {
 std::vector<std::uint64_t> stateRowBits(const ParticlePool& pool, std::size_t row) {
   std::vector<std::uint64_t> bits = {pool.id()[row],
                                      static_cast<std::uint64_t>(pool.birthTick()[row])};
-  for (const auto& column : floatColumns(pool)) {
-    std::uint32_t b = 0;  // +0.0f in a column the pool does not keep
-    if (column.second != nullptr)
-      std::memcpy(&b, &(*column.second)[static_cast<Eigen::Index>(row)], sizeof b);
-    bits.push_back(b);
+  for (const HashedColumn& column : floatColumns(pool)) {
+    float value = 0.0f;
+    column.values(pool, row, row + 1, &value);
+    bits.push_back(std::bit_cast<std::uint32_t>(value));
   }
   return bits;
 }

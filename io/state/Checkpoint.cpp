@@ -51,9 +51,9 @@ void forEachFloatColumn(Pool& pool, F&& f) {
     const bool absent = c == &pool.acceleration() && !pool.keepsAcceleration();
     for (int k = 0; k < 3; ++k) f(absent ? nullptr : &(*c)[k]);
   }
-  for (auto* c : {&pool.age(), &pool.lifetime(), &pool.mass(), &pool.inverseMass()}) f(c);
+  for (auto* c : {&pool.lifetime(), &pool.mass()}) f(c);
 }
-constexpr int kFloatColumns = 16;
+constexpr int kFloatColumns = 14;
 constexpr int kFirstAccelerationColumn = 9;  // after position, velocity, previous position
 
 std::uint64_t loadU64(const char* p) {
@@ -335,7 +335,7 @@ Parsed parsePayload(std::string_view payload, std::uint32_t flags) {
   const std::uint32_t attributes = r.u32("the attribute count");
   for (const char*& column : p.floats) column = r.column(p.size, 4, "the particle columns");
   p.ids = r.column(p.size, 8, "the id column");
-  p.births = r.column(p.size, 8, "the birth-tick column");
+  p.births = r.column(p.size, 4, "the birth-tick column");
   const std::uint32_t hasVelocities = r.u32("the tick-start velocities flag");
   if (hasVelocities > 1) throw Malformed{"a tick-start velocities flag that is not 0 or 1"};
   if (hasVelocities == 1) {
@@ -476,7 +476,7 @@ std::optional<std::string> mismatch(const Parsed& p, const ParticleSystem& syste
            " particles, more than max_particles " + std::to_string(pool.maxParticles()) + ")";
   }
   std::vector<std::uint64_t> ids(static_cast<std::size_t>(p.size));
-  std::vector<std::int64_t> births(ids.size());
+  std::vector<std::uint32_t> births(ids.size());
   loadLittleEndian(p.ids, ids.data(), ids.size());
   loadLittleEndian(p.births, births.data(), births.size());
   if (auto problem = ParticlePool::restoreProblem(ids, births, p.nextId, p.tick)) {
@@ -582,7 +582,7 @@ struct StateView : StateScalars {
   std::size_t size = 0;
   const float* floats[kFloatColumns] = {};
   const std::uint64_t* ids = nullptr;
-  const std::int64_t* births = nullptr;
+  const std::uint32_t* births = nullptr;
   bool hasVelocities = false;       // tick-start velocities ...
   const float* velocities[3] = {};  // ... these (null for no rows)
   std::vector<std::pair<std::string_view, const float*>> attributes;
@@ -924,6 +924,7 @@ MergedCheckpoint mergeShardCheckpoints(const std::vector<std::filesystem::path>&
   v.springs = springs;
   v.springsBroken = springsBroken;
   writeStateFile(out, v);
+  pool.setClock(v.tick, v.stepRateHz);  // the ages the hash covers
   const MergedCheckpoint merged{stateHash(pool), v.tick, v.info};
   return merged;
 }

@@ -25,8 +25,10 @@ struct CheckpointInfo {
   Flicks elapsed = 0;
 };
 
-/// The format version this build writes and the only one it reads.
-inline constexpr std::uint32_t kCheckpointVersion = 2;
+/// The format version this build writes and the only one it reads. Version 3 no longer stores
+/// ages and inverse masses (worked out from birth ticks and masses) and narrows birth ticks to 32
+/// bits: a version 2 file is refused ("checkpoint format version 2 (this build reads 3)").
+inline constexpr std::uint32_t kCheckpointVersion = 3;
 
 /// Writes the state of `system` (after its last completed tick) and `info` to `path`.
 ///
@@ -35,7 +37,7 @@ inline constexpr std::uint32_t kCheckpointVersion = 2;
 /// the old checkpoint or this one, whole). When writing fails, an existing `path` is left as it
 /// was and no temporary stays behind; throws io::WriteError "PATH: error: cannot write (REASON)".
 ///
-/// Layout, version 2, every integer little-endian, floats as their IEEE-754 bits:
+/// Layout, version 3, every integer little-endian, floats as their IEEE-754 bits:
 ///
 ///     header   "TICKFXCK"  u32 version  u32 flags  u64 file length  u64 effect hash
 ///     payload  i64 step rate (Hz)   str integrator   u64 max particles
@@ -44,9 +46,9 @@ inline constexpr std::uint32_t kCheckpointVersion = 2;
 ///              i64 driver remainder
 ///              i64 frame   i64 elapsed (flicks)
 ///              u64 particle count n   u64 next id   u64 dropped spawns   u32 attribute count
-///              f32[n] × 16: position, velocity, previous position, acceleration (x, y, z each),
-///                           age, lifetime, mass, inverse mass
-///              u64[n] id   i64[n] birth tick
+///              f32[n] × 14: position, velocity, previous position, acceleration (x, y, z each),
+///                           lifetime, mass
+///              u64[n] id   u32[n] birth tick
 ///              u32 1 with f32[n] × 3: velocity at the start of the newest tick (x, y, z; what
 ///                  render copies interpolate from), or u32 0 without
 ///              per attribute: str name, f32[n] values

@@ -24,9 +24,9 @@ namespace tickfx::python {
 namespace {
 
 // Bytes of one row of the pool's columns: position, velocity, previous position and acceleration
-// (12 floats), age, lifetime, mass and inverse mass (4 floats), id and birth tick (8 bytes each)
-// and the dead flag; a custom attribute adds a float.
-constexpr double kPoolBytesPerRow = 12 * 4 + 4 * 4 + 8 + 8 + 1;
+// (12 floats), lifetime and mass (2 floats), id (8 bytes), birth tick (4) and the dead flag; a
+// custom attribute adds a float.
+constexpr double kPoolBytesPerRow = 12 * 4 + 2 * 4 + 8 + 4 + 1;
 
 std::string gigabytes(double bytes) {
   char text[32];
@@ -118,7 +118,7 @@ constexpr const char* kViewNote =
     "\n\nA zero-copy, read-only window onto the pool's rows [0, count) as they were when taken "
     "(the state after the newest tick, not interpolated to `time`). Later steps may reorder or "
     "refill those rows and add rows past them: take a new view after stepping. The first view of "
-    "a system reserves storage for simulation.max_particles rows (about 81 bytes each), so that "
+    "a system reserves storage for simulation.max_particles rows (about 69 bytes each), so that "
     "the pool never moves while views exist. A view keeps its System alive.";
 
 std::string viewDoc(const std::string& what) { return what + kViewNote; }
@@ -328,14 +328,24 @@ void bindSystemClass(py::module_& m) {
         return "<tickfx.System " + s.path() + " tick=" + std::to_string(s.system().tickCount()) +
                " count=" + std::to_string(s.system().pool().size()) + ">";
       });
+  cls.def_property_readonly(
+      "ages",
+      [](const PySystem& s) {
+        const ParticlePool& pool = s.system().pool();
+        py::array_t<float> ages(static_cast<py::ssize_t>(pool.size()));
+        pool.ages(0, pool.size(), ages.mutable_data());
+        return ages;
+      },
+      "Ages in seconds at the newest tick, as a new float32 array: the pool keeps birth ticks, "
+      "and works ages out from them where they are read (exactly the ages a cache of that tick "
+      "holds).");
   bindColumnViews<std::vector<std::uint64_t>>(
       cls, {{"ids", &ParticlePool::id,
              "Particle ids, uint64, unique per system and increasing with birth (rows are in "
              "id order)."}});
   bindColumnViews<FloatColumn>(
       cls,
-      {{"ages", &ParticlePool::age, "Ages in seconds at the newest tick, float32."},
-       {"lifetimes", &ParticlePool::lifetime, "Lifetimes in seconds, float32 (inf: never dies)."},
+      {{"lifetimes", &ParticlePool::lifetime, "Lifetimes in seconds, float32 (inf: never dies)."},
        {"masses", &ParticlePool::mass, "Masses in kilograms, float32 (inf: pinned)."}});
 }
 

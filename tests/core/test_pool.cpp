@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -36,7 +39,7 @@ TEST(ParticlePool, SpawnsPastTheCapAreDroppedAndCounted) {
   EXPECT_EQ(pool.nextId(), 3u);  // a refused spawn takes no id
   EXPECT_LE(pool.storageRows(), 3u);
   // Room again once particles die; the count of refusals is kept.
-  pool.updateAges(30, 60);  // age 0.5 s = lifetime
+  pool.advanceClock(30, 60);  // age 0.5 s = lifetime
   EXPECT_EQ(pool.removeDead(), 3u);
   EXPECT_EQ(pool.spawn(tagged(5.0f), 30), 0u);
   EXPECT_EQ(pool.id()[0], 3u);
@@ -56,11 +59,11 @@ TEST(ParticlePool, CapHoldsAcrossStorageGrowth) {
   for (std::size_t i = 0; i < pool.size(); ++i) {
     const auto r = static_cast<Eigen::Index>(i);
     ASSERT_EQ(pool.id()[i], i);
-    ASSERT_EQ(pool.birthTick()[i], static_cast<std::int64_t>(i));
+    ASSERT_EQ(pool.birthTick()[i], static_cast<std::uint32_t>(i));
     ASSERT_EQ(pool.position().x[r],
               static_cast<float>(i));  // rows written before growth survive it
     ASSERT_EQ(pool.previousPosition().y[r], 2.0f * static_cast<float>(i));
-    ASSERT_EQ(pool.inverseMass()[r], 1.0f / (1.0f + static_cast<float>(i)));
+    ASSERT_EQ(inverseMassOf(pool.mass()[r]), 1.0f / (1.0f + static_cast<float>(i)));
   }
 }
 
@@ -97,7 +100,8 @@ TEST(ParticlePool, InfiniteMassIsPinned) {
   ParticleInit init;
   init.mass = kForever;
   pool.spawn(init, 0);
-  EXPECT_EQ(pool.inverseMass()[0], 0.0f);
+  EXPECT_EQ(inverseMassOf(pool.mass()[0]), 0.0f);
+  EXPECT_TRUE(pool.anyPinned());
 }
 
 // Deaths at the end of a tick remove rows by a stable compaction: the survivors keep id order and
@@ -110,9 +114,9 @@ TEST(ParticlePool, DeathsKeepIdOrderAndMoveEveryColumn) {
     pool.spawn(tagged(static_cast<float>(i), i % 2 == 1 ? 0.5f : kForever), 0);
     pool.attribute(tag)[i] = 10.0f * static_cast<float>(i);
   }
-  pool.updateAges(29, 60);
+  pool.advanceClock(29, 60);
   EXPECT_EQ(pool.removeDead(), 0u);  // age 29/60 < 0.5
-  pool.updateAges(30, 60);
+  pool.advanceClock(30, 60);
   EXPECT_EQ(pool.removeDead(), 10u);
   ASSERT_EQ(pool.size(), 10u);
 
@@ -121,7 +125,7 @@ TEST(ParticlePool, DeathsKeepIdOrderAndMoveEveryColumn) {
   pool.spawn(tagged(21.0f), 30);
   pool.dead()[2] = 1;  // id 4
   pool.dead()[7] = 1;  // id 14
-  pool.updateAges(31, 60);
+  pool.advanceClock(31, 60);
   EXPECT_EQ(pool.removeDead(), 2u);
 
   const std::vector<std::uint64_t> expected{0, 2, 6, 8, 10, 12, 16, 18, 20, 21};
@@ -136,7 +140,7 @@ TEST(ParticlePool, DeathsKeepIdOrderAndMoveEveryColumn) {
     EXPECT_EQ(pool.velocity().x[r], 0.5f * x);
     EXPECT_EQ(pool.mass()[r], 1.0f + x);
     EXPECT_EQ(pool.lifetime()[r], kForever);
-    EXPECT_EQ(pool.birthTick()[i], expected[i] < 20 ? 0 : 30);
+    EXPECT_EQ(pool.birthTick()[i], expected[i] < 20 ? 0u : 30u);
     EXPECT_EQ(pool.attribute(tag)[r], expected[i] < 20 ? 10.0f * x : -1.0f);
     EXPECT_EQ(pool.dead()[i], 0);
   }
@@ -158,18 +162,19 @@ TEST(ParticlePool, ADeadRowIsFoundWhereverItSits) {
   }
 }
 
-// What the pool's memory is made of: three vectors (position, velocity, previous position), four
-// floats (age, lifetime, mass, inverse mass), the id, the birth tick, the dead flag, a float for
-// each named attribute, and the acceleration (a vector) once something keeps it.
+// What the pool's memory is made of: three vectors (position, velocity, previous position), two
+// floats (lifetime, mass), the 64-bit id, the 32-bit birth tick, the dead flag, a float for each
+// named attribute, and the acceleration (a vector) once something keeps it. Ages and inverse
+// masses are worked out where they are read.
 TEST(ParticlePool, BytesPerRowCountEveryColumn) {
   ParticlePool pool(8);
-  EXPECT_EQ(pool.bytesPerRow(), 3u * 12u + 4u * 4u + 8u + 8u + 1u);
+  EXPECT_EQ(pool.bytesPerRow(), 3u * 12u + 2u * 4u + 8u + 4u + 1u);
   pool.addAttribute("temperature");
   pool.addAttribute("temperature");  // the same attribute: no new column
   pool.addAttribute("Cd_r");
-  EXPECT_EQ(pool.bytesPerRow(), 69u + 2u * 4u);
+  EXPECT_EQ(pool.bytesPerRow(), 57u + 2u * 4u);
   pool.keepAcceleration();
-  EXPECT_EQ(pool.bytesPerRow(), 81u + 2u * 4u);
+  EXPECT_EQ(pool.bytesPerRow(), 69u + 2u * 4u);
 }
 
 // The acceleration column exists once kept, zero for the rows already there and the rows spawned
@@ -233,13 +238,13 @@ TEST(ParticlePool, EveryPatternOfDeathsKeepsTheSurvivorsWithTheirColumns) {
         const auto r = static_cast<Eigen::Index>(i);
         const float x = static_cast<float>(expected[i]);
         ASSERT_EQ(pool.id()[i], expected[i]) << name << ", row " << i;
-        ASSERT_EQ(pool.birthTick()[i], static_cast<std::int64_t>(expected[i] / 100)) << name;
+        ASSERT_EQ(pool.birthTick()[i], static_cast<std::uint32_t>(expected[i] / 100)) << name;
         ASSERT_EQ(pool.position().y[r], 2.0f * x) << name << ", row " << i;
         ASSERT_EQ(pool.previousPosition().z[r], -x) << name << ", row " << i;
         ASSERT_EQ(pool.velocity().x[r], 0.5f * x) << name << ", row " << i;
         ASSERT_EQ(follower.x[r], 0.5f * x) << name << ", row " << i;
         ASSERT_EQ(pool.mass()[r], 1.0f + x) << name << ", row " << i;
-        ASSERT_EQ(pool.inverseMass()[r], 1.0f / (1.0f + x)) << name << ", row " << i;
+        ASSERT_EQ(inverseMassOf(pool.mass()[r]), 1.0f / (1.0f + x)) << name << ", row " << i;
         ASSERT_EQ(pool.attribute(tag)[r], 10.0f * x) << name << ", row " << i;
       }
       for (int i = 0; i < kRows; ++i)
@@ -256,7 +261,7 @@ TEST(ParticlePool, AnyNonzeroDeadFlagRemovesTheParticle) {
   pool.dead()[1] = 2;
   pool.dead()[3] = 1;
   pool.dead()[4] = 0xff;
-  pool.updateAges(1, 60);
+  pool.advanceClock(1, 60);
   EXPECT_EQ(pool.removeDead(), 3u);
   const std::vector<std::uint64_t> expected{0, 2, 5};
   ASSERT_EQ(pool.size(), expected.size());
@@ -276,7 +281,7 @@ TEST(ParticlePool, ALifetimeEndsOnItsTick) {
   ParticleSystem system(settings, {e}, ForceSet{});
   system.stepTicks(29);
   EXPECT_EQ(system.pool().size(), 3u);
-  EXPECT_EQ(system.pool().age()[0], static_cast<float>(29.0 / 60.0));
+  EXPECT_EQ(system.pool().age(0), static_cast<float>(29.0 / 60.0));
   system.step();
   EXPECT_EQ(system.pool().size(), 0u);
 }
@@ -289,11 +294,11 @@ TEST(ParticlePool, AgesAreExactQuotientsOfTickCounts) {
     for (std::int64_t b = 0; b < 1000; ++b) pool.spawn(ParticleInit{}, b);
     for (std::int64_t tick : {std::int64_t{1000}, std::int64_t{4321}, std::int64_t{100'003},
                               std::int64_t{7'654'321}, std::int64_t{1} << 40}) {
-      pool.updateAges(tick, rate);
+      pool.advanceClock(tick, rate);
       for (std::size_t i = 0; i < pool.size(); ++i) {
         const double lived = static_cast<double>(tick - pool.birthTick()[i]);
         const float exact = static_cast<float>(lived / static_cast<double>(rate));
-        ASSERT_EQ(test::bitsOf(pool.age()[static_cast<Eigen::Index>(i)]), test::bitsOf(exact))
+        ASSERT_EQ(test::bitsOf(pool.age(i)), test::bitsOf(exact))
             << "lived " << lived << " ticks at " << rate << " Hz";
       }
     }
@@ -334,6 +339,84 @@ TEST(ParticlePool, AttributesAreInTheStateHash) {
   EXPECT_NE(stateHash(pool), before);
   pool.attribute(a)[0] = 1.0f;
   EXPECT_EQ(stateHash(pool), before);
+}
+
+// The scans a tick may skip: for expired rows only while a row may have a finite lifetime, for
+// pinned rows only while one may be pinned, for flagged rows only once something may have flagged
+// one. A spawn raises what it brings, a scan that finds nothing lowers its flag, and so does the
+// removal of the flagged rows.
+TEST(ParticlePool, ScansRunOnlyWhenARowMayNeedThem) {
+  ParticlePool pool(16);
+  EXPECT_FALSE(pool.mayHaveFiniteLifetimes());
+  EXPECT_FALSE(pool.mayHavePinned());
+  EXPECT_FALSE(pool.mayHaveDead());
+  for (int i = 0; i < 4; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);  // immortal, mass 1+i
+  EXPECT_FALSE(pool.mayHaveFiniteLifetimes());
+  EXPECT_FALSE(pool.mayHavePinned());
+  EXPECT_FALSE(pool.anyPinned());
+  pool.advanceClock(100, 60);
+  EXPECT_FALSE(pool.mayHaveDead()) << "nothing expired, nothing flagged";
+  EXPECT_EQ(pool.removeDead(), 0u);
+
+  pool.spawn(tagged(4.0f, 0.5f), 100);  // dies after 30 ticks
+  EXPECT_TRUE(pool.mayHaveFiniteLifetimes());
+  pool.advanceClock(129, 60);
+  EXPECT_FALSE(pool.mayHaveDead());
+  EXPECT_TRUE(pool.mayHaveFiniteLifetimes()) << "the finite lifetime is still in the pool";
+  pool.advanceClock(130, 60);
+  EXPECT_TRUE(pool.mayHaveDead());
+  EXPECT_EQ(pool.removeDead(), 1u);
+  EXPECT_FALSE(pool.mayHaveDead());
+  pool.advanceClock(131, 60);
+  EXPECT_FALSE(pool.mayHaveFiniteLifetimes()) << "the scan found only infinite lifetimes";
+
+  ParticleInit pinned = tagged(5.0f);
+  pinned.mass = kForever;
+  pool.spawn(pinned, 131);
+  EXPECT_TRUE(pool.mayHavePinned());
+  EXPECT_TRUE(pool.anyPinned());
+  pool.mass()[4] = 2.0f;  // a host's write
+  EXPECT_FALSE(pool.anyPinned());
+  EXPECT_FALSE(pool.mayHavePinned());
+
+  // A mutable access counts as a write of what the flag looks for.
+  pool.lifetime();
+  EXPECT_TRUE(pool.mayHaveFiniteLifetimes());
+  pool.mass();
+  EXPECT_TRUE(pool.mayHavePinned());
+  pool.dead()[2] = 1;
+  EXPECT_TRUE(pool.mayHaveDead());
+  EXPECT_EQ(pool.removeDead(), 1u);
+}
+
+// Birth ticks are 32 bits: a system runs up to tick 2^32 − 1 and refuses the next with a message,
+// before running any tick of the call; a saved state past that is refused too.
+TEST(ParticlePool, ARunEndsAtTheLastBirthTick) {
+  SystemSettings settings = test::referenceSettings();
+  EmitterSettings e;
+  e.rate = 60.0;
+  ParticleSystem system(settings, {e}, ForceSet{});
+  system.restoreClock(ParticleSystem::kMaxTicks - 2, nullptr);
+  system.stepTicks(2);
+  EXPECT_EQ(system.tickCount(), ParticleSystem::kMaxTicks);
+  ASSERT_EQ(system.pool().size(), 2u);
+  EXPECT_EQ(system.pool().birthTick()[1], 0xffffffffu);
+  EXPECT_EQ(system.pool().age(1), static_cast<float>(1.0 / 60.0));
+  try {
+    system.step();
+    FAIL() << "ran past the last birth tick";
+  } catch (const std::overflow_error& error) {
+    EXPECT_STREQ(error.what(),
+                 "tick 4294967296 is past the last tick a run can have, 4294967295 (birth ticks "
+                 "are 32 bits)");
+  }
+  EXPECT_EQ(system.tickCount(), ParticleSystem::kMaxTicks);
+  const std::vector<std::uint64_t> ids{0};
+  const std::vector<std::uint32_t> births{0};
+  EXPECT_EQ(ParticlePool::restoreProblem(ids, births, 1, ParticleSystem::kMaxTicks + 1),
+            "tick 4294967297 is past the last a run can have (4294967296: birth ticks are 32 "
+            "bits)");
+  EXPECT_EQ(ParticlePool::restoreProblem(ids, births, 1, ParticleSystem::kMaxTicks), std::nullopt);
 }
 
 }  // namespace

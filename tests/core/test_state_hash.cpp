@@ -52,8 +52,7 @@ TEST(StateHash, OneFlippedBitOfOneParticleChangesIt) {
   ParticlePool& pool = system->editPool();
   const std::uint64_t original = stateHash(pool);
   const auto last = static_cast<Eigen::Index>(pool.size() - 1);
-  std::vector<FloatColumn*> columns{&pool.age(), &pool.lifetime(), &pool.mass(),
-                                    &pool.inverseMass()};
+  std::vector<FloatColumn*> columns{&pool.lifetime(), &pool.mass()};
   for (Vec3Column* v :
        {&pool.position(), &pool.velocity(), &pool.previousPosition(), &pool.acceleration()}) {
     for (int c = 0; c < 3; ++c) columns.push_back(&(*v)[c]);

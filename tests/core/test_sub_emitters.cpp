@@ -98,7 +98,7 @@ TEST(SubEmitters, ShellsBurstIntoExactlyNSparksAtTheirLastPositionAndTime) {
   EXPECT_TRUE(system->events()->pending().empty());
   for (std::size_t i = 0; i < 21; ++i) {
     EXPECT_EQ(pool.id()[i], 3 + i);
-    EXPECT_EQ(pool.birthTick()[i], 30) << "born at t = 0.5 s, the first tick at the death";
+    EXPECT_EQ(pool.birthTick()[i], 30u) << "born at t = 0.5 s, the first tick at the death";
     EXPECT_EQ(columnValue(*system, kEmitterColumn, i), 1.0f);
     // Stepped once from where it was born: the previous position is the shell's last.
     EXPECT_EQ(row3(pool.previousPosition(), i), row3(reference->pool().position(), i / 7))
@@ -184,7 +184,7 @@ TEST(SubEmitters, BirthChildrenAndGrandchildrenAreBornInTheParentsTick) {
   const ParticlePool& pool = system->pool();
   ASSERT_EQ(pool.size(), 3u + 6u + 18u);
   for (std::size_t i = 0; i < pool.size(); ++i) {
-    EXPECT_EQ(pool.birthTick()[i], 0);
+    EXPECT_EQ(pool.birthTick()[i], 0u);
     const float e = columnValue(*system, kEmitterColumn, i);
     EXPECT_EQ(e, i < 3 ? 0.0f : (i < 9 ? 1.0f : 2.0f)) << "row " << i;
   }
@@ -231,7 +231,7 @@ TEST(SubEmitters, CollisionChildrenAtTheContactFirstOnlyOnce) {
   ASSERT_EQ(pool.size(), 4u + 8u);
   for (std::size_t i = 4; i < pool.size(); ++i) {
     EXPECT_EQ(pool.velocity().y[static_cast<Eigen::Index>(i)], 2.0f) << "along the normal";
-    EXPECT_EQ(pool.birthTick()[i], 10);
+    EXPECT_EQ(pool.birthTick()[i], 10u);
   }
   EXPECT_EQ(columnValue(*system, kContactsColumn, 0), 1.0f);
   // Back up 0.5 m, the drops meet the ceiling at t = 0.33 s: first_only makes no more chips.

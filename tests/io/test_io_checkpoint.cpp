@@ -345,12 +345,12 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
   ASSERT_GT(n, 0u);
 
   ASSERT_NE(a->tickStartVelocities(), nullptr) << "advance() keeps them";
-  const std::size_t payload = 8 + (4 + 15) + 76 + 3 * 8 + 4 + n * (16 * 4 + 8 + 8) + 4 + n * 12 +
+  const std::size_t payload = 8 + (4 + 15) + 76 + 3 * 8 + 4 + n * (14 * 4 + 8 + 4) + 4 + n * 12 +
                               (4 + 4 + 4 * n) * 2  // "heat", "spin"
                               + 8 + 8;             // no springs
   ASSERT_EQ(bytes.size(), 32 + payload + 8);
   EXPECT_EQ(bytes.substr(0, 8), "TICKFXCK");
-  EXPECT_EQ(bytes.substr(8, 8), std::string("\x02\0\0\0\0\0\0\0", 8));
+  EXPECT_EQ(bytes.substr(8, 8), std::string("\x03\0\0\0\0\0\0\0", 8));
   EXPECT_EQ(loadU64(bytes, 16), bytes.size());
   EXPECT_EQ(loadU64(bytes, 24), kEffect);
   EXPECT_EQ(loadU64(bytes, 32), 60u);
@@ -372,7 +372,7 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
       bits = (bits << 8) | static_cast<unsigned char>(bytes[columns + 4 * i + b]);
     EXPECT_EQ(bits, test::bitsOf(pool.position().x[static_cast<Eigen::Index>(i)])) << "row " << i;
   }
-  EXPECT_EQ(loadU64(bytes, columns + 16 * 4 * n), pool.id()[0]);
+  EXPECT_EQ(loadU64(bytes, columns + 14 * 4 * n), pool.id()[0]);
   EXPECT_EQ(loadU64(bytes, bytes.size() - 8),
             fingerprint(std::string_view(bytes).substr(0, bytes.size() - 8)));
 }
@@ -520,14 +520,15 @@ TEST_F(ioCheckpointRefusal, NotACheckpoint) {
 }
 
 TEST_F(ioCheckpointRefusal, OtherFormatVersions) {
-  // Version 1 lacks the driver's ticks due and the tick-start velocities.
-  for (std::uint32_t version : {0u, 1u, 3u, 9u, 0xffffffffu}) {
+  // Version 1 lacks the driver's ticks due and the tick-start velocities; version 2 has age and
+  // inverse-mass columns and 64-bit birth ticks.
+  for (std::uint32_t version : {0u, 1u, 2u, 4u, 9u, 0xffffffffu}) {
     SCOPED_TRACE(version);
     std::string bad = bytes_;
     storeU32(bad, 8, version);
     reseal(bad);  // otherwise well-formed: the version alone is refused
     expectRefused(bad,
-                  "checkpoint format version " + std::to_string(version) + " (this build reads 2)");
+                  "checkpoint format version " + std::to_string(version) + " (this build reads 3)");
   }
 }
 
@@ -667,33 +668,43 @@ TEST_F(ioCheckpointRefusal, MalformedPayloadWithAGoodChecksum) {
     expectRefused(bad, driverState("-9223372036854775808", due));
   }
   // Found by fuzz_checkpoint: a birth tick of -2⁶³ overflowed the ages' tick − birth (undefined
-  // behaviour) on the next tick. Ids and births are vetted with the pool's own rules
+  // behaviour) on the next tick; birth ticks are 32 bits unsigned since version 3, and one past
+  // the tick is still refused. Ids and births are vetted with the pool's own rules
   // (ParticlePool::restoreProblem) before anything is restored.
   const std::uint64_t rows = loadU64(bytes_, count), nextId = loadU64(bytes_, count + 8);
   const std::int64_t tick = static_cast<std::int64_t>(loadU64(bytes_, count - 56));
-  const std::size_t idAt = count + 8 + 8 + 8 + 4 + 16 * 4 * rows, birthAt = idAt + 8 * rows;
+  const std::size_t idAt = count + 8 + 8 + 8 + 4 + 14 * 4 * rows, birthAt = idAt + 8 * rows;
   ASSERT_GE(rows, 3u);
   const std::uint64_t id1 = loadU64(bytes_, idAt + 8);
-  const std::pair<std::pair<std::size_t, std::uint64_t>, std::string> cases[] = {
-      {{birthAt + 8, 0x8000000000000000ULL},
-       "row 1 was born at tick -9223372036854775808 (expected 0 to " + std::to_string(tick) + ")"},
-      {{birthAt + 16, static_cast<std::uint64_t>(tick) + 1},
+  struct Case {
+    std::size_t at;
+    std::uint64_t value;
+    int bytes;
+    std::string why;
+  };
+  const Case cases[] = {
+      {birthAt + 4, 0xffffffffULL, 4,
+       "row 1 was born at tick 4294967295 (expected 0 to " + std::to_string(tick) + ")"},
+      {birthAt + 8, static_cast<std::uint64_t>(tick) + 1, 4,
        "row 2 was born at tick " + std::to_string(tick + 1) + " (expected 0 to " +
            std::to_string(tick) + ")"},
-      {{idAt + 16, id1},
+      {idAt + 16, id1, 8,
        "row 2 has id " + std::to_string(id1) +
            " (ids rise from row to row and stay below the next id, " + std::to_string(nextId) +
            ")"},
-      {{idAt + 8 * (rows - 1), nextId},
+      {idAt + 8 * (rows - 1), nextId, 8,
        "row " + std::to_string(rows - 1) + " has id " + std::to_string(nextId) +
            " (ids rise from row to row and stay below the next id, " + std::to_string(nextId) +
            ")"},
   };
-  for (const auto& [edit, why] : cases) {
+  for (const Case& c : cases) {
     std::string bad = bytes_;
-    storeU64(bad, edit.first, edit.second);
+    if (c.bytes == 4)
+      storeU32(bad, c.at, static_cast<std::uint32_t>(c.value));
+    else
+      storeU64(bad, c.at, c.value);
     reseal(bad);
-    expectRefused(bad, "checkpoint is malformed (" + why + ")");
+    expectRefused(bad, "checkpoint is malformed (" + c.why + ")");
   }
 }
 

@@ -35,6 +35,13 @@ inline std::uint32_t bitsOf(float f) {
   return b;
 }
 
+/// The pool's ages at its clock (ParticlePool::ages), rows [0, size()).
+inline FloatColumn agesOf(const ParticlePool& pool) {
+  FloatColumn ages(static_cast<Eigen::Index>(pool.size()));
+  pool.ages(0, pool.size(), ages.data());
+  return ages;
+}
+
 inline float withBits(std::uint32_t b) {
   float f = 0.0f;
   std::memcpy(&f, &b, sizeof f);
