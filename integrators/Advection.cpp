@@ -45,7 +45,6 @@ void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime&
   const float sixth = static_cast<float>(1.0 / 6.0);
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
-  Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
 
   // k_out = u(X_in, t)
@@ -62,7 +61,7 @@ void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime&
   // The step itself: v = mean velocity, x += displacement.
   auto finish = [&](const Tile& tile) {
     Vec3Rows k1 = tile.stage(K1), xr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-             old = rowsOf(prev, tile.rows());
+             old = previousRowsOf(pool, rows, tile.rows());
     for (int c = 0; c < 3; ++c) {
       old[c] = xr[c];
       switch (scheme_) {

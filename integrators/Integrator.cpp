@@ -8,13 +8,15 @@ Integrator::Integrator() = default;
 Integrator::~Integrator() = default;
 
 void Integrator::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
-                      NonfiniteCheck* check) {
+                      NonfiniteCheck* check, bool keepPrevious) {
   prepare(pool, forces);
-  stepRows(pool, forces, time, StepRows::wholePool(pool), check);
+  if (keepPrevious) pool.keepPrevious();
+  stepRows(pool, forces, time, StepRows::wholePool(pool, keepPrevious), check);
 }
 
 void Integrator::prepare(ParticlePool& pool, const ForceSet& forces) {
   prepareColumns(pool);
+  if (readsPreviousPosition()) pool.keepPrevious(true);
   if (forces.prescribesVelocity() && !advection_) {
     advection_ = std::make_unique<Advection>(advectionScheme());
   }

@@ -30,7 +30,8 @@ struct StepTime {
 
 /// A time-stepping scheme. An integrator advances rows (all of the pool, or a block: StepRows) by
 /// one tick, asking the forces for accelerations at the states and times its scheme needs, and
-/// stores the position it started from in pool.previousPosition() (for interpolation). Rows from
+/// stores the position it started from in pool.previousPosition() when the step keeps it (for
+/// interpolation: StepRows::keepPrevious) or the scheme reads it as state. Rows from
 /// StepRows::fresh on were spawned this tick: schemes with history start them on their own.
 ///
 /// When the forces prescribe velocity (advection, ForceSet::prescribesVelocity), step() runs the
@@ -59,8 +60,9 @@ class Integrator {
   /// Advances rows [0, pool.size()) by one tick: integrate(), or the advection scheme. With
   /// `check`, each tile's new positions and velocities are checked for non-finite values inside
   /// the scheme's last pass over it (see NonfiniteCheck); the state's bits are the same either way.
+  /// `keepPrevious`: see StepRows::keepPrevious.
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
-            NonfiniteCheck* check = nullptr);
+            NonfiniteCheck* check = nullptr, bool keepPrevious = true);
 
   /// Readies the pool's columns and this integrator for `forces` (velocity Verlet's kept
   /// acceleration, the advection scheme), so that stepRows() may then run on disjoint blocks

@@ -11,7 +11,6 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
   const float halfDt = 0.5f * dt;
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
-  Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1);
   if (const auto forms = tickForms(pool, forces, time, {0, 1})) {
     // Both evaluations in the row's registers: the midpoint velocity, then the acceleration at
@@ -36,7 +35,7 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
             {forcePass(pool, forces, kPoolColumn, kPoolColumn, t0, 0),
              [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), vMid = tile.stage(1), pr = rowsOf(p, tile.rows()),
-                        vr = rowsOf(v, tile.rows()), old = rowsOf(prev, tile.rows());
+                        vr = rowsOf(v, tile.rows()), old = previousRowsOf(pool, rows, tile.rows());
                // The position is final here: it is checked as it is written.
                const auto update = [dt, halfDt](auto at, float* pos, float* last, float* mid,
                                                 const float* vel, const float* acc) {

@@ -18,7 +18,6 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   const float sixthH = h / 6.0f;
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
-  Vec3Column& prev = pool.previousPosition();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
 
   if (const auto forms = tickForms(pool, forces, time, {0, 1, 2})) {
@@ -75,7 +74,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
                   k4 = tile.stage(K4);
          Vec3Rows v2 = tile.stage(V2), v3 = tile.stage(V3), v4 = tile.stage(V4);
          Vec3Rows pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                  old = rowsOf(prev, tile.rows());
+                  old = previousRowsOf(pool, rows, tile.rows());
          // s1..s4: the four slopes of the velocity (k1..k4); u2..u4: the stage velocities.
          const auto update = [sixthH](auto at, float* pos, float* vel, float* last, const float* s1,
                                       const float* s2, const float* s3, const float* s4,

@@ -31,13 +31,12 @@ void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const Step
   }
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
-  Vec3Column& prev = pool.previousPosition();
   const TileCheck tiles = forcePassCheck(check, pool, forces, rows);
   runPasses(rows, forces.isLocal(), scratch,
             {forcePass(pool, forces, kPoolColumn, kPoolColumn, time.stage(0), 0),
              [&](const Tile& tile) {
                Vec3Rows a = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                        old = rowsOf(prev, tile.rows());
+                        old = previousRowsOf(pool, rows, tile.rows());
                const auto update = [row](auto at, float* pos, float* vel, float* last,
                                          const float* acc) {
                  return row(at.load(acc), at, pos, vel, last);

@@ -101,6 +101,16 @@ RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position,
   };
 }
 
+Vec3Rows previousRowsOf(ParticlePool& pool, const StepRows& rows, RowRange r) {
+  if (rows.keepPrevious || pool.previousIsState()) return Vec3Rows::of(pool.previousPosition(), r);
+  // One sink for all three components: written, never read. A tile's rows at most (a fused
+  // tile, or a parallel block of split passes).
+  thread_local std::vector<float> sink;
+  const std::size_t n = r.end - r.begin;
+  if (sink.size() < n) sink.resize(std::max<std::size_t>(n, Tile::kRows));
+  return {sink.data(), sink.data(), sink.data(), r.count()};
+}
+
 RowRange intersect(RowRange r, std::size_t begin, std::size_t end) {
   const std::size_t b = std::max(r.begin, begin);
   const std::size_t e = std::min(r.end, end);

@@ -92,6 +92,11 @@ RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position,
 /// Rows of `r` that are also in [begin, end).
 RowRange intersect(RowRange r, std::size_t begin, std::size_t end);
 
+/// Where a step of `rows` writes the starting positions of tile rows `r`: the pool's
+/// previousPosition() rows when the step keeps them or the scheme reads them as state, else a sink
+/// on the calling thread that nothing reads (the same stores, into L1: the column is not touched).
+Vec3Rows previousRowsOf(ParticlePool& pool, const StepRows& rows, RowRange r);
+
 /// Rows `r` of a pool column, writable or read-only.
 inline Vec3Rows rowsOf(Vec3Column& c, RowRange r) { return Vec3Rows::of(c, r); }
 inline auto rowsOf(FloatColumn& c, RowRange r) { return c.segment(r.offset(), r.count()); }

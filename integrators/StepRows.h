@@ -17,9 +17,13 @@ struct StepRows {
   std::size_t fresh = 0;
   /// Run on the calling thread: the caller parallelises.
   bool serial = false;
+  /// Write each row's starting position to pool.previousPosition() (a frame interpolates across
+  /// this tick). Else the schemes that do not read it as state write it nowhere: a tick then
+  /// neither reads nor writes the column (ParticlePool::previousIsState()).
+  bool keepPrevious = true;
   /// Every row of `pool`, its unstepped rows fresh, in parallel.
-  static StepRows wholePool(const ParticlePool& pool) {
-    return {RowRange{0, pool.size()}, pool.firstUnstepped(), false};
+  static StepRows wholePool(const ParticlePool& pool, bool keepPrevious = true) {
+    return {RowRange{0, pool.size()}, pool.firstUnstepped(), false, keepPrevious};
   }
 };
 

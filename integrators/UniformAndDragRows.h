@@ -125,13 +125,12 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
                 const BeforeTile& beforeTile, Extra&... extra) {
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
-  Vec3Column& prev = pool.previousPosition();
   // Fused tiles whose only other inputs are the forms: by exceptions when those are finite.
   const TileCheck tiles = tileCheck(check, pool, rows, forms.finite());
   runPasses(rows, true, scratch, {[&](const Tile& tile) {
               beforeTile(tile);
               const RowRange r = tile.rows();
-              Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = rowsOf(prev, r);
+              Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = previousRowsOf(pool, rows, r);
               std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
               updateTileUnderForms(tiles.sums, pool, r, forms, kernelFor, [&](int c) {
                 return std::apply(

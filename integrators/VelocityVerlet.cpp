@@ -13,7 +13,6 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   Vec3Column& a = pool.acceleration();
-  Vec3Column& prev = pool.previousPosition();
   const std::size_t fresh = rows.fresh;
   const std::size_t n = rows.rows.end;
   const TickInstant t0 = time.stage(0), t1 = time.stage(2);
@@ -53,7 +52,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
       {startRows,
        [&](const Tile& tile) {
          Vec3Rows vPred = tile.stage(0), pr = rowsOf(p, tile.rows()), vr = rowsOf(v, tile.rows()),
-                  ar = rowsOf(a, tile.rows()), old = rowsOf(prev, tile.rows());
+                  ar = rowsOf(a, tile.rows()), old = previousRowsOf(pool, rows, tile.rows());
          // The position is final here: it is checked as it is written.
          const auto update = [dt, halfDt2](auto at, float* pos, float* last, float* pred,
                                            const float* vel, const float* acc) {

@@ -98,7 +98,8 @@ void ParticlePool::reserve(std::size_t rows) {
 
 std::size_t ParticlePool::bytesPerRow() const {
   constexpr std::size_t kVec3 = 3 * sizeof(float);
-  return (keepsAcceleration_ ? 4 : 3) * kVec3 + 2 * sizeof(float) + sizeof(std::uint64_t) +
+  const int vectors = 2 + (keepsPrevious_ ? 1 : 0) + (keepsAcceleration_ ? 1 : 0);
+  return static_cast<std::size_t>(vectors) * kVec3 + 2 * sizeof(float) + sizeof(std::uint64_t) +
          sizeof(std::uint32_t) + sizeof(std::uint8_t) + attributes_.size() * sizeof(float);
 }
 
@@ -109,9 +110,18 @@ void ParticlePool::keepAcceleration() {
   keepsAcceleration_ = true;
 }
 
+void ParticlePool::keepPrevious(bool asState) {
+  previousIsState_ = previousIsState_ || asState;
+  if (keepsPrevious_) return;
+  previous_.resize(static_cast<Eigen::Index>(storageRows_));
+  for (int c = 0; c < 3; ++c) previous_[c] = position_[c];
+  keepsPrevious_ = true;
+}
+
 void ParticlePool::grow(std::size_t rows) {
   const auto n = static_cast<Eigen::Index>(rows);
-  for (Vec3Column* c : {&position_, &velocity_, &previous_}) c->conservativeResize(n);
+  for (Vec3Column* c : {&position_, &velocity_}) c->conservativeResize(n);
+  if (keepsPrevious_) previous_.conservativeResize(n);
   if (keepsAcceleration_) acceleration_.conservativeResize(n);
   for (FloatColumn* c : {&lifetime_, &mass_}) c->conservativeResize(n);
   id_.resize(rows);
@@ -170,9 +180,11 @@ void ParticlePool::setRow(std::size_t row, const ParticleInit& init) {
   velocity_.x[r] = init.velocity.x();
   velocity_.y[r] = init.velocity.y();
   velocity_.z[r] = init.velocity.z();
-  previous_.x[r] = init.position.x();
-  previous_.y[r] = init.position.y();
-  previous_.z[r] = init.position.z();
+  if (keepsPrevious_) {
+    previous_.x[r] = init.position.x();
+    previous_.y[r] = init.position.y();
+    previous_.z[r] = init.position.z();
+  }
   if (keepsAcceleration_) {
     acceleration_.x[r] = 0.0f;
     acceleration_.y[r] = 0.0f;
@@ -279,7 +291,8 @@ std::size_t ParticlePool::removeDead() {
   // Columns are independent: each is a task, moved whole (bytes only, nothing to reorder).
   std::vector<float*> floats;
   for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_}) {
-    if (c == &acceleration_ && !keepsAcceleration_) continue;
+    if ((c == &acceleration_ && !keepsAcceleration_) || (c == &previous_ && !keepsPrevious_))
+      continue;
     for (int k = 0; k < 3; ++k) floats.push_back((*c)[k].data());
   }
   for (FloatColumn* c : {&lifetime_, &mass_}) floats.push_back(c->data());

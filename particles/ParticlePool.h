@@ -173,8 +173,18 @@ class ParticlePool {
   // Columns. Storage may be longer than size(); only rows [0, size()) are meaningful.
   Vec3Column& position() { return position_; }
   Vec3Column& velocity() { return velocity_; }
-  /// Position at the previous tick (for interpolation, and position Verlet's history).
+  /// Position at the start of the newest tick that kept it: for interpolating a frame between
+  /// two ticks, and position Verlet's history (its state). The column exists only once
+  /// keepPrevious() was called (holding no rows until then); a tick writes it only when a frame
+  /// interpolates across that tick (StepRows::keepPrevious), colliders follow paths from it, or
+  /// it is state.
   Vec3Column& previousPosition() { return previous_; }
+  /// Gives the pool its previous-position column, every row's value its position, if it has none
+  /// yet; `asState` (position Verlet) makes it state from now on: written by every tick and
+  /// covered by the state hash.
+  void keepPrevious(bool asState = false);
+  bool keepsPrevious() const { return keepsPrevious_; }
+  bool previousIsState() const { return previousIsState_; }
   /// Acceleration at the current state, kept by velocity Verlet between ticks (m/s²). The column
   /// exists only once keepAcceleration() was called (velocity Verlet does); until then it holds
   /// no rows, and the state has 0 there (the state hash and checkpoints count it as zeros).
@@ -262,6 +272,8 @@ class ParticlePool {
   std::uint64_t droppedSpawns_ = 0;
   std::uint64_t rowsVersion_ = 0;
   bool keepsAcceleration_ = false;
+  bool keepsPrevious_ = false;
+  bool previousIsState_ = false;
   std::int64_t clockTick_ = 0;
   std::int64_t stepRateHz_ = 60;
   RelaxedFlag mayExpire_, mayDie_;

@@ -95,6 +95,9 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
     const std::size_t particles = build.particles.size();
     structures_.push_back(PendingStructure{std::move(build), tick, particles});
   }
+  // Position Verlet's history is state; colliders follow each tick's paths from the start.
+  if (integrator_->readsPreviousPosition()) pool_.keepPrevious(/*asState=*/true);
+  if (!colliders.empty()) pool_.keepPrevious();
   if (!colliders.empty()) {
     colliders.addHitColumns(pool_);
     colliders_ = std::make_unique<ColliderSet>(std::move(colliders));
@@ -115,7 +118,8 @@ ParticleSystem::~ParticleSystem() = default;
 
 AdvanceResult ParticleSystem::advance(Flicks frame) {
   const AdvanceResult result = driver_.advance(frame);
-  runTicks(result.ticks, /*keepVelocities=*/true);
+  // Only a frame between two ticks interpolates: its last tick keeps what it started from.
+  runTicks(result.ticks, /*shown=*/driver_.frameOffset() != kFlicksPerSecond);
   alpha_ = result.alpha;
   frameOffset_ = driver_.frameOffset();
   return result;
@@ -124,14 +128,14 @@ AdvanceResult ParticleSystem::advance(Flicks frame) {
 void ParticleSystem::step() { stepTicks(1); }
 
 void ParticleSystem::stepTicks(std::int64_t ticks) {
-  runTicks(ticks, /*keepVelocities=*/false);
+  runTicks(ticks, /*shown=*/false);
   if (ticks > 0) {
     alpha_ = 1.0f;
     frameOffset_ = kFlicksPerSecond;
   }
 }
 
-void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
+void ParticleSystem::runTicks(std::int64_t ticks, bool shown) {
   if (ticks <= 0 || nonfiniteStop_) return;
   if (ticks > kMaxTicks - tick_) {
     throw std::overflow_error("tick " + std::to_string(tick_ + ticks - 1) +
@@ -139,10 +143,10 @@ void ParticleSystem::runTicks(std::int64_t ticks, bool keepVelocities) {
                               std::to_string(kMaxTicks - 1) + " (birth ticks are 32 bits)");
   }
   runParallel([&] {
-    if (fusesTicks(ticks) && runFusedTicks(ticks, keepVelocities)) return;
+    if (fusesTicks(ticks) && runFusedTicks(ticks, shown)) return;
     for (std::int64_t i = 0; i < ticks && !nonfiniteStop_; ++i) {
-      // Only the last tick of a frame needs its starting velocities, for interpolation.
-      runTick(keepVelocities && i == ticks - 1);
+      // Only the last tick of a frame is interpolated across.
+      runTick(shown && i == ticks - 1);
       if (tickObserver_) tickObserver_(*this);
     }
   });
@@ -228,7 +232,9 @@ bool ParticleSystem::fusesTicks(std::int64_t ticks) const {
   return births <= pool_.maxParticles() - pool_.size();
 }
 
-bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
+bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
+  const bool keepVelocities = shown;
+  const bool keepPrevious = shown || keepPreviousAlways_;
   const std::int64_t first = tick_;
   const std::size_t startRows = pool_.size();
   const std::size_t stepped = pool_.firstUnstepped();
@@ -248,6 +254,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
     frameStart_->reserve(pool_, integrator_->readsPreviousPosition());
   }
   if (keepVelocities) previousVelocity_.resize(static_cast<Eigen::Index>(rows));
+  if (keepPrevious) pool_.keepPrevious();
 
   // Blocks never straddle a birth tick: block i starts at tick first + firstTick[i].
   struct Block {
@@ -278,7 +285,8 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
       const std::size_t fresh = j != block.firstTick ? block.end
                                 : j == 0             ? std::max(block.begin, stepped)
                                                      : block.begin;
-      const StepRows blockRows{RowRange{block.begin, block.end}, std::min(fresh, block.end), true};
+      const StepRows blockRows{RowRange{block.begin, block.end}, std::min(fresh, block.end), true,
+                               keepPrevious && j == ticks - 1};
       integrator_->stepRows(pool_, *forces_, StepTime{first + j, settings_.stepRateHz}, blockRows,
                             check);
     }
@@ -293,6 +301,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool keepVelocities) {
   }
   pool_.markAllStepped();
   endTicks(first + ticks, keepVelocities);
+  if (keepPrevious) previousTick_ = tick_;
   fusedTicks_ += ticks;
   return true;
 }
@@ -313,7 +322,9 @@ void ParticleSystem::emitTick(std::int64_t tick) {
   if (events_) events_->spawn(pool_, tick, firstNew);
 }
 
-void ParticleSystem::runTick(bool keepVelocities) {
+void ParticleSystem::runTick(bool shown) {
+  const bool keepVelocities = shown;
+  const bool keepPrevious = shown || keepPreviousAlways_ || colliders_ != nullptr;
   emitTick(tick_);
   for (std::size_t k = 0; k < structures_.size(); ++k) {
     PendingStructure& p = structures_[k];
@@ -338,7 +349,7 @@ void ParticleSystem::runTick(bool keepVelocities) {
   if (colliders_ && forces_->isLocal()) {
     stepAndCollideBlocks(time, check);
   } else {
-    integrator_->step(pool_, *forces_, time, check);
+    integrator_->step(pool_, *forces_, time, check, keepPrevious);
     if (colliders_) {
       colliders_->collide(pool_, tick_, settings_.stepRateHz, integrator_->readsPreviousPosition());
     }
@@ -350,6 +361,7 @@ void ParticleSystem::runTick(bool keepVelocities) {
   pool_.markAllStepped();
   forces_->endTick(pool_, time.stage(2));
   endTicks(tick_ + 1, keepVelocities);
+  if (keepPrevious) previousTick_ = tick_;
 }
 
 void ParticleSystem::stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check) {
@@ -411,6 +423,7 @@ void ParticleSystem::takeNonfinite() {
 void ParticleSystem::restoreClock(std::int64_t tick, const Vec3Column* tickStartVelocities) {
   tick_ = tick;
   pool_.setClock(tick, settings_.stepRateHz);
+  previousTick_ = pool_.keepsPrevious() ? tick : -1;  // a restored state brings its own
   pathsTick_ = -1;  // a restored state has no collision paths: frames follow straight lines
   alpha_ = driver_.alpha();
   frameOffset_ = driver_.frameOffset();
@@ -523,6 +536,11 @@ double ParticleSystem::shownSeconds() const {
 }
 
 void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
+  if (alpha != 1.0f && !previousPositionsKept()) {
+    throw std::logic_error(
+        "interpolatedPositions: the newest tick did not keep the positions it started from "
+        "(ParticleSystem::setKeepPreviousPositions)");
+  }
   const Vec3Destination to = columnsOf(out, pool_.size());
   runParallel(
       [&] { interpolate(pool_.previousPosition(), pool_.position(), alpha, pool_.size(), to); });

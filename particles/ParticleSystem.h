@@ -148,8 +148,22 @@ class ParticleSystem {
   void renderAges(FloatColumn& out) const;
 
   /// Positions interpolated by any `alpha` in [0, 1] between the previous and the current tick:
-  /// previous + (current − previous) · α, exactly previous at 0 and current at 1.
+  /// previous + (current − previous) · α, exactly previous at 0 and current at 1. For α < 1 the
+  /// newest tick must have kept its starting positions (previousPositionsKept()); throws
+  /// std::logic_error otherwise.
   void interpolatedPositions(float alpha, Vec3Column& out) const;
+
+  /// Whether the newest tick kept the positions it started from (ParticlePool::previousPosition()):
+  /// a tick does when advance() shows a frame between it and the tick before, when colliders
+  /// follow paths from them, when they are the scheme's state (position Verlet), or when a host
+  /// asked (setKeepPreviousPositions()). Other ticks neither read nor write them.
+  bool previousPositionsKept() const {
+    return pool_.previousIsState() || (previousTick_ == tick_ && tick_ > 0);
+  }
+  /// Makes every tick keep its starting positions, for a host that interpolates with
+  /// interpolatedPositions() after step() (Python's positions(alpha)). Off by default: it costs
+  /// 24 bytes of memory traffic a particle-step. The state's bits do not depend on it.
+  void setKeepPreviousPositions(bool keep) { keepPreviousAlways_ = keep; }
 
   /// The render copies above, written straight into a host's buffers (a vertex buffer, a
   /// renderer's point arrays) in any layout: the same bits as renderPositions() and the others,
@@ -227,12 +241,14 @@ class ParticleSystem {
 
  private:
   struct PendingStructure;
-  void runTicks(std::int64_t ticks, bool keepVelocities);
-  void runTick(bool keepVelocities);
+  // `shown`: the frame of these ticks falls between the last two, so the last one keeps its
+  // starting positions and velocities for the render copies.
+  void runTicks(std::int64_t ticks, bool shown);
+  void runTick(bool shown);
   // A tick's step and collisions block by block (colliders with local forces).
   void stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check);
   bool fusesTicks(std::int64_t ticks) const;
-  bool runFusedTicks(std::int64_t ticks, bool keepVelocities);
+  bool runFusedTicks(std::int64_t ticks, bool shown);
   // After the ticks up to `tick` (the count it sets): ages, the kept velocities' rows matched to
   // the deaths, the dead removed. Shared by a tick and a fused frame.
   void endTicks(std::int64_t tick, bool keepVelocities);
@@ -270,6 +286,9 @@ class ParticleSystem {
   Shard shard_;  // the whole run unless setShard()
   std::int64_t tick_ = 0;
   std::int64_t fusedTicks_ = 0;
+  // The tick count after the newest tick that kept its starting positions (-1: none).
+  std::int64_t previousTick_ = -1;
+  bool keepPreviousAlways_ = false;
   float alpha_ = 1.0f;
   // The shown time as the driver's frameOffset(): past tick tick_ − 1, kFlicksPerSecond = on
   // tick_.

@@ -72,10 +72,13 @@ class Hasher {
 std::vector<HashedColumn> floatColumns(const ParticlePool& pool) {
   using Kind = HashedColumn::Kind;
   std::vector<HashedColumn> columns;
+  // The previous position is state only where the scheme reads it (position Verlet); elsewhere
+  // it is what the newest frame between ticks interpolates from, kept only by the ticks such a
+  // frame needs, and the same state after tick k whatever the frames carries zeros here.
   const std::pair<const char*, const Vec3Column*> vectors[] = {
       {"position", &pool.position()},
       {"velocity", &pool.velocity()},
-      {"previous_position", &pool.previousPosition()},
+      {"previous_position", pool.previousIsState() ? &pool.previousPosition() : nullptr},
       {"acceleration", pool.keepsAcceleration() ? &pool.acceleration() : nullptr}};
   for (const auto& [name, column] : vectors) {
     for (int k = 0; k < 3; ++k) {

@@ -10,8 +10,11 @@
 namespace tickfx {
 
 /// A 64-bit hash over the bits of every column of rows [0, size()) in id order (the pool's row
-/// order), plus the row count, the next id and the dropped-spawn count. Two states hash equal
-/// only if (barring collisions) every float is bitwise equal; −0 and +0 differ, as they should.
+/// order), plus the row count, the next id and the dropped-spawn count. Ages and inverse masses
+/// count as the columns they once were (worked out from birth ticks and masses); the previous
+/// position counts as zeros unless it is state (ParticlePool::previousIsState()). Two states hash
+/// equal only if (barring collisions) every float is bitwise equal; −0 and +0 differ, as they
+/// should.
 std::uint64_t stateHash(const ParticlePool& pool);
 
 class ParticleSystem;

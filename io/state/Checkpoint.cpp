@@ -48,7 +48,8 @@ template <typename Pool, typename F>
 void forEachFloatColumn(Pool& pool, F&& f) {
   for (auto* c :
        {&pool.position(), &pool.velocity(), &pool.previousPosition(), &pool.acceleration()}) {
-    const bool absent = c == &pool.acceleration() && !pool.keepsAcceleration();
+    const bool absent = (c == &pool.acceleration() && !pool.keepsAcceleration()) ||
+                        (c == &pool.previousPosition() && !pool.keepsPrevious());
     for (int k = 0; k < 3; ++k) f(absent ? nullptr : &(*c)[k]);
   }
   for (auto* c : {&pool.lifetime(), &pool.mass()}) f(c);
@@ -495,7 +496,8 @@ void apply(const Parsed& p, ParticleSystem& system) {
     const char* bytes = p.floats[kFirstAccelerationColumn + k];
     if (std::any_of(bytes, bytes + 4 * n, [](char b) { return b != 0; })) pool.keepAcceleration();
   }
-  pool.reserve(n);  // the other allocation, changing no state either
+  pool.keepPrevious();  // what a restored frame between ticks interpolates from
+  pool.reserve(n);      // the other allocation, changing no state either
   pool.resizeForRestore(n, p.nextId, p.droppedSpawns);
   int c = 0;
   forEachFloatColumn(pool, [&](FloatColumn* column) {
@@ -709,6 +711,11 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   forEachFloatColumn(pool, [&](const FloatColumn* column) {
     v.floats[c++] = column != nullptr ? column->data() : nullptr;
   });
+  // Previous positions the newest tick did not keep are written as the positions: the file is
+  // the same whatever frames drove the run to this tick.
+  if (!system.previousPositionsKept()) {
+    for (int k = 0; k < 3; ++k) v.floats[6 + k] = pool.position()[k].data();
+  }
   v.ids = pool.id().data();
   v.births = pool.birthTick().data();
   // What render copies interpolate velocities from, so that a resumed run's caches match.
@@ -856,6 +863,7 @@ MergedCheckpoint mergeShardCheckpoints(const std::vector<std::filesystem::path>&
         pool.keepAcceleration();
     }
   }
+  pool.keepPrevious();
   pool.reserve(n);
   pool.resizeForRestore(n, first.nextId, first.droppedSpawns);
   int c = 0;

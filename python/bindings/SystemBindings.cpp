@@ -42,7 +42,10 @@ class PySystem {
       : system_(std::move(system)),
         effect_(std::move(effect)),
         path_(std::move(path)),
-        effectHash_(std::move(effectHash)) {}
+        effectHash_(std::move(effectHash)) {
+    // positions(alpha) interpolates after step() as after advance().
+    system_->setKeepPreviousPositions(true);
+  }
 
   ParticleSystem& system() { return *system_; }
   const ParticleSystem& system() const { return *system_; }

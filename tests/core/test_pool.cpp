@@ -48,6 +48,7 @@ TEST(ParticlePool, SpawnsPastTheCapAreDroppedAndCounted) {
 
 TEST(ParticlePool, CapHoldsAcrossStorageGrowth) {
   ParticlePool pool(1500);  // storage grows 1024 → 1500, never past the cap
+  pool.keepPrevious();
   std::size_t refused = 0;
   for (int i = 0; i < 2000; ++i) {
     if (pool.spawn(tagged(static_cast<float>(i)), i) == ParticlePool::npos) ++refused;
@@ -108,6 +109,7 @@ TEST(ParticlePool, InfiniteMassIsPinned) {
 // every column (and custom attribute) moves with its particle.
 TEST(ParticlePool, DeathsKeepIdOrderAndMoveEveryColumn) {
   ParticlePool pool(64);
+  pool.keepPrevious();
   const std::size_t tag = pool.addAttribute("tag", -1.0f);
   for (int i = 0; i < 20; ++i) {
     // Odd ids live 0.5 s (30 ticks at 60 Hz), even ids forever.
@@ -162,16 +164,18 @@ TEST(ParticlePool, ADeadRowIsFoundWhereverItSits) {
   }
 }
 
-// What the pool's memory is made of: three vectors (position, velocity, previous position), two
-// floats (lifetime, mass), the 64-bit id, the 32-bit birth tick, the dead flag, a float for each
-// named attribute, and the acceleration (a vector) once something keeps it. Ages and inverse
-// masses are worked out where they are read.
+// What the pool's memory is made of: two vectors (position, velocity), two floats (lifetime,
+// mass), the 64-bit id, the 32-bit birth tick, the dead flag, a float for each named attribute,
+// and the previous position and the acceleration (vectors) once something keeps them. Ages and
+// inverse masses are worked out where they are read.
 TEST(ParticlePool, BytesPerRowCountEveryColumn) {
   ParticlePool pool(8);
-  EXPECT_EQ(pool.bytesPerRow(), 3u * 12u + 2u * 4u + 8u + 4u + 1u);
+  EXPECT_EQ(pool.bytesPerRow(), 2u * 12u + 2u * 4u + 8u + 4u + 1u);
   pool.addAttribute("temperature");
   pool.addAttribute("temperature");  // the same attribute: no new column
   pool.addAttribute("Cd_r");
+  EXPECT_EQ(pool.bytesPerRow(), 45u + 2u * 4u);
+  pool.keepPrevious();
   EXPECT_EQ(pool.bytesPerRow(), 57u + 2u * 4u);
   pool.keepAcceleration();
   EXPECT_EQ(pool.bytesPerRow(), 69u + 2u * 4u);
@@ -217,6 +221,7 @@ TEST(ParticlePool, EveryPatternOfDeathsKeepsTheSurvivorsWithTheirColumns) {
   for (const auto& [name, dies] : patterns) {
     for (int threads : {1, 2}) {
       ParticlePool pool(kRows);
+      pool.keepPrevious();
       const std::size_t tag = pool.addAttribute("tag", -1.0f);
       std::vector<std::uint64_t> expected;
       for (int i = 0; i < kRows; ++i) {

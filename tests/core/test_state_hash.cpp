@@ -44,19 +44,49 @@ TEST(StateHash, ThreadCountDoesNotChangeTheState) {
   EXPECT_EQ(hashes[0], hashes[1]);
 }
 
+// Flips bits of `columns` (and an id and a birth tick) of three rows of `pool`, expecting each
+// flip to change the hash and its undoing to restore it.
+void expectEveryBitCounts(ParticlePool& pool, const std::vector<FloatColumn*>& columns);
+
 // Every float column of every row is in the hash: flipping its lowest bit or its sign (+0 and −0
 // included) changes the hash, and flipping it back restores it.
 TEST(StateHash, OneFlippedBitOfOneParticleChangesIt) {
-  const auto system = test::referenceSystem(test::referenceSettings("velocity_verlet"));
-  system->stepTicks(90);
-  ParticlePool& pool = system->editPool();
+  // Velocity Verlet keeps an acceleration; position Verlet's previous position is state.
+  for (const char* integrator : {"velocity_verlet", "position_verlet"}) {
+    SCOPED_TRACE(integrator);
+    const auto system = test::referenceSystem(test::referenceSettings(integrator));
+    system->stepTicks(90);
+    ParticlePool& pool = system->editPool();
+    std::vector<FloatColumn*> columns{&pool.lifetime(), &pool.mass()};
+    for (Vec3Column* v :
+         {&pool.position(), &pool.velocity(),
+          pool.keepsAcceleration() ? &pool.acceleration() : &pool.previousPosition()}) {
+      for (int c = 0; c < 3; ++c) columns.push_back(&(*v)[c]);
+    }
+    expectEveryBitCounts(pool, columns);
+  }
+}
+
+// Elsewhere the previous position is what a frame between ticks interpolates from, not state:
+// the state after tick k is the same whatever frames drove it, and so is its hash.
+TEST(StateHash, APreviousPositionThatIsNotStateIsNotHashed) {
+  const auto kept = test::referenceSystem(test::referenceSettings("rk4"));
+  const auto plain = test::referenceSystem(test::referenceSettings("rk4"));
+  kept->setKeepPreviousPositions(true);
+  kept->stepTicks(40);
+  plain->stepTicks(40);
+  ASSERT_TRUE(kept->pool().keepsPrevious());
+  EXPECT_FALSE(plain->pool().keepsPrevious());
+  EXPECT_EQ(stateHash(*kept), stateHash(*plain));
+  ParticlePool& pool = kept->editPool();
+  const std::uint64_t original = stateHash(pool);
+  pool.previousPosition().x[3] = -pool.previousPosition().x[3];
+  EXPECT_EQ(stateHash(pool), original);
+}
+
+void expectEveryBitCounts(ParticlePool& pool, const std::vector<FloatColumn*>& columns) {
   const std::uint64_t original = stateHash(pool);
   const auto last = static_cast<Eigen::Index>(pool.size() - 1);
-  std::vector<FloatColumn*> columns{&pool.lifetime(), &pool.mass()};
-  for (Vec3Column* v :
-       {&pool.position(), &pool.velocity(), &pool.previousPosition(), &pool.acceleration()}) {
-    for (int c = 0; c < 3; ++c) columns.push_back(&(*v)[c]);
-  }
   for (std::size_t k = 0; k < columns.size(); ++k) {
     for (Eigen::Index row : {Eigen::Index{0}, last / 2, last}) {
       for (std::uint32_t bit : {0u, 31u}) {
@@ -116,6 +146,7 @@ TEST(StateHash, ColumnHashesNameTheColumnThatChanged) {
 // twice or skipping one shows) have this hash and these column hashes for good.
 TEST(StateHash, AKnownStateKeepsItsHashAcrossVersions) {
   ParticlePool pool(4);
+  pool.keepPrevious(/*asState=*/true);  // as position Verlet's: every column in the hash
   ParticleInit a;
   a.position = Eigen::Vector3f(0.25f, -1.5f, 3.0f);
   a.velocity = Eigen::Vector3f(-0.125f, 2.0f, 0.75f);

@@ -80,6 +80,7 @@ TEST(SubEmitters, ShellsBurstIntoExactlyNSparksAtTheirLastPositionAndTime) {
   ASSERT_EQ(reference->pool().size(), 3u);
 
   const auto system = make({shells(), sparks(7)});
+  system->setKeepPreviousPositions(true);  // read below
   system->stepTicks(30);
   EXPECT_EQ(system->pool().size(), 0u);  // the shells died in tick 29, their sparks wait
   ASSERT_EQ(system->events()->pending().size(), 3u);
@@ -131,6 +132,7 @@ TEST(SubEmitters, ChildrenPastThePoolCapAreRefusedAndCounted) {
   const auto reference = make({shells(1.0)});
   reference->stepTicks(30);
   const auto system = make({shells(), sparks(5)}, {}, 1, /*maxParticles=*/12);
+  system->setKeepPreviousPositions(true);  // read below
   system->stepTicks(31);
   const ParticlePool& pool = system->pool();
   ASSERT_EQ(pool.size(), 12u);
@@ -180,6 +182,7 @@ TEST(SubEmitters, BirthChildrenAndGrandchildrenAreBornInTheParentsTick) {
   dust.sub.parent = "trail";
   dust.sub.on = EmitterEvent::Birth;
   const auto system = make({shells(), trail, dust});
+  system->setKeepPreviousPositions(true);  // read below
   system->step();
   const ParticlePool& pool = system->pool();
   ASSERT_EQ(pool.size(), 3u + 6u + 18u);
