@@ -5,42 +5,15 @@
 #include <cstdint>
 #include <string>
 
+#include "particles/DetMathKernels.h"
+
 namespace tickfx::det {
 namespace {
 
-// π/2 split into three parts whose products with a small integer are exact (Cody–Waite), so the
-// reduced argument keeps full precision while k · kPio2Hi is exact (below kCodyWaiteLimit).
-constexpr double kPio2Hi = 1.57079632673412561417e+00;
-constexpr double kPio2Mid = 6.07710050630396597660e-11;
-constexpr double kPio2Lo = 2.02226624879595063154e-21;
-constexpr double kTwoOverPi = 6.36619772367581382433e-01;
-
-// Taylor polynomials on [−π/4, π/4]; the first omitted term is below 2.1e-14 relative for sine
-// and 1.1e-15 for cosine, well under the float resolution the simulation keeps.
-double sinKernel(double r) {
-  const double z = r * r;
-  double p = -1.0 / 1307674368000.0;  // −1/15!
-  p = p * z + 1.0 / 6227020800.0;     // 1/13!
-  p = p * z - 1.0 / 39916800.0;       // −1/11!
-  p = p * z + 1.0 / 362880.0;         // 1/9!
-  p = p * z - 1.0 / 5040.0;           // −1/7!
-  p = p * z + 1.0 / 120.0;            // 1/5!
-  p = p * z - 1.0 / 6.0;              // −1/3!
-  return r + r * z * p;
-}
-
-double cosKernel(double r) {
-  const double z = r * r;
-  double p = 1.0 / 20922789888000.0;  // 1/16!
-  p = p * z - 1.0 / 87178291200.0;    // −1/14!
-  p = p * z + 1.0 / 479001600.0;      // 1/12!
-  p = p * z - 1.0 / 3628800.0;        // −1/10!
-  p = p * z + 1.0 / 40320.0;          // 1/8!
-  p = p * z - 1.0 / 720.0;            // −1/6!
-  p = p * z + 1.0 / 24.0;             // 1/4!
-  p = p * z - 0.5;                    // −1/2!
-  return 1.0 + z * p;
-}
+using kernel::cosKernel;
+using kernel::kCodyWaiteLimit;
+using kernel::kTwoOverPi;
+using kernel::sinKernel;
 
 struct Reduced {
   double r;
@@ -57,10 +30,6 @@ constexpr const char* kTwoOverPiHex =
     "e99c7026b45f7e413991d639835339f49c845f8bbdf9283b1ff897ffde05980f"
     "ef2f118b5a0a6d1f6d367ecf27cb09b74f463f669e5fea2d7527bac7ebe5f17b"
     "3d0739f78a5292ea6bfb5fb11f8d5d0856033046fc7b6bab";
-
-// Cody–Waite is exact while k · kPio2Hi is (kPio2Hi has 33 bits: k < 2^20); past 2^19 the
-// reduction multiplies by 2/π in exact integers instead (Payne–Hanek).
-constexpr double kCodyWaiteLimit = 524288.0;  // 2^19
 
 Reduced reduceLarge(double x) {
   using Big = boost::multiprecision::cpp_int;
@@ -91,8 +60,7 @@ Reduced reduce(double x) {
   if (std::fabs(x) >= kCodyWaiteLimit) return reduceLarge(x);
   // nearbyint under the default rounding mode is exact and the same everywhere.
   const double k = std::nearbyint(x * kTwoOverPi);
-  const double r = ((x - k * kPio2Hi) - k * kPio2Mid) - k * kPio2Lo;
-  return {r, static_cast<std::int64_t>(k)};
+  return {kernel::codyWaite(x, k), static_cast<std::int64_t>(k)};
 }
 
 // sin(q·π/2 + r) for |r| ≤ π/4: a quadrant's turn swaps the kernels and their signs. cos(x) is
@@ -147,10 +115,10 @@ double cbrt(double x) {
   // gives step i − 1's value) and the 60th value taken from its parity: the bits of running all
   // 60 steps, at a tenth of the cost.
   double before = y;
-  for (int i = 0; i < 60; ++i) {
-    const double next = y - (y * y * y - x) / (3.0 * y * y);
+  for (int i = 0; i < kernel::kCbrtSteps; ++i) {
+    const double next = kernel::cbrtStep(y, x);
     if (next == y) break;
-    if (i > 0 && next == before) return (60 - (i - 1)) % 2 == 0 ? before : y;
+    if (i > 0 && next == before) return kernel::cbrtCycleEnd(i, before, y);
     before = y;
     y = next;
   }
