@@ -52,15 +52,27 @@ inline double uniformFromBits(std::uint64_t bits) {
   return static_cast<double>(bits >> 11) * 0x1.0p-53;
 }
 
+/// The first rounds of a particle's key, those that mix in the seed and the emitter: the same for
+/// all of an emitter's particles, so a batch of them works it out once (particleKey()).
+std::uint64_t emitterKey(std::uint64_t seed, std::uint32_t emitter);
+
+/// The key of the particle of serial `serial`, from its emitter's emitterKey().
+constexpr std::uint64_t particleKey(std::uint64_t emitterKey, std::uint64_t serial) {
+  return mix64(emitterKey ^ (serial * 0xaef17502108ef2d9ULL + 2));
+}
+
+/// 64 random bits for `purpose` of the particle whose key is `particleKey`.
+constexpr std::uint64_t purposeBits(std::uint64_t particleKey, std::uint32_t purpose) {
+  return mix64(particleKey ^ (static_cast<std::uint64_t>(purpose) * 0xf1357aea2e62a9c5ULL + 3));
+}
+
 /// The draws of one particle: randomBits() and randomUniform() for (seed, emitter, serial) and any
 /// purpose, the same values, with the rounds that mix in the first three coordinates done once
 /// rather than once a draw.
 class ParticleRandom {
  public:
   ParticleRandom(std::uint64_t seed, std::uint32_t emitter, std::uint64_t serial);
-  std::uint64_t bits(std::uint32_t purpose) const {
-    return mix64(mixed_ ^ (static_cast<std::uint64_t>(purpose) * 0xf1357aea2e62a9c5ULL + 3));
-  }
+  std::uint64_t bits(std::uint32_t purpose) const { return purposeBits(mixed_, purpose); }
   double uniform(std::uint32_t purpose) const { return uniformFromBits(bits(purpose)); }
 
  private:
