@@ -1,6 +1,7 @@
 #include "particles/Emitter.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -9,9 +10,13 @@
 #include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
 #include "particles/Random.h"
+#include "particles/SpawnBatch.h"
 
 namespace tickfx {
 namespace {
+
+// Rows emit() draws at once (sampleBatch) before setting them: a few KiB on the stack.
+constexpr std::size_t kSpawnBatchRows = 256;
 
 // Two unit vectors completing `n` (unit) to a right-handed orthonormal basis, without a branch
 // on a threshold that a tiny change of n could flip (Duff et al. 2017).
@@ -206,12 +211,56 @@ std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t
       pool.appendRowsStrided(static_cast<std::size_t>(tried), tick, own - first, shard.count,
                              tried + (last - first - owned));
   TICKFX_ASSERT(firstRow + tried == pool.size(), "an emitter's rows not at the pool's end");
+  const SpawnRecipe recipe = spawnRecipe(seed);
   parallelForRows(static_cast<std::size_t>(tried), [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k)
-      pool.setRow(firstRow + k, sample(seed, own + k * shard.count));
+    std::array<ParticleInit, kSpawnBatchRows> batch;
+    for (std::size_t k = begin; k < end; k += batch.size()) {
+      const std::size_t n = std::min(batch.size(), end - k);
+      spawnBatch(recipe, own + k * shard.count, shard.count, std::span(batch.data(), n));
+      for (std::size_t i = 0; i < n; ++i) pool.setRow(firstRow + k + i, batch[i]);
+    }
   });
   pool.refuseSpawns(owned - tried);
   return last - first;
+}
+
+SpawnRecipe Emitter::spawnRecipe(std::uint64_t seed) const {
+  SpawnRecipe r;
+  r.emitterKey = emitterKey(seed, index_);
+  r.position = s_.position;
+  if (const auto* sphere = std::get_if<SphereShape>(&s_.shape)) {
+    r.shape = SpawnRecipe::Shape::Sphere;
+    r.radius = sphere->radius;
+    r.surface = sphere->surface;
+  } else if (const auto* box = std::get_if<BoxShape>(&s_.shape)) {
+    r.shape = SpawnRecipe::Shape::Box;
+    r.boxSize = box->size;
+  } else if (const auto* disc = std::get_if<DiscShape>(&s_.shape)) {
+    r.shape = SpawnRecipe::Shape::Disc;
+    r.radius = disc->radius;
+    r.discB1 = discB1_;
+    r.discB2 = discB2_;
+  } else if (const auto* list = std::get_if<PointListShape>(&s_.shape)) {
+    r.shape = SpawnRecipe::Shape::PointList;
+    r.points = list->positions;
+    r.pointVelocities = list->velocities;
+  }
+  r.direction = s_.direction;
+  r.directionB1 = directionB1_;
+  r.directionB2 = directionB2_;
+  r.spreadDegrees = s_.spreadDegrees;
+  r.cosSpread = cosSpread_;
+  r.speed = s_.speed;
+  r.speedJitter = s_.speedJitter;
+  r.lifetime = s_.lifetime;
+  r.lifetimeJitter = s_.lifetimeJitter;
+  r.mass = s_.mass;
+  return r;
+}
+
+void Emitter::sampleBatch(std::uint64_t seed, std::uint64_t firstSerial, std::uint64_t stride,
+                          std::span<ParticleInit> out) const {
+  spawnBatch(spawnRecipe(seed), firstSerial, stride, out);
 }
 
 ParticleInit Emitter::draw(const ParticleRandom& random, const Eigen::Vector3d& direction,

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <variant>
 #include <vector>
@@ -45,6 +46,8 @@ struct PointListShape {
   std::vector<Eigen::Vector3f> velocities;  // m/s, one per point, or empty
 };
 using EmitterShape = std::variant<PointShape, SphereShape, BoxShape, DiscShape, PointListShape>;
+
+struct SpawnRecipe;  // particles/SpawnBatch.h (internal)
 
 /// `count` particles at once at the first tick starting at or after `time` seconds.
 struct Burst {
@@ -124,8 +127,16 @@ class Emitter {
   std::uint64_t emit(ParticlePool& pool, std::uint64_t seed, std::int64_t tick,
                      const Shard& shard = {}) const;
 
-  /// The particle with serial `serial` as it is born (pure function of seed, index and serial).
+  /// The particle with serial `serial` as it is born (pure function of seed, index and serial),
+  /// worked out on its own, one draw after another: the reference that sampleBatch() and emit()
+  /// match bit for bit.
   ParticleInit sample(std::uint64_t seed, std::uint64_t serial) const;
+
+  /// out[k] = sample(seed, firstSerial + k · stride) for every k (stride >= 1), bit for bit, drawn
+  /// a batch at a time: each step for many particles before the next, in vectorised loops. How
+  /// emit() fills a pool's rows; any out.size() gives the same values.
+  void sampleBatch(std::uint64_t seed, std::uint64_t firstSerial, std::uint64_t stride,
+                   std::span<ParticleInit> out) const;
 
   /// A sub-emitter's children for `event`: how many (count, or drawn per event from count_range;
   /// 0 past the first event when first_only), and child `child` as it is born. Pure functions of
@@ -140,6 +151,8 @@ class Emitter {
 
  private:
   std::uint64_t rateCountBefore(std::int64_t tick) const;
+  // What sampleBatch() needs of this emitter for `seed`.
+  SpawnRecipe spawnRecipe(std::uint64_t seed) const;
   // A particle of `random` at `origin` plus the shape's offset, going along `dir` (unit) within the
   // spread around it (b1, b2 completing it to a basis).
   ParticleInit draw(const ParticleRandom& random, const Eigen::Vector3d& dir,
