@@ -114,7 +114,8 @@ void ParticlePool::keepPrevious(bool asState) {
   previousIsState_ = previousIsState_ || asState;
   if (keepsPrevious_) return;
   previous_.resize(static_cast<Eigen::Index>(storageRows_));
-  for (int c = 0; c < 3; ++c) previous_[c] = position_[c];
+  // The live rows start where they are; the rows past them are written when spawned.
+  previous_.copyRows(position_, 0, size_);
   keepsPrevious_ = true;
 }
 
