@@ -54,10 +54,10 @@ class Hasher {
   }
   // Each value's 32 bits, in chunks: a worked-out column never exists whole.
   void addFloats(const ParticlePool& pool, const HashedColumn& column, std::size_t rows) {
-    constexpr std::size_t kChunk = 4096;
-    float chunk[kChunk];
-    for (std::size_t b = 0; b < rows; b += kChunk) {
-      const std::size_t e = std::min(rows, b + kChunk);
+    constexpr std::size_t kRowsAtOnce = 4096;
+    float chunk[kRowsAtOnce];
+    for (std::size_t b = 0; b < rows; b += kRowsAtOnce) {
+      const std::size_t e = std::min(rows, b + kRowsAtOnce);
       column.values(pool, b, e, chunk);
       for (std::size_t i = 0; i < e - b; ++i) add(std::bit_cast<std::uint32_t>(chunk[i]));
     }
