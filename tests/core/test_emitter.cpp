@@ -305,8 +305,9 @@ TEST(EmitterBulk, ABurstFillsTheRowsOfOneSpawnAtATimeOnAnyThreadCount) {
       const ParticleInit want = initOf(expected, r);
       ASSERT_TRUE(sameBits(got, want)) << "row " << row << ", " << threads << " threads";
       ASSERT_EQ(test::bitsOf(pool.mass()[r]), test::bitsOf(expected.mass()[r]));
-      if (pool.keepsPrevious())
+      if (pool.keepsPrevious()) {
         ASSERT_EQ(test::bitsOf(pool.previousPosition().x[r]), test::bitsOf(pool.position().x[r]));
+      }
     }
   }
 }

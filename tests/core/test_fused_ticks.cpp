@@ -86,8 +86,9 @@ void expectSameState(const ParticleSystem& fused, const ParticleSystem& referenc
   EXPECT_TRUE(sameBits(a.velocity(), b.velocity(), n));
   // Kept by the same ticks (a frame's last, when it falls between ticks), with the same bits.
   EXPECT_EQ(fused.previousPositionsKept(), reference.previousPositionsKept());
-  if (fused.previousPositionsKept() && reference.previousPositionsKept())
+  if (fused.previousPositionsKept() && reference.previousPositionsKept()) {
     EXPECT_TRUE(sameBits(a.previousPosition(), b.previousPosition(), n));
+  }
   EXPECT_TRUE(sameBits(test::agesOf(a), test::agesOf(b), n));
   EXPECT_TRUE(sameBits(a.lifetime(), b.lifetime(), n));
   EXPECT_EQ(a.keepsAcceleration(), b.keepsAcceleration());
