@@ -7,7 +7,7 @@
 // reader's std::runtime_error, leaving the system as it was, or be read into a system that runs.
 //
 // The seeds in tests/fuzz/corpus/checkpoint were written by this target itself:
-//   TICKFX_FUZZ_WRITE_SEED=tests/fuzz/corpus/checkpoint/rope_and_spray.ckpt
+//   TICKFX_FUZZ_WRITE_SEED=tests/fuzz/corpus/checkpoint/rope_and_spray.tfxc
 //   build/.../fuzz_checkpoint -runs=0
 #include <cstddef>
 #include <cstdint>
