@@ -17,6 +17,7 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   particles/ParticlePool.h
   particles/ParticleSystem.h
   particles/Random.h
+  particles/RelaxedFlag.h
   particles/RenderDestination.h
   particles/RowViews.h
   particles/SettingProblem.h

@@ -1,7 +1,6 @@
 #include "fields/SpringNetwork.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -50,17 +49,17 @@ bool SpringNetwork::tablesStillHold(const ParticlePool& pool) const {
   if (pendingEnds_ > 0 && pool.nextId() != builtNextId_) return false;
   if (!breakable_) return true;
   const Vec3Column& p = pool.position();
-  std::atomic<bool> broke{false};
+  RelaxedFlag broke;
   parallelForRows(ends_.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
       const Ends& e = ends_[k];
       if (stretchedPastItsRatio(springs_[e.spring], p, e.a, e.b)) {
-        broke.store(true, std::memory_order_relaxed);
+        broke.raise();
         return;
       }
     }
   });
-  return !broke.load(std::memory_order_relaxed);
+  return !broke.get();
 }
 
 void SpringNetwork::rebuild(const ParticlePool& pool) {

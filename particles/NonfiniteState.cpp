@@ -62,7 +62,7 @@ void NonfiniteCheck::scan(ParticlePool& pool, std::size_t begin, std::size_t end
     }
     if (!ok) {
       dead[i] = static_cast<std::uint8_t>(dead[i] | kFlag);
-      found_.store(true, std::memory_order_relaxed);
+      found_.raise();
     }
   }
 }

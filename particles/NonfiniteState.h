@@ -2,13 +2,13 @@
 // that divides by zero. What the system does when a tick makes some, and what it reports.
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "particles/ParticlePool.h"
+#include "particles/RelaxedFlag.h"
 
 namespace tickfx {
 
@@ -66,8 +66,8 @@ class NonfiniteCheck {
   /// Checks rows [begin, end).
   void scan(ParticlePool& pool, std::size_t begin, std::size_t end);
   /// Whether any scan() since the last clear() flagged a row.
-  bool found() const { return found_.load(std::memory_order_relaxed); }
-  void clear() { found_.store(false, std::memory_order_relaxed); }
+  bool found() const { return found_.get(); }
+  void clear() { found_.clear(); }
 
   /// Whether the rows a tick steps (all but those spawned for it) are known to be finite when it
   /// starts: the tick before them was checked and nothing has written the state since
@@ -78,7 +78,7 @@ class NonfiniteCheck {
   void setSteppedRowsFinite(bool finite) { steppedRowsFinite_ = finite; }
 
  private:
-  std::atomic<bool> found_{false};
+  RelaxedFlag found_;
   bool steppedRowsFinite_ = false;
 };
 

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -13,6 +12,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "particles/RelaxedFlag.h"
 
 namespace tickfx {
 
@@ -32,27 +33,6 @@ struct Vec3Column {
   void conservativeResize(Eigen::Index rows);
   /// Copies rows [begin, end) of `from` into the same rows here, component by component.
   void copyRows(const Vec3Column& from, std::size_t begin, std::size_t end);
-};
-
-/// A flag threads may set at once (relaxed: read only after the parallel loop that sets it has
-/// joined). Copyable, so the pool stays a value.
-class RelaxedFlag {
- public:
-  RelaxedFlag() = default;
-  RelaxedFlag(const RelaxedFlag& other) : value_(other.get()) {}
-  RelaxedFlag& operator=(const RelaxedFlag& other) {
-    value_.store(other.get(), std::memory_order_relaxed);
-    return *this;
-  }
-  bool get() const { return value_.load(std::memory_order_relaxed); }
-  /// Sets it, without writing the shared line when it is set already.
-  void raise() {
-    if (!get()) value_.store(true, std::memory_order_relaxed);
-  }
-  void clear() { value_.store(false, std::memory_order_relaxed); }
-
- private:
-  std::atomic<bool> value_{false};
 };
 
 /// The inverse mass of a particle of `mass` kilograms: 0 for an infinite mass (pinned).

@@ -97,8 +97,8 @@ ParticleSystem::ParticleSystem(const SystemSettings& settings,
   }
   // Position Verlet's history is state; colliders follow each tick's paths from the start.
   if (integrator_->readsPreviousPosition()) pool_.keepPrevious(/*asState=*/true);
-  if (!colliders.empty()) pool_.keepPrevious();
   if (!colliders.empty()) {
+    pool_.keepPrevious();
     colliders.addHitColumns(pool_);
     colliders_ = std::make_unique<ColliderSet>(std::move(colliders));
   }
@@ -234,7 +234,7 @@ bool ParticleSystem::fusesTicks(std::int64_t ticks) const {
 
 bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
   const bool keepVelocities = shown;
-  const bool keepPrevious = shown || keepPreviousAlways_;
+  const bool keepPrevious = keepsPrevious(shown);
   const std::int64_t first = tick_;
   const std::size_t startRows = pool_.size();
   const std::size_t stepped = pool_.firstUnstepped();
@@ -324,7 +324,7 @@ void ParticleSystem::emitTick(std::int64_t tick) {
 
 void ParticleSystem::runTick(bool shown) {
   const bool keepVelocities = shown;
-  const bool keepPrevious = shown || keepPreviousAlways_ || colliders_ != nullptr;
+  const bool keepPrevious = keepsPrevious(shown);
   emitTick(tick_);
   for (std::size_t k = 0; k < structures_.size(); ++k) {
     PendingStructure& p = structures_[k];

@@ -245,6 +245,11 @@ class ParticleSystem {
   // starting positions and velocities for the render copies.
   void runTicks(std::int64_t ticks, bool shown);
   void runTick(bool shown);
+  // Whether a tick keeps its starting positions: `shown` (its frame interpolates across it), a
+  // host's wish, or colliders (their paths start there). Position Verlet's are state, kept anyway.
+  bool keepsPrevious(bool shown) const {
+    return shown || keepPreviousAlways_ || colliders_ != nullptr;
+  }
   // A tick's step and collisions block by block (colliders with local forces).
   void stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check);
   bool fusesTicks(std::int64_t ticks) const;

@@ -55,6 +55,7 @@ void forEachFloatColumn(Pool& pool, F&& f) {
   for (auto* c : {&pool.lifetime(), &pool.mass()}) f(c);
 }
 constexpr int kFloatColumns = 14;
+constexpr int kFirstPreviousColumn = 6;      // after position, velocity
 constexpr int kFirstAccelerationColumn = 9;  // after position, velocity, previous position
 
 std::uint64_t loadU64(const char* p) {
@@ -714,7 +715,7 @@ void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& sy
   // Previous positions the newest tick did not keep are written as the positions: the file is
   // the same whatever frames drove the run to this tick.
   if (!system.previousPositionsKept()) {
-    for (int k = 0; k < 3; ++k) v.floats[6 + k] = pool.position()[k].data();
+    for (int k = 0; k < 3; ++k) v.floats[kFirstPreviousColumn + k] = pool.position()[k].data();
   }
   v.ids = pool.id().data();
   v.births = pool.birthTick().data();

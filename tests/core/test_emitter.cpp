@@ -229,15 +229,6 @@ EmitterSettings randomEverything() {
   return s;
 }
 
-bool sameBits(const ParticleInit& a, const ParticleInit& b) {
-  for (int c = 0; c < 3; ++c) {
-    if (test::bitsOf(a.position[c]) != test::bitsOf(b.position[c])) return false;
-    if (test::bitsOf(a.velocity[c]) != test::bitsOf(b.velocity[c])) return false;
-  }
-  return test::bitsOf(a.lifetime) == test::bitsOf(b.lifetime) &&
-         test::bitsOf(a.mass) == test::bitsOf(b.mass);
-}
-
 // sample(seed, serial) depends on nothing else: not on call order, earlier calls, the instance or
 // the step rate.
 TEST(EmitterSample, IsAPureFunctionOfSeedAndSerial) {
@@ -247,10 +238,10 @@ TEST(EmitterSample, IsAPureFunctionOfSeedAndSerial) {
   for (std::uint64_t serial = 0; serial < 1000; ++serial) forward.push_back(a.sample(42, serial));
   for (std::uint64_t k = 0; k < 1000; ++k) {
     const std::uint64_t serial = (k * 617) % 1000;  // a permutation of 0..999
-    ASSERT_TRUE(sameBits(b.sample(42, serial), forward[serial])) << "serial " << serial;
-    ASSERT_TRUE(sameBits(a.sample(42, serial), forward[serial])) << "serial " << serial;
+    ASSERT_TRUE(test::sameBits(b.sample(42, serial), forward[serial])) << "serial " << serial;
+    ASSERT_TRUE(test::sameBits(a.sample(42, serial), forward[serial])) << "serial " << serial;
   }
-  EXPECT_TRUE(sameBits(a.sample(42, 123'456'789'012ULL), b.sample(42, 123'456'789'012ULL)));
+  EXPECT_TRUE(test::sameBits(a.sample(42, 123'456'789'012ULL), b.sample(42, 123'456'789'012ULL)));
 }
 
 TEST(EmitterSample, DifferentSeedEmitterOrSerialGivesDifferentParticles) {
@@ -303,7 +294,7 @@ TEST(EmitterBulk, ABurstFillsTheRowsOfOneSpawnAtATimeOnAnyThreadCount) {
       const auto r = static_cast<Eigen::Index>(row);
       const ParticleInit got = initOf(pool, r);
       const ParticleInit want = initOf(expected, r);
-      ASSERT_TRUE(sameBits(got, want)) << "row " << row << ", " << threads << " threads";
+      ASSERT_TRUE(test::sameBits(got, want)) << "row " << row << ", " << threads << " threads";
       ASSERT_EQ(test::bitsOf(pool.mass()[r]), test::bitsOf(expected.mass()[r]));
       if (pool.keepsPrevious()) {
         ASSERT_EQ(test::bitsOf(pool.previousPosition().x[r]), test::bitsOf(pool.position().x[r]));

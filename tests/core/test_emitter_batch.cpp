@@ -77,15 +77,6 @@ std::vector<Case> cases() {
   return out;
 }
 
-bool sameBits(const ParticleInit& a, const ParticleInit& b) {
-  for (int c = 0; c < 3; ++c) {
-    if (test::bitsOf(a.position[c]) != test::bitsOf(b.position[c])) return false;
-    if (test::bitsOf(a.velocity[c]) != test::bitsOf(b.velocity[c])) return false;
-  }
-  return test::bitsOf(a.lifetime) == test::bitsOf(b.lifetime) &&
-         test::bitsOf(a.mass) == test::bitsOf(b.mass);
-}
-
 std::string describe(const ParticleInit& p) {
   std::ostringstream s;
   s.precision(9);
@@ -113,7 +104,7 @@ TEST(EmitterBatch, SampleBatchGivesTheBitsOfSampleForEveryShapeSizeAndStride) {
               for (std::size_t k = 0; k < n; ++k) {
                 const std::uint64_t serial = first + k * stride;
                 const ParticleInit want = emitter.sample(seed, serial);
-                ASSERT_TRUE(sameBits(got[k], want))
+                ASSERT_TRUE(test::sameBits(got[k], want))
                     << c.name << ", emitter " << index << ", seed " << seed << ", serial " << serial
                     << " (batch of " << n << " from " << first << " by " << stride << "): got "
                     << describe(got[k]) << ", want " << describe(want);
@@ -161,7 +152,7 @@ TEST(EmitterBatch, CuttingTheSerialsAnywhereChangesNoParticle) {
       at += n;
     }
     for (std::size_t k = 0; k < whole.size(); ++k)
-      ASSERT_TRUE(sameBits(whole[k], pieces[k])) << c.name << ", particle " << k;
+      ASSERT_TRUE(test::sameBits(whole[k], pieces[k])) << c.name << ", particle " << k;
     // Not all alike: the test compares particles that differ from one another.
     if (c.name.rfind("point_", 0) != 0 && c.name.find("spread0") == std::string::npos) {
       EXPECT_NE(whole[0].velocity, whole[1].velocity) << c.name;
@@ -204,7 +195,7 @@ TEST(EmitterBatch, ShardedEmitFillsEachRowWithTheSampleOfItsSerial) {
             const std::uint64_t serial = pool.id()[row];
             ASSERT_EQ(shard.ownerOfSerial(1, serial), index) << c.name << ", row " << row;
             const ParticleInit want = emitter.sample(31, serial);
-            ASSERT_TRUE(sameBits(rowOf(pool, row), want))
+            ASSERT_TRUE(test::sameBits(rowOf(pool, row), want))
                 << c.name << ", shard " << shard.text() << ", " << threads << " threads, row "
                 << row << ", serial " << serial << ": got " << describe(rowOf(pool, row))
                 << ", want " << describe(want);

@@ -35,6 +35,15 @@ inline std::uint32_t bitsOf(float f) {
   return b;
 }
 
+/// Whether two particles' starting values (position, velocity, lifetime, mass) have the same bits.
+inline bool sameBits(const ParticleInit& a, const ParticleInit& b) {
+  for (int c = 0; c < 3; ++c) {
+    if (bitsOf(a.position[c]) != bitsOf(b.position[c])) return false;
+    if (bitsOf(a.velocity[c]) != bitsOf(b.velocity[c])) return false;
+  }
+  return bitsOf(a.lifetime) == bitsOf(b.lifetime) && bitsOf(a.mass) == bitsOf(b.mass);
+}
+
 /// The pool's ages at its clock (ParticlePool::ages), rows [0, size()).
 inline FloatColumn agesOf(const ParticlePool& pool) {
   FloatColumn ages(static_cast<Eigen::Index>(pool.size()));
