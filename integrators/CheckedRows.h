@@ -5,7 +5,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <tuple>
 #include <type_traits>
@@ -23,6 +25,28 @@ namespace tickfx {
 /// bits of the rows computed one by one.
 using Lanes4 = float __attribute__((vector_size(16)));
 
+/// Lane by lane, `value` with every subnormal replaced by a zero of its sign; normal values,
+/// zeros, infinities and NaNs unchanged. The integrators store state through this, so that no
+/// state stays subnormal: a long decay (a drag) reaches exact zeros instead of running for
+/// thousands of ticks on subnormals, which x86 and many ARM cores compute tens of times slower.
+/// It is a rule on IEEE results in integer bits, the same on every platform, and leaves the
+/// host's floating-point environment alone: hardware flush-to-zero (MXCSR FTZ, FPCR.FZ) is not
+/// used because x86 detects tininess after rounding and AArch64 before, so the two flush
+/// different results (docs/determinism.md, subnormals).
+template <class Lane>
+Lane flushTiny(Lane value) {
+  if constexpr (std::is_same_v<Lane, float>) {
+    const auto bits = std::bit_cast<std::uint32_t>(value);
+    const bool tiny = (bits & 0x7fffffffU) < 0x00800000U;
+    return std::bit_cast<float>(tiny ? bits & 0x80000000U : bits);
+  } else {
+    using Bits = std::int32_t __attribute__((vector_size(16)));
+    const auto bits = std::bit_cast<Bits>(value);
+    const Bits keep = (bits & 0x7fffffff) >= 0x00800000;  // all ones where normal, inf or NaN
+    return std::bit_cast<Lane>(bits & (keep | std::int32_t{-0x7fffffff - 1}));
+  }
+}
+
 /// Where a row kernel reads and writes: row `i` of each column it is given (Lane = float), or
 /// rows i..i+3 (Lane = Lanes4). A kernel is written once over `auto row` and `auto` values, and
 /// runs four rows at a time in the loop's body and one at a time in its tail.
@@ -39,11 +63,13 @@ struct RowsAt {
       return value;
     }
   }
+  /// Writes `value` flushed (flushTiny()): every value an integrator writes is normal or zero.
   void store(float* column, Lane value) const {
+    const Lane flushed = flushTiny(value);
     if constexpr (std::is_same_v<Lane, float>) {
-      column[i] = value;
+      column[i] = flushed;
     } else {
-      std::memcpy(column + i, &value, sizeof value);
+      std::memcpy(column + i, &flushed, sizeof flushed);
     }
   }
 };
