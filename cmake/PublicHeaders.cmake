@@ -6,6 +6,7 @@
 set(TICKFX_CORE_PUBLIC_HEADERS
   particles/Assert.h
   particles/Clock.h
+  particles/Column.h
   particles/EmissionRate.h
   particles/Emitter.h
   particles/EventEmission.h

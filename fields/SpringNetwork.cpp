@@ -15,7 +15,7 @@ constexpr std::uint32_t kMissing = std::numeric_limits<std::uint32_t>::max();
 // Rows are in id order (spawns append increasing ids, deaths compact stably). Until something
 // dies, a particle's row is its id minus the first id: try that before a binary search, which
 // otherwise cost most of a cloth's tick.
-std::uint32_t rowOf(const std::vector<std::uint64_t>& ids, std::size_t size, std::uint64_t id) {
+std::uint32_t rowOf(const RowColumn<std::uint64_t>& ids, std::size_t size, std::uint64_t id) {
   if (size > 0 && id >= ids[0]) {
     const std::uint64_t guess = id - ids[0];
     if (guess < size && ids[guess] == id) return static_cast<std::uint32_t>(guess);

@@ -92,7 +92,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
            at.store(vel, nextV);
            return CheckedPair{nextP, nextV};
          };
-         const auto in = [](Eigen::Map<FloatColumn>& column) {
+         const auto in = [](Eigen::Map<Eigen::ArrayXf>& column) {
            return static_cast<const float*>(column.data());
          };
          updateTile(tiles.sums, pool, tile.rows(), update, [&](int c) {

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "particles/Assert.h"
@@ -33,10 +34,8 @@ std::size_t firstFlagged(const std::uint8_t* flags, std::size_t from, std::size_
 }
 
 // The runs of kept rows in [first, size), rows before `first` staying where they are.
-std::vector<KeptRun> keptRuns(const std::vector<std::uint8_t>& dead, std::size_t first,
-                              std::size_t size) {
+std::vector<KeptRun> keptRuns(const std::uint8_t* flags, std::size_t first, std::size_t size) {
   std::vector<KeptRun> runs;
-  const std::uint8_t* flags = dead.data();
   std::size_t to = first;
   std::size_t i = first;
   while (i < size) {
@@ -49,6 +48,13 @@ std::vector<KeptRun> keptRuns(const std::vector<std::uint8_t>& dead, std::size_t
     }
   }
   return runs;
+}
+
+// The number of rows flagged at the front, [0, lead).
+std::size_t leadingFlagged(const std::uint8_t* flags, std::size_t size) {
+  std::size_t i = 0;
+  while (i < size && flags[i] != 0) ++i;
+  return i;
 }
 
 // Moves each run of a column of T: memmove for long runs (a whole column is one or a few when
@@ -80,6 +86,14 @@ void Vec3Column::conservativeResize(Eigen::Index rows) {
   z.conservativeResize(rows);
 }
 
+void Vec3Column::setRows(std::size_t rows, std::size_t keep) {
+  for (int c = 0; c < 3; ++c) (*this)[c].setRows(rows, keep);
+}
+
+void Vec3Column::dropFront(std::size_t k) {
+  for (int c = 0; c < 3; ++c) (*this)[c].dropFront(k);
+}
+
 void Vec3Column::copyRows(const Vec3Column& from, std::size_t begin, std::size_t end) {
   const auto i = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
   for (int c = 0; c < 3; ++c) (*this)[c].segment(i, n) = from[c].segment(i, n);
@@ -93,7 +107,7 @@ ParticlePool::ParticlePool(std::size_t maxParticles) : maxParticles_(maxParticle
 }
 
 void ParticlePool::reserve(std::size_t rows) {
-  if (rows > storageRows_) grow(std::min(rows, maxParticles_));
+  if (rows > storageRows_) setStorageRows(std::max(storageRows_, std::min(rows, maxParticles_)));
 }
 
 std::size_t ParticlePool::bytesPerRow() const {
@@ -119,17 +133,64 @@ void ParticlePool::keepPrevious(bool asState) {
   keepsPrevious_ = true;
 }
 
-void ParticlePool::grow(std::size_t rows) {
-  const auto n = static_cast<Eigen::Index>(rows);
-  for (Vec3Column* c : {&position_, &velocity_}) c->conservativeResize(n);
-  if (keepsPrevious_) previous_.conservativeResize(n);
-  if (keepsAcceleration_) acceleration_.conservativeResize(n);
-  for (FloatColumn* c : {&lifetime_, &mass_}) c->conservativeResize(n);
-  id_.resize(rows);
-  birthTick_.resize(rows);
-  dead_.resize(rows);
-  for (NamedColumn& a : attributes_) a.values.conservativeResize(n);
+template <class Visit>
+void ParticlePool::forEachColumn(const Visit& visit) {
+  for (Vec3Column* v : {&position_, &velocity_, &previous_, &acceleration_}) {
+    if ((v == &acceleration_ && !keepsAcceleration_) || (v == &previous_ && !keepsPrevious_))
+      continue;
+    for (int k = 0; k < 3; ++k) visit((*v)[k]);
+  }
+  for (FloatColumn* c : {&lifetime_, &mass_}) visit(*c);
+  for (NamedColumn& a : attributes_) visit(a.values);
+  visit(id_);
+  visit(birthTick_);
+  visit(dead_);
+}
+
+void ParticlePool::setStorageRows(std::size_t rows) {
+  TICKFX_ASSERT(rows >= size_, "storage shorter than the live rows");
+  // Columns are independent: each is a task (a move of the live rows at most).
+  std::vector<FloatColumn*> floats;
+  forEachColumn([&](auto& column) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(column)>, FloatColumn>)
+      floats.push_back(&column);
+  });
+  parallelForTasks(floats.size() + 3, [&](std::size_t c) {
+    if (c < floats.size()) {
+      floats[c]->setRows(rows, size_);
+    } else if (c == floats.size()) {
+      id_.setRows(rows, size_);
+    } else if (c == floats.size() + 1) {
+      birthTick_.setRows(rows, size_);
+    } else {
+      dead_.setRows(rows, size_);
+    }
+  });
   storageRows_ = rows;
+  frontRows_ = 0;
+}
+
+void ParticlePool::makeRoom(std::size_t rows) {
+  if (rows <= storageRows_) return;
+  const std::size_t capacity = storageRows_ + frontRows_;
+  // The freed front is reused once it is a quarter of the storage (or the storage is as large as
+  // it may be): moving the live rows to the front then costs at most four rows moved per row
+  // freed since the storage last moved.
+  if (rows <= capacity && frontRows_ > 0 &&
+      (4 * frontRows_ >= capacity || capacity >= maxParticles_)) {
+    setStorageRows(capacity);
+    return;
+  }
+  // Geometric growth as one spawn at a time would make it, or room for the whole burst.
+  const std::size_t doubled = std::max<std::size_t>(1024, capacity * 2);
+  setStorageRows(std::min(maxParticles_, std::max(doubled, rows)));
+}
+
+void ParticlePool::dropFront(std::size_t count) {
+  forEachColumn([count](auto& column) { column.dropFront(count); });
+  size_ -= count;
+  storageRows_ -= count;
+  frontRows_ += count;
 }
 
 std::size_t ParticlePool::spawn(const ParticleInit& init, std::int64_t tick) {
@@ -154,11 +215,8 @@ std::size_t ParticlePool::appendRowsStrided(std::size_t count, std::int64_t tick
   TICKFX_ASSERT(stride >= 1 && (count == 0 || firstOffset + (count - 1) * stride < idsUsed),
                 "strided ids past the ids handed out");
   const std::size_t first = size_;
-  if (first + count > storageRows_) {
-    // Geometric growth as one spawn at a time would make it, or room for the whole burst.
-    const std::size_t doubled = std::max<std::size_t>(1024, storageRows_ * 2);
-    grow(std::min(maxParticles_, std::max(doubled, first + count)));
-  }
+  if (first > 0 && birthTick_[first - 1] > tick) birthsInOrder_ = false;
+  makeRoom(first + count);
   size_ += count;
   TICKFX_ASSERT(size_ <= storageRows_, "rows appended past the pool's storage");
   for (std::size_t i = first; i < size_; ++i) {
@@ -235,6 +293,36 @@ void ParticlePool::setClock(std::int64_t tick, std::int64_t stepRateHz) {
   stepRateHz_ = stepRateHz;
 }
 
+std::size_t ParticlePool::rowsThatMayExpire(std::int64_t tick, double secondsPerTick) {
+  if (!birthsInOrder_) {
+    // Written from outside (a restored state): find out once whether they are in order.
+    birthsInOrder_ = std::is_sorted(birthTick_.begin(), birthTick_.begin() + size_);
+    if (!birthsInOrder_) return size_;
+  }
+  if (floorRows_ < size_) {
+    // The rows appended since the last tick (or all, after a mutable access): a minimum, the same
+    // in any order of its terms.
+    const float* life = lifetime_.data();
+    float floor = lifetimeFloor_;
+    for (std::size_t i = floorRows_; i < size_; ++i) floor = life[i] < floor ? life[i] : floor;
+    lifetimeFloor_ = floor;
+    floorRows_ = size_;
+  }
+  // Ages fall (weakly) from row to row: the rows whose age reached the floor are a prefix,
+  // found by bisection with the expression the scan compares.
+  const std::uint32_t* birth = birthTick_.data();
+  std::size_t lo = 0, hi = size_;
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (ageSeconds(tick - birth[mid], secondsPerTick) >= lifetimeFloor_) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo;
+}
+
 void ParticlePool::advanceClock(std::int64_t tick, std::int64_t stepRateHz) {
   setClock(tick, stepRateHz);
   if (!mayExpire_.get()) return;
@@ -242,9 +330,15 @@ void ParticlePool::advanceClock(std::int64_t tick, std::int64_t stepRateHz) {
   const std::uint32_t* birth = birthTick_.data();
   const float* life = lifetime_.data();
   std::uint8_t* dead = dead_.data();
+  const std::size_t end = rowsThatMayExpire(tick, secondsPerTick);
+  if (birthsInOrder_ && floorRows_ == size_ && lifetimeFloor_ == std::numeric_limits<float>::infinity()) {
+    mayExpire_.clear();  // no row has a finite lifetime
+    return;
+  }
   // Whether any row has a finite lifetime: when none has, the next ticks skip this scan.
   RelaxedFlag finite, expired;
-  parallelForRows(size_, [&](std::size_t b, std::size_t e) {
+  if (end < size_) finite.raise();  // the rows past `end` were not read: assume one has
+  parallelForRows(end, [&](std::size_t b, std::size_t e) {
     // Ages in registers, compared and dropped: a vectorised test first, the byte flags only for
     // a block where some particle died (rare, or a run at the front).
     int anyExpired = 0, anyFinite = 0;
@@ -260,7 +354,10 @@ void ParticlePool::advanceClock(std::int64_t tick, std::int64_t stepRateHz) {
       dead[i] = static_cast<std::uint8_t>(dead[i] | (over ? 1 : 0));
     }
   });
-  if (expired.get()) mayDie_.raise();
+  if (expired.get()) {
+    mayDie_.raise();
+    expiredRowsEnd_ = std::max(expiredRowsEnd_, end);
+  }
   if (!finite.get()) mayExpire_.clear();
 }
 
@@ -279,42 +376,70 @@ bool ParticlePool::anyPinned() const {
   return found.get();
 }
 
-std::size_t ParticlePool::firstDeadRow() const { return firstFlagged(dead_.data(), 0, size_); }
+namespace {
+
+// keptRuns() of rows [first, size) when no row from `end` on is flagged (only [first, end) read).
+std::vector<KeptRun> keptRunsBelow(const std::uint8_t* flags, std::size_t first, std::size_t end,
+                                   std::size_t size) {
+  std::vector<KeptRun> runs = keptRuns(flags, first, end);
+  if (end < size) {
+    if (!runs.empty() && runs.back().from + runs.back().count == end) {
+      runs.back().count += size - end;
+    } else {
+      const std::size_t to = runs.empty() ? first : runs.back().to + runs.back().count;
+      runs.push_back(KeptRun{end, size - end, to});
+    }
+  }
+  return runs;
+}
+
+}  // namespace
 
 std::size_t ParticlePool::removeDead() {
   // Most ticks nobody dies: find that out with no scan when nothing can have flagged a row, else
   // with one byte scan, and touch nothing else.
   if (!mayDie_.get()) return 0;
   mayDie_.clear();
-  const std::size_t first = firstDeadRow();
-  if (first == size_) return 0;
-  const std::vector<KeptRun> runs = keptRuns(dead_, first, size_);
-  // Columns are independent: each is a task, moved whole (bytes only, nothing to reorder).
-  std::vector<float*> floats;
-  for (Vec3Column* c : {&position_, &velocity_, &previous_, &acceleration_}) {
-    if ((c == &acceleration_ && !keepsAcceleration_) || (c == &previous_ && !keepsPrevious_))
-      continue;
-    for (int k = 0; k < 3; ++k) floats.push_back((*c)[k].data());
+  std::size_t end = flaggedRowsEnd();
+  mayDieAnywhere_.clear();
+  expiredRowsEnd_ = 0;
+  std::size_t first = firstFlagged(dead_.data(), 0, end);
+  if (first == end) return 0;
+  const std::size_t before = size_;
+  if (first == 0) {
+    // The dead at the front go with no copy; the scan below starts at the first one kept.
+    const std::size_t lead = leadingFlagged(dead_.data(), end);
+    dropFront(lead);
+    end -= lead;
+    first = firstFlagged(dead_.data(), 0, end);
   }
-  for (FloatColumn* c : {&lifetime_, &mass_}) floats.push_back(c->data());
-  for (NamedColumn& a : attributes_) floats.push_back(a.values.data());
-  parallelForTasks(floats.size() + 2, [&](std::size_t c) {
-    if (c < floats.size()) {
-      moveRuns(floats[c], runs);
-    } else if (c == floats.size()) {
-      moveRuns(id_.data(), runs);
-    } else {
-      moveRuns(birthTick_.data(), runs);
-    }
-  });
-  const std::size_t kept = runs.empty() ? first : runs.back().to + runs.back().count;
-  std::fill(dead_.begin() + static_cast<std::ptrdiff_t>(first),
-            dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
-  const std::size_t removed = size_ - kept;
-  size_ = kept;
+  if (first < end) {
+    const std::vector<KeptRun> runs = keptRunsBelow(dead_.data(), first, end, size_);
+    // Columns are independent: each is a task, moved whole (bytes only, nothing to reorder).
+    std::vector<float*> floats;
+    forEachColumn([&](auto& column) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(column)>, FloatColumn>)
+        floats.push_back(column.data());
+    });
+    parallelForTasks(floats.size() + 2, [&](std::size_t c) {
+      if (c < floats.size()) {
+        moveRuns(floats[c], runs);
+      } else if (c == floats.size()) {
+        moveRuns(id_.data(), runs);
+      } else {
+        moveRuns(birthTick_.data(), runs);
+      }
+    });
+    const std::size_t kept = runs.empty() ? first : runs.back().to + runs.back().count;
+    std::fill(dead_.begin() + first, dead_.begin() + end, std::uint8_t{0});
+    size_ = kept;
+  }
   ++rowsVersion_;
   firstUnstepped_ = std::min(firstUnstepped_, size_);
-  return removed;
+  // The survivors of the rows the lifetime floor covered are still the first rows, all but at
+  // most the removed count of them.
+  floorRows_ -= std::min(floorRows_, before - size_);
+  return before - size_;
 }
 
 void ParticlePool::dropNewest(std::size_t size, std::uint64_t nextId) {
@@ -322,8 +447,9 @@ void ParticlePool::dropNewest(std::size_t size, std::uint64_t nextId) {
                 "dropping rows that were not the newest spawns");
   size_ = size;
   nextId_ = nextId;
+  floorRows_ = std::min(floorRows_, size_);
   ++rowsVersion_;
-  std::fill(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
+  std::fill(dead_.begin(), dead_.begin() + size_, std::uint8_t{0});
   firstUnstepped_ = std::min(firstUnstepped_, size_);
 }
 
@@ -331,9 +457,16 @@ void ParticlePool::applyRemovalTo(Vec3Column& column) const {
   TICKFX_ASSERT(static_cast<std::size_t>(column.x.size()) >= size_,
                 "a column shorter than the pool it follows");
   if (!mayDie_.get()) return;
-  const std::size_t first = firstDeadRow();
-  if (first == size_) return;
-  const std::vector<KeptRun> runs = keptRuns(dead_, first, size_);
+  const std::size_t end = flaggedRowsEnd();
+  const std::size_t first = firstFlagged(dead_.data(), 0, end);
+  if (first == end) return;
+  // As removeDead(): the dead at the front dropped, the rest compacted.
+  const std::size_t lead = first == 0 ? leadingFlagged(dead_.data(), end) : 0;
+  column.dropFront(lead);
+  const std::uint8_t* flags = dead_.data() + lead;
+  const std::size_t next = firstFlagged(flags, 0, end - lead);
+  if (next == end - lead) return;
+  const std::vector<KeptRun> runs = keptRunsBelow(flags, next, end - lead, size_ - lead);
   for (int k = 0; k < 3; ++k) moveRuns(column[k].data(), runs);
 }
 
@@ -361,8 +494,10 @@ void ParticlePool::resizeForRestore(std::size_t size, std::uint64_t nextId,
   }
   reserve(size);
   size_ = size;
+  forgetLifetimeFloor();
+  birthsInOrder_ = false;  // the caller writes them
   ++rowsVersion_;
-  std::fill(dead_.begin(), dead_.begin() + static_cast<std::ptrdiff_t>(size_), std::uint8_t{0});
+  std::fill(dead_.begin(), dead_.begin() + size_, std::uint8_t{0});
   firstUnstepped_ = size_;
   nextId_ = nextId;
   droppedSpawns_ = droppedSpawns;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -13,12 +14,10 @@
 #include <utility>
 #include <vector>
 
+#include "particles/Column.h"
 #include "particles/RelaxedFlag.h"
 
 namespace tickfx {
-
-/// One float per particle. Eigen's allocator aligns the storage for SIMD loads.
-using FloatColumn = Eigen::ArrayXf;
 
 /// A vector quantity as three component columns: the x values of all particles are contiguous,
 /// so a loop over one component vectorises without gathers.
@@ -31,6 +30,9 @@ struct Vec3Column {
 
   void resize(Eigen::Index rows);
   void conservativeResize(Eigen::Index rows);
+  /// FloatColumn::setRows and dropFront, component by component.
+  void setRows(std::size_t rows, std::size_t keep);
+  void dropFront(std::size_t k);
   /// Copies rows [begin, end) of `from` into the same rows here, component by component.
   void copyRows(const Vec3Column& from, std::size_t begin, std::size_t end);
 };
@@ -55,10 +57,16 @@ struct ParticleInit {
 /// the scans for expired, pinned and flagged rows run only when a row may be one (the may*()
 /// flags, raised by spawns and by any mutable access to the column concerned).
 ///
-/// Ownership: the pool owns all columns. References to columns stay valid until the next spawn
-/// (which may grow the storage) or removeDead() (which moves rows). Spawning appends; deaths are
-/// removed by a stable compaction at the end of a tick, so the row order is the id order and the
-/// same for any thread count.
+/// Ownership: the pool owns all columns. References to columns stay valid; pointers to their
+/// values (data()) until the next spawn (which may grow or move the storage) or removeDead()
+/// (which moves rows). Spawning appends; deaths are removed by a stable compaction at the end of
+/// a tick, so the row order is the id order and the same for any thread count.
+///
+/// Deaths in place: the rows dead at the front (the oldest particles, the usual deaths of a rate
+/// emitter) are dropped by moving each column's start (FloatColumn::dropFront), so they cost no
+/// copy; only the rows behind a death further in move. The storage they free is reused by later
+/// spawns once it is a quarter of the storage (the live rows are then moved to its front: each
+/// row freed pays for at most four moved), else the storage grows.
 class ParticlePool {
  public:
   /// `maxParticles` is a hard cap: spawns past it are dropped and counted (droppedSpawns()).
@@ -175,6 +183,7 @@ class ParticlePool {
   /// Seconds the particle lives (+∞: never). Mutable access counts as writing a finite one.
   FloatColumn& lifetime() {
     mayExpire_.raise();
+    forgetLifetimeFloor();
     return lifetime_;
   }
   /// Kilograms (+∞: pinned). Mutable access counts as writing an infinite one.
@@ -182,13 +191,18 @@ class ParticlePool {
     mayPin_.raise();
     return mass_;
   }
-  std::vector<std::uint64_t>& id() { return id_; }
-  /// The tick each particle was born in (0 to kMaxBirthTick).
-  std::vector<std::uint32_t>& birthTick() { return birthTick_; }
+  RowColumn<std::uint64_t>& id() { return id_; }
+  /// The tick each particle was born in (0 to kMaxBirthTick). Mutable access counts as writing
+  /// births out of row order.
+  RowColumn<std::uint32_t>& birthTick() {
+    birthsInOrder_ = false;
+    return birthTick_;
+  }
   /// Nonzero marks a particle for removal at the end of the tick (written by force modules that
   /// kill, each for its own rows only). Mutable access counts as flagging one.
-  std::vector<std::uint8_t>& dead() {
+  RowColumn<std::uint8_t>& dead() {
     mayDie_.raise();
+    mayDieAnywhere_.raise();
     return dead_;
   }
 
@@ -198,9 +212,9 @@ class ParticlePool {
   const Vec3Column& acceleration() const { return acceleration_; }
   const FloatColumn& lifetime() const { return lifetime_; }
   const FloatColumn& mass() const { return mass_; }
-  const std::vector<std::uint64_t>& id() const { return id_; }
-  const std::vector<std::uint32_t>& birthTick() const { return birthTick_; }
-  const std::vector<std::uint8_t>& dead() const { return dead_; }
+  const RowColumn<std::uint64_t>& id() const { return id_; }
+  const RowColumn<std::uint32_t>& birthTick() const { return birthTick_; }
+  const RowColumn<std::uint8_t>& dead() const { return dead_; }
 
   /// Adds a named float attribute, every row set to `initial` (new particles get it too).
   /// Returns its index; adding an existing name returns the existing index.
@@ -217,10 +231,15 @@ class ParticlePool {
   /// (springs) rebuilds them only when it changed.
   std::uint64_t rowsVersion() const { return rowsVersion_; }
 
-  /// Rows the columns currently hold (>= size()); grows geometrically, never past maxParticles.
+  /// Rows the columns currently hold from row 0 on (>= size()); grows geometrically, never past
+  /// maxParticles.
   std::size_t storageRows() const { return storageRows_; }
+  /// Rows the columns' storage holds in all: storageRows() and the rows dropped at the front
+  /// since the storage last moved (reused by later spawns). Memory is allocatedRows() ·
+  /// bytesPerRow() bytes.
+  std::size_t allocatedRows() const { return storageRows_ + frontRows_; }
   /// Bytes a row takes over every column, the named attributes included: the pool's columns hold
-  /// storageRows() · bytesPerRow() bytes.
+  /// allocatedRows() · bytesPerRow() bytes.
   std::size_t bytesPerRow() const;
   /// Makes room for `rows` rows without changing size() (for restoring a saved state).
   void reserve(std::size_t rows);
@@ -241,12 +260,30 @@ class ParticlePool {
     FloatColumn values;
   };
 
-  void grow(std::size_t rows);
-  std::size_t firstDeadRow() const;  // size() when nobody is flagged
+  // Room for `rows` rows from row 0: the freed front reused, or the storage grown.
+  void makeRoom(std::size_t rows);
+  // Every column holds `rows` rows from row 0 on, the live ones kept.
+  void setStorageRows(std::size_t rows);
+  // Drops the first `count` rows of every column (dead at the front), in O(1).
+  void dropFront(std::size_t count);
+  template <class Visit>
+  void forEachColumn(const Visit& visit);
+  // Rows [0, end) hold every flag: the rows advanceClock() tested, or all after a mutable dead().
+  std::size_t flaggedRowsEnd() const {
+    return mayDieAnywhere_.get() ? size_ : std::min(expiredRowsEnd_, size_);
+  }
+  // The rows advanceClock() must test: [0, end), every row past it younger than the lifetime
+  // floor, so alive.
+  std::size_t rowsThatMayExpire(std::int64_t tick, double secondsPerTick);
+  void forgetLifetimeFloor() {
+    lifetimeFloor_ = std::numeric_limits<float>::infinity();
+    floorRows_ = 0;
+  }
 
   std::size_t maxParticles_;
   std::size_t size_ = 0;
   std::size_t storageRows_ = 0;
+  std::size_t frontRows_ = 0;  // dropped at the front of the storage, not yet reused
   std::size_t firstUnstepped_ = 0;
   std::uint64_t nextId_ = 0;
   std::uint64_t droppedSpawns_ = 0;
@@ -257,13 +294,22 @@ class ParticlePool {
   std::int64_t clockTick_ = 0;
   std::int64_t stepRateHz_ = 60;
   RelaxedFlag mayExpire_, mayDie_;
+  RelaxedFlag mayDieAnywhere_;       // raised by dead(): a flag may be in any row
+  std::size_t expiredRowsEnd_ = 0;  // advanceClock() flagged rows below this only
+  // No lifetime of rows [0, floorRows_) is below lifetimeFloor_ (rows removed since only raise
+  // the true minimum; the rows appended since are covered at the next advanceClock()).
+  float lifetimeFloor_ = std::numeric_limits<float>::infinity();
+  std::size_t floorRows_ = 0;
+  // Birth ticks never fall from row to row (spawns append at the clock's tick): then ages never
+  // rise from row to row, and the rows old enough to expire are a prefix.
+  bool birthsInOrder_ = true;
   mutable RelaxedFlag mayPin_;  // cleared by a const scan that found nothing
 
   Vec3Column position_, velocity_, previous_, acceleration_;
   FloatColumn lifetime_, mass_;
-  std::vector<std::uint64_t> id_;
-  std::vector<std::uint32_t> birthTick_;
-  std::vector<std::uint8_t> dead_;
+  RowColumn<std::uint64_t> id_;
+  RowColumn<std::uint32_t> birthTick_;
+  RowColumn<std::uint8_t> dead_;
   std::vector<NamedColumn> attributes_;
 };
 

@@ -549,7 +549,7 @@ void ParticleSystem::interpolatedPositions(float alpha, Vec3Column& out) const {
 
 void ParticleSystem::followPaths(float alpha, const Vec3Destination& out) const {
   if (!colliders_ || pathsTick_ != tick_ || alpha == 1.0f) return;
-  const std::vector<std::uint64_t>& ids = pool_.id();
+  const auto& ids = pool_.id();
   const std::size_t n = pool_.size();
   float* const dst[3] = {out.x, out.y, out.z};
   for (const CollisionPath& path : colliders_->paths()) {

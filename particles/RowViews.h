@@ -20,7 +20,7 @@ struct RowRange {
 /// Writable values of three components for the rows of one RowRange: element j of each map
 /// belongs to pool row range.begin + j.
 struct Vec3Rows {
-  Eigen::Map<FloatColumn> x, y, z;
+  Eigen::Map<Eigen::ArrayXf> x, y, z;
 
   Vec3Rows(float* px, float* py, float* pz, Eigen::Index n) : x(px, n), y(py, n), z(pz, n) {}
   /// Rows `r` of a pool-sized column.
@@ -29,16 +29,16 @@ struct Vec3Rows {
                   "a row range past the end of its column");
     return {c.x.data() + r.begin, c.y.data() + r.begin, c.z.data() + r.begin, r.count()};
   }
-  Eigen::Map<FloatColumn>& operator[](int c) { return c == 0 ? x : (c == 1 ? y : z); }
+  Eigen::Map<Eigen::ArrayXf>& operator[](int c) { return c == 0 ? x : (c == 1 ? y : z); }
 };
 
 /// Read-only values of three components for the rows of one RowRange.
 struct ConstVec3Rows {
-  Eigen::Map<const FloatColumn> x, y, z;
+  Eigen::Map<const Eigen::ArrayXf> x, y, z;
 
   ConstVec3Rows(const float* px, const float* py, const float* pz, Eigen::Index n)
       : x(px, n), y(py, n), z(pz, n) {}
-  const Eigen::Map<const FloatColumn>& operator[](int c) const {
+  const Eigen::Map<const Eigen::ArrayXf>& operator[](int c) const {
     return c == 0 ? x : (c == 1 ? y : z);
   }
 };

@@ -115,7 +115,7 @@ FrameData readCsvCache(const std::filesystem::path& path) {
   }
   const auto n = static_cast<Eigen::Index>(frame.id.size());
   auto column = [&](std::size_t k) {
-    return FloatColumn(Eigen::Map<const FloatColumn>(values[k].data(), n));
+    return FloatColumn(Eigen::Map<const Eigen::ArrayXf>(values[k].data(), n));
   };
   for (int c = 0; c < 3; ++c) frame.position[c] = column(static_cast<std::size_t>(c));
   for (int c = 0; c < 3; ++c) frame.velocity[c] = column(static_cast<std::size_t>(3 + c));

@@ -342,7 +342,7 @@ void bindSystemClass(py::module_& m) {
       "Ages in seconds at the newest tick, as a new float32 array: the pool keeps birth ticks, "
       "and works ages out from them where they are read (exactly the ages a cache of that tick "
       "holds).");
-  bindColumnViews<std::vector<std::uint64_t>>(
+  bindColumnViews<RowColumn<std::uint64_t>>(
       cls, {{"ids", &ParticlePool::id,
              "Particle ids, uint64, unique per system and increasing with birth (rows are in "
              "id order)."}});

@@ -212,6 +212,7 @@ TEST(ParticlePool, EveryPatternOfDeathsKeepsTheSurvivorsWithTheirColumns) {
   constexpr int kRows = 3000;
   const std::vector<std::pair<const char*, std::function<bool(int)>>> patterns{
       {"the oldest 1000", [](int i) { return i < 1000; }},
+      {"the oldest 999 and every 13th after", [](int i) { return i < 999 || i % 13 == 0; }},
       {"the youngest 7", [](int i) { return i >= kRows - 7; }},
       {"every other", [](int i) { return i % 2 == 1; }},
       {"runs of 5 every 37", [](int i) { return i % 37 < 5; }},
@@ -252,10 +253,131 @@ TEST(ParticlePool, EveryPatternOfDeathsKeepsTheSurvivorsWithTheirColumns) {
         ASSERT_EQ(inverseMassOf(pool.mass()[r]), 1.0f / (1.0f + x)) << name << ", row " << i;
         ASSERT_EQ(pool.attribute(tag)[r], 10.0f * x) << name << ", row " << i;
       }
-      for (int i = 0; i < kRows; ++i)
-        ASSERT_EQ(pool.dead()[static_cast<std::size_t>(i)], 0) << name;
+      for (std::size_t i = 0; i < pool.storageRows(); ++i) ASSERT_EQ(pool.dead()[i], 0) << name;
     }
   }
+}
+
+// advanceClock() tests only the rows old enough to reach the smallest lifetime (births never fall
+// from row to row, so those are a prefix), and removeDead() reads the flags only where they may
+// be. Against the rule itself, tick by tick: a row goes when its age reaches its lifetime, and
+// at no other time, through jittered lifetimes, a lifetime lowered from outside, births written
+// out of order (as a restore may) and a flag raised by a module past the rows that expire.
+TEST(ParticlePool, ExpiryTestsOnlyTheRowsThatMayExpireAndMissesNone) {
+  constexpr std::int64_t kRate = 60;
+  ParticlePool pool(100'000);
+  std::vector<std::uint64_t> alive;  // ids, in order
+  std::vector<float> lifeOf, birthOf;  // by id
+  const auto lifeFor = [](std::uint64_t id) {
+    return 0.05f + 0.01f * static_cast<float>((id * 2654435761U) % 97);  // 0.05 to 1.01 s
+  };
+  for (std::int64_t tick = 0; tick < 240; ++tick) {
+    for (int k = 0; k < 37; ++k) {
+      const std::uint64_t id = pool.nextId();
+      pool.spawn(tagged(static_cast<float>(id), lifeFor(id)), tick);
+      alive.push_back(id);
+      lifeOf.push_back(lifeFor(id));
+      birthOf.push_back(static_cast<float>(tick));
+    }
+    if (tick == 100) {
+      // The newest row may now die young: the floor must go.
+      pool.lifetime()[static_cast<Eigen::Index>(pool.size() - 1)] = 0.001f;
+      lifeOf[alive.back()] = 0.001f;
+    }
+    if (tick == 150) {
+      // A module kills the newest row (past every row old enough to expire).
+      pool.dead()[pool.size() - 1] = 1;
+    }
+    pool.advanceClock(tick + 1, kRate);
+    std::vector<std::uint64_t> kept;
+    for (std::uint64_t id : alive) {
+      const auto lived = static_cast<std::int64_t>(tick + 1 - static_cast<std::int64_t>(birthOf[id]));
+      const bool expires = ParticlePool::ageSeconds(lived, 1.0 / kRate) >= lifeOf[id];
+      const bool killed = tick == 150 && id == alive.back();
+      if (!expires && !killed) kept.push_back(id);
+    }
+    pool.removeDead();
+    alive = kept;
+    ASSERT_EQ(pool.size(), alive.size()) << "tick " << tick;
+    for (std::size_t i = 0; i < alive.size(); ++i)
+      ASSERT_EQ(pool.id()[i], alive[i]) << "tick " << tick << ", row " << i;
+  }
+  // Births written out of order (by hand, as a saved state's may be): every row is tested.
+  ParticlePool restored(8);
+  for (int i = 0; i < 4; ++i) restored.spawn(tagged(1.0f, 0.5f), 0);
+  restored.birthTick()[0] = 30;  // young, first
+  restored.birthTick()[3] = 0;   // old, last
+  restored.advanceClock(31, kRate);
+  restored.removeDead();
+  ASSERT_EQ(restored.size(), 1u);
+  EXPECT_EQ(restored.id()[0], 0u);
+}
+
+// Deaths in place: the rows dead at the front are dropped by moving the columns' start, so the
+// survivors stay where they were in memory, and the storage they free is reused, not grown.
+TEST(ParticlePool, TheDeadAtTheFrontCostNoMove) {
+  ParticlePool pool(10'000);
+  pool.keepPrevious();
+  const std::size_t tag = pool.addAttribute("tag");
+  for (int i = 0; i < 2000; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);
+  for (std::size_t i = 0; i < 300; ++i) pool.dead()[i] = 1;
+  const float* survivorX = &pool.position().x[300];
+  const std::uint64_t* survivorId = &pool.id()[300];
+  const float* survivorTag = &pool.attribute(tag)[300];
+  EXPECT_EQ(pool.removeDead(), 300u);
+  EXPECT_EQ(pool.position().x.data(), survivorX);
+  EXPECT_EQ(pool.id().data(), survivorId);
+  EXPECT_EQ(pool.attribute(tag).data(), survivorTag);
+  EXPECT_EQ(pool.id()[0], 300u);
+  EXPECT_EQ(pool.size(), 1700u);
+  EXPECT_EQ(pool.storageRows() + 300, pool.allocatedRows());
+}
+
+// A steady emitter's life: each round spawns a batch at the back and kills the oldest batch (and
+// a scattered few), for many times the storage. The rows are always the survivors in id order
+// with their own values, and the storage stops growing: the freed front is reused.
+TEST(ParticlePool, SteadyDeathsAtTheFrontReuseTheStorage) {
+  constexpr std::size_t kBatch = 97, kAlive = 40 * kBatch;
+  ParticlePool pool(10 * kAlive);
+  pool.keepPrevious();
+  const std::size_t tag = pool.addAttribute("tag", -1.0f);
+  std::vector<std::uint64_t> expected;  // ids alive, in order
+  std::size_t allocatedAfterFill = 0;
+  for (int round = 0; round < 400; ++round) {
+    for (std::size_t k = 0; k < kBatch; ++k) {
+      const std::uint64_t id = pool.nextId();
+      const std::size_t row = pool.spawn(tagged(static_cast<float>(id)), round);
+      pool.attribute(tag)[static_cast<Eigen::Index>(row)] = 3.0f * static_cast<float>(id);
+      expected.push_back(id);
+    }
+    if (pool.size() > kAlive) {
+      std::vector<std::uint64_t> kept;
+      for (std::size_t i = 0; i < pool.size(); ++i) {
+        const std::uint64_t id = pool.id()[i];
+        if (i < kBatch || id % 89 == static_cast<std::uint64_t>(round % 89)) {
+          pool.dead()[i] = 1;
+        } else {
+          kept.push_back(id);
+        }
+      }
+      pool.removeDead();
+      expected = kept;
+    }
+    ASSERT_EQ(pool.size(), expected.size()) << "round " << round;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      const float x = static_cast<float>(expected[i]);
+      ASSERT_EQ(pool.id()[i], expected[i]) << "round " << round << ", row " << i;
+      ASSERT_EQ(pool.position().y[r], 2.0f * x) << "round " << round << ", row " << i;
+      ASSERT_EQ(pool.previousPosition().z[r], -x) << "round " << round << ", row " << i;
+      ASSERT_EQ(pool.mass()[r], 1.0f + x) << "round " << round << ", row " << i;
+      ASSERT_EQ(pool.attribute(tag)[r], 3.0f * x) << "round " << round << ", row " << i;
+    }
+    if (round == 100) allocatedAfterFill = pool.allocatedRows();
+  }
+  EXPECT_GT(allocatedAfterFill, 0u);
+  EXPECT_EQ(pool.allocatedRows(), allocatedAfterFill);
+  EXPECT_LE(pool.allocatedRows(), 4 * kAlive);
 }
 
 // dead() is "nonzero marks a particle for removal" (ParticlePool.h): a module may write any
