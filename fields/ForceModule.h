@@ -24,6 +24,13 @@ struct ForceInput {
   double time() const { return at.seconds(); }
 };
 
+/// The integer coordinates of a block of a grid (ForceModule::sampleBlocks).
+struct BlockCoord {
+  std::int32_t x = 0, y = 0, z = 0;
+  /// x of a position that is in no block: a non-finite one, or one far outside any grid.
+  static constexpr std::int32_t kNowhere = INT32_MIN;
+};
+
 /// A force module adds acceleration (m/s²) to particles. Modules are composed in an ordered list
 /// (ForceSet) and evaluated in that order, so the floating-point sum is the same on every run.
 ///
@@ -81,6 +88,24 @@ class ForceModule {
   /// is row rows.begin + j. Same threading rules as accumulate().
   virtual void accumulateVelocity(const ForceInput& /*in*/, RowRange /*rows*/,
                                   Vec3Rows& /*velocity*/) const {}
+
+  /// Advection modules: true when accumulateVelocity() reads nothing of its input but the
+  /// positions of its rows and the instant (no pool column, no velocity), so that it may be handed
+  /// positions gathered from any rows, in any order, as rows [0, n) of a buffer
+  /// (ForceSet::evaluateVelocityGathered). False unless a module says so.
+  virtual bool velocityFromPositionsOnly() const { return false; }
+
+  /// Advection modules that sample a grid: writes to out[j] the coordinates of the block of the
+  /// grid (an OpenVDB leaf node) whose values a sample at the position of row rows.begin + j
+  /// reads first, and returns true. Integrators visit particles block by block with it
+  /// (integrators/LeafOrder.h) so that consecutive samples share the block's memory and its
+  /// lookup: it orders visits and nothing else, so it need not be exact, only cheap and the same
+  /// for the same position. A position the grid cannot place (not finite, or beyond ±2^30
+  /// voxels) gets BlockCoord::kNowhere. False (the default): the module has no such blocks.
+  virtual bool sampleBlocks(const Vec3View& /*position*/, RowRange /*rows*/,
+                            BlockCoord* /*out*/) const {
+    return false;
+  }
 
   /// Called once per tick after the step, with the state at the end of the tick (`end` is
   /// the tick's instant t + dt): a module may flag particles dead here (a field's kill region).

@@ -1,6 +1,8 @@
 #include "fields/ForceSet.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -19,6 +21,14 @@ void holdPinned(const ForceInput& in, RowRange rows, Vec3Rows& value) {
   value.z = pinned.select(0.0f, value.z);
 }
 
+// holdPinned() for values gathered from pool rows rows[j]: the same test (an infinite mass),
+// row for row.
+void holdPinnedGathered(const FloatColumn& mass, const std::uint32_t* rows, Vec3Rows& value) {
+  for (Eigen::Index j = 0; j < value.x.size(); ++j) {
+    if (std::isinf(mass[rows[j]])) value.x[j] = value.y[j] = value.z[j] = 0.0f;
+  }
+}
+
 }  // namespace
 
 ForceModule& ForceSet::add(std::unique_ptr<ForceModule> module) {
@@ -34,6 +44,7 @@ ForceModule& ForceSet::add(std::unique_ptr<ForceModule> module) {
     }
   }
   advects_ = module->prescribesVelocity();
+  gathers_ = gathers_ && module->velocityFromPositionsOnly();
   modules_.push_back(std::move(module));
   return *modules_.back();
 }
@@ -101,6 +112,25 @@ void ForceSet::evaluateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& v
   velocity.z.setZero();
   for (const auto& m : modules_) m->accumulateVelocity(in, rows, velocity);
   if (anyPinned_) holdPinned(in, rows, velocity);
+}
+
+void ForceSet::evaluateVelocityGathered(const ParticlePool& pool, const Vec3View& position,
+                                        const std::uint32_t* rows, TickInstant at,
+                                        Vec3Rows& velocity) const {
+  TICKFX_ASSERT(gathersVelocity(), "gathered positions for a module that reads more than them");
+  velocity.x.setZero();
+  velocity.y.setZero();
+  velocity.z.setZero();
+  // The modules read the positions alone: the velocity view is never read.
+  const ForceInput in{pool, position, position, at};
+  const RowRange elements{0, static_cast<std::size_t>(velocity.x.size())};
+  for (const auto& m : modules_) m->accumulateVelocity(in, elements, velocity);
+  if (anyPinned_) holdPinnedGathered(pool.mass(), rows, velocity);
+}
+
+bool ForceSet::sampleBlocks(const Vec3View& position, RowRange rows, BlockCoord* out) const {
+  return std::any_of(modules_.begin(), modules_.end(),
+                     [&](const auto& m) { return m->sampleBlocks(position, rows, out); });
 }
 
 void ForceSet::endTick(ParticlePool& pool, const TickInstant& end) {

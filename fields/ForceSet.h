@@ -62,6 +62,21 @@ class ForceSet {
   /// 0 + u_1 + u_2 + ... in module order; 0 for pinned particles.
   void evaluateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const;
 
+  /// True when the modules prescribe velocity and each reads nothing but positions
+  /// (ForceModule::velocityFromPositionsOnly): evaluateVelocityGathered() may then stand for
+  /// evaluateVelocity().
+  bool gathersVelocity() const { return advects_ && gathers_; }
+  /// evaluateVelocity() at positions gathered from any pool rows: element j of `position` (a
+  /// base-0 buffer) and of `velocity` belongs to pool row rows[j], j < velocity's size. Each row
+  /// gets the bits evaluateVelocity() gives it. Only when gathersVelocity().
+  void evaluateVelocityGathered(const ParticlePool& pool, const Vec3View& position,
+                                const std::uint32_t* rows, TickInstant at,
+                                Vec3Rows& velocity) const;
+
+  /// The grid blocks of the first module that has some (ForceModule::sampleBlocks); false when
+  /// no module has.
+  bool sampleBlocks(const Vec3View& position, RowRange rows, BlockCoord* out) const;
+
   /// Once per tick after the step: the modules' endTick, in order (see ForceModule::endTick).
   void endTick(ParticlePool& pool, const TickInstant& end);
 
@@ -72,6 +87,7 @@ class ForceSet {
   std::vector<std::unique_ptr<ForceModule>> modules_;
   bool anyPinned_ = false;
   bool advects_ = false;
+  bool gathers_ = true;  // every module velocityFromPositionsOnly()
 };
 
 }  // namespace tickfx

@@ -99,6 +99,8 @@ struct VectorField::Impl {
   /// at or before the instant).
   virtual void flagOutside(const Frames& frames, const ForceInput& in, RowRange rows,
                            std::uint8_t* dead) const = 0;
+  /// VectorField::sampleBlocks().
+  virtual void sampleBlocks(const Vec3View& position, RowRange rows, BlockCoord* out) const = 0;
   std::string valueType;
   bool staggered = false;
   int frameCount = 1;
@@ -226,6 +228,26 @@ struct ImplT final : VectorField::Impl {
       if (!first.acc.isValueOn(openvdb::Coord::round(index))) {
         dead[rows.begin + static_cast<std::size_t>(j)] = 1;
       }
+    }
+  }
+
+  void sampleBlocks(const Vec3View& position, RowRange rows, BlockCoord* out) const override {
+    using Leaf = typename GridT::TreeType::LeafNodeType;
+    // Beyond ±2^30 voxels (or not finite) floor() would not fit an int.
+    constexpr double kFar = 1073741824.0;
+    const Frame first(*grids.front());
+    const ConstVec3Rows p = position.rows(rows);
+    for (Eigen::Index j = 0; j < rows.count(); ++j) {
+      const openvdb::Vec3d index = first.toIndex(openvdb::Vec3d(p.x[j], p.y[j], p.z[j]));
+      BlockCoord& b = out[j];
+      if (!(std::abs(index.x()) < kFar && std::abs(index.y()) < kFar &&
+            std::abs(index.z()) < kFar)) {
+        b = BlockCoord{BlockCoord::kNowhere, 0, 0};
+        continue;
+      }
+      const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(index);
+      b = BlockCoord{base.x() >> Leaf::LOG2DIM, base.y() >> Leaf::LOG2DIM,
+                     base.z() >> Leaf::LOG2DIM};
     }
   }
 };
@@ -386,6 +408,11 @@ void VectorField::endTick(ParticlePool& pool, const TickInstant& end) {
 
 Eigen::Vector3f VectorField::sample(const Eigen::Vector3f& x, double t) const {
   return impl_->sample(s_, framesAtSeconds(*this, t), x.cast<double>());
+}
+
+bool VectorField::sampleBlocks(const Vec3View& position, RowRange rows, BlockCoord* out) const {
+  impl_->sampleBlocks(position, rows, out);
+  return true;
 }
 
 void VectorField::flagOutside(const ForceInput& in, RowRange rows, std::uint8_t* dead) const {

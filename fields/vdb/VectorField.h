@@ -80,6 +80,11 @@ class VectorField final : public ForceModule {
   void accumulate(const ForceInput& in, RowRange rows, Vec3Rows& acceleration) const override;
   bool prescribesVelocity() const override { return s_.mode == Mode::Advect; }
   void accumulateVelocity(const ForceInput& in, RowRange rows, Vec3Rows& velocity) const override;
+  /// In advect mode a sample reads nothing but the position (and the instant).
+  bool velocityFromPositionsOnly() const override { return s_.mode == Mode::Advect; }
+  /// The leaf nodes of the first frame: the base corner of a trilinear sample, shifted down by the
+  /// leaf's log2 size (ordering only: any sampler, any frame).
+  bool sampleBlocks(const Vec3View& position, RowRange rows, BlockCoord* out) const override;
   void endTick(ParticlePool& pool, const TickInstant& end) override;
 
   /// The frames of a sequence around an instant: indices from 0 (frame firstFrame) and the
