@@ -51,34 +51,47 @@ Eigen::Vector3f toFloat(const openvdb::Vec3d& v) {
 }
 
 /// openvdb::tools::BoxSampler with the same result bit for bit, faster where it matters. BoxSampler
-/// reads the eight corners of the cell with eight accessor probes; when the cell lies inside one
-/// leaf node (7³ of its 8³ base corners: two cells in three for scattered points) this reads them
-/// from the leaf directly, then interpolates with BoxSampler's own function. Other cells, and
-/// cells where no leaf is allocated, go through BoxSampler itself.
+/// reads the eight corners of the cell with eight accessor probes, which for a cell across leaf
+/// nodes (one in three for scattered points) alternate between leaves and miss the accessor's
+/// leaf cache at each. This looks each leaf of the cell up once, reads the corners from the leaf
+/// buffers (a corner where no leaf is allocated from the accessor: a tile or the background, as
+/// BoxSampler reads it), then interpolates with BoxSampler's own function.
 struct LeafBoxSampler {
   template <class Accessor, class ValueT>
   static void sample(Accessor& acc, const openvdb::Vec3R& index, ValueT& result) {
-    using Leaf = typename Accessor::TreeType::LeafNodeType;
     const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(index);
-    const openvdb::Coord ijk(base);
-    constexpr openvdb::Int32 kLast = static_cast<openvdb::Int32>(Leaf::DIM) - 1;
-    const openvdb::Int32 i = ijk.x() & kLast, j = ijk.y() & kLast, k = ijk.z() & kLast;
-    const Leaf* leaf = i < kLast && j < kLast && k < kLast ? acc.probeConstLeaf(ijk) : nullptr;
-    if (leaf == nullptr) {
-      openvdb::tools::BoxSampler::sample(acc, index, result);
-      return;
-    }
-    constexpr openvdb::Index kDx = 1u << (2 * Leaf::LOG2DIM), kDy = 1u << Leaf::LOG2DIM;
-    const openvdb::Index o = Leaf::coordToOffset(ijk);
-    // The buffer once (LeafBuffer::data() checks for out-of-core data on every call).
-    const auto* values = leaf->buffer().data();
     ValueT data[2][2][2];
-    for (openvdb::Index a = 0; a < 2; ++a) {
-      for (openvdb::Index b = 0; b < 2; ++b) {
-        for (openvdb::Index c = 0; c < 2; ++c) data[a][b][c] = values[o + a * kDx + b * kDy + c];
+    corners(acc, openvdb::Coord(base), data);
+    result = openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
+  }
+
+  // The values at ijk + (a, b, c), a, b, c in {0, 1}, into data[a][b][c].
+  template <class Accessor, class ValueT>
+  static void corners(Accessor& acc, const openvdb::Coord& ijk, ValueT (&data)[2][2][2]) {
+    using Leaf = typename Accessor::TreeType::LeafNodeType;
+    constexpr openvdb::Int32 kLast = static_cast<openvdb::Int32>(Leaf::DIM) - 1;
+    // Whether a step of +1 along each axis leaves ijk's leaf.
+    const int cross[3] = {(ijk.x() & kLast) == kLast, (ijk.y() & kLast) == kLast,
+                          (ijk.z() & kLast) == kLast};
+    // The cell's leaves by which axes they lie across, each looked up once (the buffer once:
+    // LeafBuffer::data() checks for out-of-core data on every call).
+    const typename Leaf::ValueType* buffers[2][2][2] = {};
+    bool known[2][2][2] = {};
+    for (int a = 0; a < 2; ++a) {
+      for (int b = 0; b < 2; ++b) {
+        for (int c = 0; c < 2; ++c) {
+          const openvdb::Coord q = ijk.offsetBy(a, b, c);
+          const int la = a & cross[0], lb = b & cross[1], lc = c & cross[2];
+          if (!known[la][lb][lc]) {
+            const Leaf* leaf = acc.probeConstLeaf(q);
+            buffers[la][lb][lc] = leaf != nullptr ? leaf->buffer().data() : nullptr;
+            known[la][lb][lc] = true;
+          }
+          const auto* values = buffers[la][lb][lc];
+          data[a][b][c] = values != nullptr ? values[Leaf::coordToOffset(q)] : acc.getValue(q);
+        }
       }
     }
-    result = openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
   }
 };
 
