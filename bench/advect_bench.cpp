@@ -1,5 +1,5 @@
-// Advection through a baked OpenVDB field: tickfx against openvdb::tools::PointAdvect on the same
-// grid, the same points, the same order and the same thread count, in one run.
+// Advection through a baked OpenVDB field: tickfx against OpenVDB's two point advectors on the
+// same grid, the same points, the same order, the same dt and the same thread count, in one run.
 //
 //   advect_bench                 10⁶ particles, orders 1 and 4, 1 and 2 threads
 //   advect_bench --quick         smoke run: 10⁴ particles, short timings
@@ -13,19 +13,30 @@
 //   coherent     sorted by leaf node (8³ voxels) then voxel, as particles born together and
 //                moving together are: consecutive samples share leaves.
 //
-// Cases, each on its own copy of the points:
-//   tickfx       Integrator::step on a ParticlePool whose only module is a VectorField in advect
-//                mode (explicit_euler → Euler, rk4 → RK4: integrators/Advection.h). SoA columns,
-//                fixed blocks of rows, one value accessor per block.
-//   PointAdvect  openvdb::tools::PointAdvect<Vec3fGrid, std::vector<Vec3f>> with the integration
-//                order set and threading on (tbb::parallel_for over the points; one accessor per
-//                TBB range).
-// Both run inside a tbb::task_arena of the case's thread count. Each batch first restores the
-// starting points (a 12 MB copy, the same for both), so every batch times the same trajectory.
-// The two give bitwise identical positions (checked below and in tests/core/test_vdb_advect.cpp).
+// Cases, each on its own copy of the points, one tick (one call, one step) at a time:
+//   tickfx        Integrator::step on a ParticlePool whose only module is a VectorField in advect
+//                 mode (explicit_euler → Euler, rk4 → RK4: integrators/Advection.h). SoA columns,
+//                 particles visited leaf by leaf (integrators/LeafOrder.h), the pool's rows left
+//                 where they are.
+//   PointAdvect   openvdb::tools::PointAdvect<Vec3fGrid, std::vector<Vec3f>> with the integration
+//                 order set and threading on (tbb::parallel_for over the points in their order;
+//                 one accessor per TBB range). The same bits as tickfx (checked below).
+//   advectPoints  openvdb::points::advectPoints on a PointDataGrid made from the same points
+//                 (untimed) with the field grid's transform, so its leaves are the field's: each
+//                 call advects in double through tools::VelocityIntegrator (float samples, cached
+//                 per point: its default), then re-buckets every point into the leaf and voxel it
+//                 moved to (points::movePoints), which tickfx does not do (it keeps rows in place
+//                 and orders its visits instead). Positions are stored voxel-relative, so its bits
+//                 are not tickfx's; the bench checks that the sums of the positions agree.
+//                 One call a tick with timeSteps = 1, as a simulation writing each tick stepped.
+// All run inside a tbb::task_arena of the case's thread count. Before each batch (untimed), the
+// starting points are restored (a copy of the columns, of the vector, of the PointDataGrid), so
+// every batch times the same trajectory from the same state.
 //
 // Output: the table, then one line a figure, `name: value unit (ratios, targets)`.
 #include <openvdb/openvdb.h>
+#include <openvdb/points/PointAdvect.h>
+#include <openvdb/points/PointConversion.h>
 #include <openvdb/tools/PointAdvect.h>
 #include <tbb/task_arena.h>
 
@@ -38,6 +49,7 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "BenchHarness.h"
@@ -102,6 +114,25 @@ void load(tickfx::ParticlePool& pool, const std::vector<openvdb::Vec3f>& points)
   }
 }
 
+/// The number of points of a PointDataGrid and the sum of their world positions' components.
+std::pair<std::size_t, double> pointSum(const openvdb::points::PointDataGrid& points) {
+  std::size_t n = 0;
+  double sum = 0.0;
+  const openvdb::math::Transform& xform = points.transform();
+  for (auto leaf = points.tree().cbeginLeaf(); leaf; ++leaf) {
+    const openvdb::points::AttributeHandle<openvdb::Vec3f> p(leaf->constAttributeArray("P"));
+    for (auto voxel = leaf->beginValueOn(); voxel; ++voxel) {
+      const openvdb::Vec3d ijk = voxel.getCoord().asVec3d();
+      for (auto index = leaf->beginIndexVoxel(voxel.getCoord()); index; ++index) {
+        const openvdb::Vec3d world = xform.indexToWorld(ijk + p.get(*index));
+        sum += world.x() + world.y() + world.z();
+        ++n;
+      }
+    }
+  }
+  return {n, sum};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -150,31 +181,35 @@ int main(int argc, char** argv) {
     tickfx::ParticlePool pool;
     tickfx::ForceSet forces;
     std::unique_ptr<tickfx::Integrator> integrator;
-    std::int64_t tick = 0;
   };
+  using PointGrid = openvdb::points::PointDataGrid;
   std::vector<std::unique_ptr<Ours>> ours;
   std::vector<std::unique_ptr<std::vector<openvdb::Vec3f>>> theirs;
+  std::vector<std::unique_ptr<PointGrid::Ptr>> pointGrids;
   std::vector<std::unique_ptr<tbb::task_arena>> arenas;
-  std::vector<AdvectCase> cases;
+  std::vector<AdvectCase> cases;  // in threes: tickfx, PointAdvect, advectPoints
   for (const std::vector<openvdb::Vec3f>* layout : {&scattered, &coherent}) {
     const std::vector<openvdb::Vec3f>& start = *layout;
     const char* layoutName = layout == &scattered ? "scattered" : "coherent";
+    // Bucketed into the field's leaves and voxels once, untimed; each batch starts on a copy.
+    const PointGrid::ConstPtr startGrid =
+        openvdb::points::createPointDataGrid<openvdb::points::NullCodec, PointGrid>(
+            start, grid->transform());
     for (const int order : {1, 4}) {
       for (const int threads : {1, 2}) {
         arenas.push_back(std::make_unique<tbb::task_arena>(threads));
         tbb::task_arena* arena = arenas.back().get();
         auto o = std::make_unique<Ours>(
             Ours{tickfx::ParticlePool(count), tickfx::ForceSet(),
-                 tickfx::makeIntegrator(order == 1 ? "explicit_euler" : "rk4"), 0});
+                 tickfx::makeIntegrator(order == 1 ? "explicit_euler" : "rk4")});
         o->forces.add(std::make_unique<tickfx::VectorField>(settings, grids));
         load(o->pool, start);
         Ours* self = o.get();
         ours.push_back(std::move(o));
-        cases.emplace_back(
+        AdvectCase& mine = cases.emplace_back(
             std::string(layoutName) + " tickfx",
-            [=, &start](std::int64_t ticks) {
+            [=](std::int64_t ticks) {
               arena->execute([&] {
-                load(self->pool, start);
                 for (std::int64_t k = 0; k < ticks; ++k) {
                   self->integrator->step(self->pool, self->forces, {k, kStepRateHz});
                 }
@@ -182,71 +217,101 @@ int main(int argc, char** argv) {
               bench::escape(self->pool.position().x.data());
             },
             order, threads, true);
+        mine.before = [self, &start] { load(self->pool, start); };
+
         theirs.push_back(std::make_unique<std::vector<openvdb::Vec3f>>(start));
         std::vector<openvdb::Vec3f>* points = theirs.back().get();
-        cases.emplace_back(
+        AdvectCase& pointAdvect = cases.emplace_back(
             std::string(layoutName) + " PointAdvect",
-            [=, &start, &grid](std::int64_t ticks) {
+            [=, &grid](std::int64_t ticks) {
               openvdb::tools::PointAdvect<openvdb::Vec3fGrid, std::vector<openvdb::Vec3f>, false>
                   advector(*grid);
               advector.setIntegrationOrder(static_cast<unsigned>(order));
               advector.setThreaded(true);
               arena->execute([&] {
-                *points = start;
                 for (std::int64_t k = 0; k < ticks; ++k) advector.advect(*points, dt, 1);
               });
               bench::escape(points->data());
             },
             order, threads, false);
+        pointAdvect.before = [points, &start] { *points = start; };
+
+        pointGrids.push_back(std::make_unique<PointGrid::Ptr>());
+        PointGrid::Ptr* moved = pointGrids.back().get();
+        AdvectCase& advectPoints = cases.emplace_back(
+            std::string(layoutName) + " advectPoints",
+            [=, &grid](std::int64_t ticks) {
+              arena->execute([&] {
+                for (std::int64_t k = 0; k < ticks; ++k) {
+                  openvdb::points::advectPoints(**moved, *grid, static_cast<openvdb::Index>(order),
+                                                static_cast<double>(dt), 1);
+                }
+              });
+              bench::escape(moved->get());
+            },
+            order, threads, false);
+        advectPoints.before = [moved, startGrid] { *moved = startGrid->deepCopy(); };
       }
     }
   }
 
-  // Same trajectory, same bits: one batch of 3 ticks each, then compare.
-  for (std::size_t i = 0; i < cases.size(); i += 2) {
-    cases[i].run(3);
-    cases[i + 1].run(3);
-    const tickfx::ParticlePool& pool = ours[i / 2]->pool;
-    const std::vector<openvdb::Vec3f>& points = *theirs[i / 2];
+  // Same trajectory: one batch of 3 ticks each, then compare. PointAdvect must give the same
+  // bits; advectPoints (double, voxel-relative positions, its own point order) the same sum of
+  // positions to float rounding.
+  for (std::size_t i = 0; i < cases.size(); i += 3) {
+    for (std::size_t j = i; j < i + 3; ++j) {
+      if (cases[j].before) cases[j].before();
+      cases[j].run(3);
+    }
+    const tickfx::ParticlePool& pool = ours[i / 3]->pool;
+    const std::vector<openvdb::Vec3f>& points = *theirs[i / 3];
     std::size_t differ = 0;
     for (std::size_t r = 0; r < count; ++r) {
       const auto e = static_cast<Eigen::Index>(r);
       differ += pool.position().x[e] != points[r].x() || pool.position().y[e] != points[r].y() ||
                 pool.position().z[e] != points[r].z();
     }
-    std::printf("%s, order %d, %d thread(s): %zu of %zu positions differ after 3 steps\n",
-                cases[i].name.c_str(), cases[i].order, cases[i].threads, differ, count);
+    const auto [moved, sum] = pointSum(**pointGrids[i / 3]);
+    std::printf(
+        "%s, order %d, %d thread(s) after 3 steps: %zu of %zu positions differ from "
+        "PointAdvect's; advectPoints: %zu points, mean position differs by %.2e m\n",
+        cases[i].name.c_str(), cases[i].order, cases[i].threads, differ, count, moved,
+        std::abs(sum - bench::positionSum(pool)) / (3.0 * static_cast<double>(count)));
   }
 
   bench::timeCases(cases, cl.timing);
 
-  std::printf("\n%-6s %-8s %-22s %16s %12s %8s\n", "order", "threads", "case", "particle-steps/s",
-              "ms/step", "ratio");
-  // Each tickfx case against its baseline, the PointAdvect case after it.
-  for (std::size_t i = 0; i < cases.size(); i += 2) {
-    const AdvectCase& tickfxCase = cases[i];
+  std::printf("\n%-6s %-8s %-24s %16s %12s %12s %13s\n", "order", "threads", "case",
+              "particle-steps/s", "ms/step", "PointAdvect", "advectPoints");
+  // Each case against both baselines, which follow the tickfx case.
+  for (std::size_t i = 0; i < cases.size(); i += 3) {
     const AdvectCase& pointAdvect = cases[i + 1];
-    for (const AdvectCase* c : {&tickfxCase, &pointAdvect}) {
-      const double t = c->seconds();
-      std::printf("%-6d %-8d %-22s %16.3e %12.3f %8.2f\n", c->order, c->threads, c->name.c_str(),
-                  static_cast<double>(count) / t, 1e3 * t, bench::speedup(*c, pointAdvect));
+    const AdvectCase& advectPoints = cases[i + 2];
+    for (std::size_t j = i; j < i + 3; ++j) {
+      const AdvectCase& c = cases[j];
+      const double t = c.seconds();
+      std::printf("%-6d %-8d %-24s %16.3e %12.3f %12.2f %13.2f\n", c.order, c.threads,
+                  c.name.c_str(), static_cast<double>(count) / t, 1e3 * t,
+                  bench::speedup(c, pointAdvect), bench::speedup(c, advectPoints));
     }
   }
   std::printf(
-      "\nratio: PointAdvect's time per step over the case's (> 1: faster than "
-      "PointAdvect); each batch includes restoring the starting points.\n");
+      "\nratios: the baseline's time per step over the case's (> 1: faster than the baseline); "
+      "restoring the starting points is not timed.\n");
 
   // The summary, one line a figure (BenchHarness.h).
   std::printf("\n");
-  for (std::size_t i = 0; i < cases.size(); i += 2) {
+  for (std::size_t i = 0; i < cases.size(); i += 3) {
     const AdvectCase& c = cases[i];
     const AdvectCase& pointAdvect = cases[i + 1];
+    const AdvectCase& advectPoints = cases[i + 2];
     std::printf(
-        "advect order %d %s %s %s: %.2fx PointAdvect (target >= 2x), %s particle-steps/s "
-        "(PointAdvect %s",
+        "advect order %d %s %s %s: %.2fx advectPoints (target >= 2x), %.2fx PointAdvect, %s "
+        "particle-steps/s (advectPoints %s, PointAdvect %s",
         c.order, bench::threadsLabel(c.threads).c_str(), c.name.substr(0, c.name.find(' ')).c_str(),
-        bench::sizeLabel(count).c_str(), bench::speedup(c, pointAdvect),
-        bench::g3(static_cast<double>(count) / c.seconds()).c_str(),
+        bench::sizeLabel(count).c_str(), bench::speedup(c, advectPoints),
+        bench::speedup(c, pointAdvect), bench::g3(static_cast<double>(count) / c.seconds()).c_str(),
+        bench::g3(static_cast<double>(count) / advectPoints.seconds()).c_str(),
         bench::g3(static_cast<double>(count) / pointAdvect.seconds()).c_str());
     if (c.threads > 1) std::printf("; %.2f of %d cores busy", c.cores(), c.threads);
     std::printf(")\n");
