@@ -243,6 +243,39 @@ TEST(LeafOrderedAdvection, MatchesRowOrderBitForBitThroughASequenceWithKill) {
   }
 }
 
+TEST(LeafOrderedAdvection, WritesThePreviousPositionOnlyWhereRowOrderDoes) {
+  // Ticks no frame interpolates across (StepRows::keepPrevious false) write no previous
+  // position, in leaf order as in row order: the pools never get the column.
+  for (const AdvectionScheme scheme : kSchemes) {
+    for (const bool coherent : {false, true}) {
+      expectLeafOrderMatchesRowOrder(scheme, coherent, 2, false, /*keepPrevious=*/false);
+    }
+  }
+  // A pool whose previous position is state (position Verlet's, kept as such) has it written
+  // by every tick, StepRows::keepPrevious or not.
+  ForceSet forces = curlNoiseField(false);
+  for (const AdvectionScheme scheme : kSchemes) {
+    ParticlePool reference(20'000), leafOrdered(20'000);
+    for (ParticlePool* pool : {&reference, &leafOrdered}) {
+      pool->keepPrevious(/*asState=*/true);
+      spawnAll(*pool, points(20'000, false), 0);
+      pool->markAllStepped();
+    }
+    const std::vector<Eigen::Vector3f> start = positionsOf(leafOrdered);
+    Advection rows(scheme, Visits::RowOrder), leaves(scheme, Visits::LeafOrder);
+    tbb::task_arena two(2);
+    rows.step(reference, forces, StepTime{0, kRate}, StepRows::wholePool(reference, false));
+    two.execute([&] {
+      leaves.step(leafOrdered, forces, StepTime{0, kRate}, StepRows::wholePool(leafOrdered, false));
+    });
+    expectSameBits(reference, leafOrdered, std::string(advectionSchemeName(scheme)));
+    for (std::size_t r = 0; r < start.size(); r += 997) {
+      const auto i = static_cast<Eigen::Index>(r);
+      EXPECT_EQ(leafOrdered.previousPosition().x[i], start[r].x()) << r;
+    }
+  }
+}
+
 TEST(LeafOrderedAdvection, SerialBlocksOfAFusedFrameMatchRowOrder) {
   // A fused frame hands each thread a block of rows to step serially: 10 000 rows here, an order
   // of 8192 rows and one of 1808.
