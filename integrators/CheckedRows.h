@@ -63,7 +63,16 @@ struct RowsAt {
       return value;
     }
   }
-  /// Writes `value` flushed (flushTiny()): every value an integrator writes is normal or zero.
+  /// Writes `value` unchanged: a copy of a value already stored (the previous position).
+  void copy(float* column, Lane value) const {
+    if constexpr (std::is_same_v<Lane, float>) {
+      column[i] = value;
+    } else {
+      std::memcpy(column + i, &value, sizeof value);
+    }
+  }
+  /// Writes `value` flushed (flushTiny()): every value an integrator computes is stored normal or
+  /// zero.
   void store(float* column, Lane value) const {
     const Lane flushed = flushTiny(value);
     if constexpr (std::is_same_v<Lane, float>) {

@@ -14,7 +14,7 @@ CheckedPair<Lane> explicitEulerRow(float dt, Lane acceleration, At at, float* po
   const Lane velocity = at.load(vel);
   const Lane nextP = position + velocity * dt;
   const Lane nextV = velocity + acceleration * dt;
-  at.store(last, position);
+  at.copy(last, position);
   at.store(pos, nextP);
   at.store(vel, nextV);
   return {nextP, nextV};

@@ -22,7 +22,7 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
         const auto mid = velocity + a.at(0, velocity) * halfDt;
         const auto next = position + mid * dt;
         const auto nextV = velocity + a.at(1, mid) * dt;
-        at.store(last, position);
+        at.copy(last, position);
         at.store(pos, next);
         at.store(vel, nextV);
         return CheckedPair{next, nextV};  // the new velocity is not in the new position
@@ -42,7 +42,7 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
                  const auto position = at.load(pos);
                  const auto velocity = at.load(vel) + at.load(acc) * halfDt;
                  const auto next = position + velocity * dt;
-                 at.store(last, position);
+                 at.copy(last, position);
                  at.store(mid, velocity);
                  at.store(pos, next);
                  return next;

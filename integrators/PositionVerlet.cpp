@@ -21,7 +21,7 @@ Lane positionVerletRow(float dt2, float invDt, Lane acceleration, At at, float* 
   const Lane position = at.load(pos);
   const Lane next = (position * 2.0f - at.load(last)) + acceleration * dt2;
   const Lane velocity = (next - position) * invDt;
-  at.store(last, position);
+  at.copy(last, position);
   at.store(pos, next);
   at.store(vel, velocity);
   return velocity;

@@ -37,7 +37,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
         const auto k4 = a.at(2, v4);
         const auto nextP = position + ((velocity + v2 * 2.0f) + (v3 * 2.0f + v4)) * sixthH;
         const auto nextV = velocity + ((k1 + k2 * 2.0f) + (k3 * 2.0f + k4)) * sixthH;
-        at.store(last, position);
+        at.copy(last, position);
         at.store(pos, nextP);
         at.store(vel, nextV);
         return CheckedPair{nextP, nextV};
@@ -87,7 +87,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
            const auto nextV =
                velocity +
                ((at.load(s1) + at.load(s2) * 2.0f) + (at.load(s3) * 2.0f + at.load(s4))) * sixthH;
-           at.store(last, position);
+           at.copy(last, position);
            at.store(pos, nextP);
            at.store(vel, nextV);
            return CheckedPair{nextP, nextV};

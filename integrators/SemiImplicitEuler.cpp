@@ -13,7 +13,7 @@ Lane semiImplicitEulerRow(float dt, Lane acceleration, At at, float* pos, float*
   const Lane position = at.load(pos);
   const Lane velocity = at.load(vel) + acceleration * dt;
   const Lane next = position + velocity * dt;
-  at.store(last, position);
+  at.copy(last, position);
   at.store(vel, velocity);
   at.store(pos, next);
   return next;

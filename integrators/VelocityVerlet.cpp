@@ -36,7 +36,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
             const auto next = position + (velocity * dt + acceleration * halfDt2);
             const auto accNext = accelerations.at(2, velocity + acceleration * dt);
             const auto nextV = velocity + (acceleration + accNext) * halfDt;
-            row.store(last, position);
+            row.copy(last, position);
             row.store(pos, next);
             row.store(vel, nextV);
             row.store(acc, accNext);
@@ -60,7 +60,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
            const auto velocity = at.load(vel);
            const auto acceleration = at.load(acc);
            const auto next = position + (velocity * dt + acceleration * halfDt2);
-           at.store(last, position);
+           at.copy(last, position);
            at.store(pos, next);
            at.store(pred, velocity + acceleration * dt);
            return next;
