@@ -331,7 +331,8 @@ void ParticlePool::advanceClock(std::int64_t tick, std::int64_t stepRateHz) {
   const float* life = lifetime_.data();
   std::uint8_t* dead = dead_.data();
   const std::size_t end = rowsThatMayExpire(tick, secondsPerTick);
-  if (birthsInOrder_ && floorRows_ == size_ && lifetimeFloor_ == std::numeric_limits<float>::infinity()) {
+  if (birthsInOrder_ && floorRows_ == size_ &&
+      lifetimeFloor_ == std::numeric_limits<float>::infinity()) {
     mayExpire_.clear();  // no row has a finite lifetime
     return;
   }

@@ -294,7 +294,7 @@ class ParticlePool {
   std::int64_t clockTick_ = 0;
   std::int64_t stepRateHz_ = 60;
   RelaxedFlag mayExpire_, mayDie_;
-  RelaxedFlag mayDieAnywhere_;       // raised by dead(): a flag may be in any row
+  RelaxedFlag mayDieAnywhere_;      // raised by dead(): a flag may be in any row
   std::size_t expiredRowsEnd_ = 0;  // advanceClock() flagged rows below this only
   // No lifetime of rows [0, floorRows_) is below lifetimeFloor_ (rows removed since only raise
   // the true minimum; the rows appended since are covered at the next advanceClock()).

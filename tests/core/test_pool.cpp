@@ -266,7 +266,7 @@ TEST(ParticlePool, EveryPatternOfDeathsKeepsTheSurvivorsWithTheirColumns) {
 TEST(ParticlePool, ExpiryTestsOnlyTheRowsThatMayExpireAndMissesNone) {
   constexpr std::int64_t kRate = 60;
   ParticlePool pool(100'000);
-  std::vector<std::uint64_t> alive;  // ids, in order
+  std::vector<std::uint64_t> alive;    // ids, in order
   std::vector<float> lifeOf, birthOf;  // by id
   const auto lifeFor = [](std::uint64_t id) {
     return 0.05f + 0.01f * static_cast<float>((id * 2654435761U) % 97);  // 0.05 to 1.01 s
@@ -291,7 +291,8 @@ TEST(ParticlePool, ExpiryTestsOnlyTheRowsThatMayExpireAndMissesNone) {
     pool.advanceClock(tick + 1, kRate);
     std::vector<std::uint64_t> kept;
     for (std::uint64_t id : alive) {
-      const auto lived = static_cast<std::int64_t>(tick + 1 - static_cast<std::int64_t>(birthOf[id]));
+      const auto lived =
+          static_cast<std::int64_t>(tick + 1 - static_cast<std::int64_t>(birthOf[id]));
       const bool expires = ParticlePool::ageSeconds(lived, 1.0 / kRate) >= lifeOf[id];
       const bool killed = tick == 150 && id == alive.back();
       if (!expires && !killed) kept.push_back(id);

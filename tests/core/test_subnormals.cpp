@@ -32,14 +32,14 @@ std::uint32_t expectedBits(std::uint32_t bits) {
 
 TEST(FlushTiny, SubnormalsBecomeSignedZerosAndNothingElseChanges) {
   const std::vector<std::uint32_t> cases{
-      0x00000000U, 0x80000000U,                  // ±0 stay
-      0x00000001U, 0x80000001U,                  // the smallest subnormals
-      0x007fffffU, 0x807fffffU,                  // the largest subnormals
-      0x00400000U, 0x80123456U,                  // subnormals between
-      0x00800000U, 0x80800000U,                  // ±FLT_MIN stay
-      0x00800001U, 0x3f800000U, 0xbf800000U,     // normals
-      0x7f7fffffU, 0x7f800000U, 0xff800000U,     // FLT_MAX, ±∞
-      0x7fc00000U, 0xffc00001U, 0x7f800001U,     // NaNs, signalling included
+      0x00000000U, 0x80000000U,               // ±0 stay
+      0x00000001U, 0x80000001U,               // the smallest subnormals
+      0x007fffffU, 0x807fffffU,               // the largest subnormals
+      0x00400000U, 0x80123456U,               // subnormals between
+      0x00800000U, 0x80800000U,               // ±FLT_MIN stay
+      0x00800001U, 0x3f800000U, 0xbf800000U,  // normals
+      0x7f7fffffU, 0x7f800000U, 0xff800000U,  // FLT_MAX, ±∞
+      0x7fc00000U, 0xffc00001U, 0x7f800001U,  // NaNs, signalling included
   };
   for (std::uint32_t b : cases) {
     EXPECT_EQ(bitsOf(flushTiny(withBits(b))), expectedBits(b)) << std::hex << b;
