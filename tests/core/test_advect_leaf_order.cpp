@@ -398,13 +398,25 @@ int keyOf(const Eigen::Vector3f& x) {
   return ((b.x + 3) * 6 + (b.y + 3)) * 6 + (b.z + 3);
 }
 
-TEST(LeafOrderedAdvection, AnIntegratorVisitsScatteredRowsLeafByLeaf) {
+// 8192 scattered points in a pool, under a flow that logs where it is sampled.
+struct LoggedPool {
   std::vector<Eigen::Vector3f> log;
   ForceSet forces;
-  forces.add(std::make_unique<LoggingFlow>(log));
-  ParticlePool pool(8192);
+  ParticlePool pool{8192};
   const std::vector<Eigen::Vector3f> start = points(8192, false);
-  spawnAll(pool, start, 0);
+
+  LoggedPool() {
+    forces.add(std::make_unique<LoggingFlow>(log));
+    spawnAll(pool, start, 0);
+  }
+};
+
+TEST(LeafOrderedAdvection, AnIntegratorVisitsScatteredRowsLeafByLeaf) {
+  LoggedPool logged;
+  const std::vector<Eigen::Vector3f>& log = logged.log;
+  const std::vector<Eigen::Vector3f>& start = logged.start;
+  ForceSet& forces = logged.forces;
+  ParticlePool& pool = logged.pool;
   pool.markAllStepped();
   tbb::task_arena one(1);
   one.execute([&] { makeIntegrator("explicit_euler")->step(pool, forces, StepTime{0, kRate}); });
@@ -426,12 +438,11 @@ TEST(LeafOrderedAdvection, AnIntegratorVisitsScatteredRowsLeafByLeaf) {
 }
 
 TEST(LeafOrderedAdvection, RowOrderVisitsRowsInOrder) {
-  std::vector<Eigen::Vector3f> log;
-  ForceSet forces;
-  forces.add(std::make_unique<LoggingFlow>(log));
-  ParticlePool pool(8192);
-  const std::vector<Eigen::Vector3f> start = points(8192, false);
-  spawnAll(pool, start, 0);
+  LoggedPool logged;
+  const std::vector<Eigen::Vector3f>& log = logged.log;
+  const std::vector<Eigen::Vector3f>& start = logged.start;
+  ForceSet& forces = logged.forces;
+  ParticlePool& pool = logged.pool;
   tbb::task_arena one(1);
   one.execute([&] {
     Advection(AdvectionScheme::Euler, Visits::RowOrder)
