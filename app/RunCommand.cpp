@@ -1,6 +1,9 @@
 // tickfx run: simulate an effect through the fixed-step driver and write one cache per frame.
 // The command runs in stages: its settings (app/RunSettings.h), the prepared run (the system built
 // and resumed, every output checked), the frames, then the report.
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -32,6 +35,7 @@
 #include "io/util/AtomicFile.h"
 #include "particles/Clock.h"
 #include "particles/ParticleSystem.h"
+#include "particles/PhaseProfile.h"
 #include "particles/StateHash.h"
 
 namespace tickfx::app {
@@ -76,7 +80,9 @@ constexpr const char* kRunHelp =
     "  --set key.path=value  override a key of the effect (repeatable), e.g. "
     "simulation.integrator=rk4\n"
     "  --threads N           worker threads (default: the effect's, 0 = all cores)\n"
-    "  --quiet               no summary (errors, warnings and --hash lines still print)\n";
+    "  --quiet               no summary (errors, warnings and --hash lines still print)\n"
+    "  --profile             print where the wall time went, phase by phase, and the share of\n"
+    "                        each that ran on one thread (docs/performance.md)\n";
 
 // ---- the prepared run -------------------------------------------------------------------------
 
@@ -174,6 +180,7 @@ bool shardRun(PreparedRun& run, const RunSettings& s) {
 
 // A shard's end: its final state, then its manifest, which says the folder is whole.
 void finishShard(const RunSettings& s, const PreparedRun& run, std::int64_t lastFrame) {
+  const profile::PhaseScope phase(profile::Phase::Checkpoint);
   io::writeCheckpoint(s.finalStatePath(), *run.system,
                       io::CheckpointInfo{run.effectHash, lastFrame, run.elapsed});
   io::ShardManifest m;
@@ -369,7 +376,10 @@ std::optional<int> FrameLoop::run() {
       if (!duration) break;
       if (!simulateFrame(*duration)) return stopAtNonfinite();
     }
-    run_.writer->finish();
+    {
+      const profile::PhaseScope phase(profile::Phase::CacheWrite);
+      run_.writer->finish();
+    }
     if (const int signal = InterruptCatcher::caught()) return stopAtInterruption(signal);
     finishUsda(run_);
   } catch (const io::WriteError& e) {
@@ -388,13 +398,23 @@ bool FrameLoop::simulateFrame(Flicks duration) {
   if (run_.system->nonfiniteStop()) return false;
   run_.elapsed += duration;
   std::optional<io::FrameData> data;
-  if (s_.writesCaches()) data = io::captureFrame(*run_.system, f, secondsFromFlicks(run_.elapsed));
+  if (s_.writesCaches()) {
+    const profile::PhaseScope phase(profile::Phase::Capture);
+    data = io::captureFrame(*run_.system, f, secondsFromFlicks(run_.elapsed));
+  }
   simulationSeconds_ += secondsSince(simulationStart);
-  if (data) run_.writer->submit(std::move(*data));
+  if (data) {
+    const profile::PhaseScope phase(profile::Phase::CacheWrite);
+    run_.writer->submit(std::move(*data));
+  }
   if (s_.checkpointEvery > 0 && f % s_.checkpointEvery == 0) {
     // A checkpoint at frame f promises the caches through f: a run resumed from it writes
     // from f + 1 on.
-    run_.writer->finish();
+    {
+      const profile::PhaseScope phase(profile::Phase::CacheWrite);
+      run_.writer->finish();
+    }
+    const profile::PhaseScope phase(profile::Phase::Checkpoint);
     io::writeCheckpoint(s_.checkpointPath(f), *run_.system,
                         io::CheckpointInfo{run_.effectHash, f, run_.elapsed});
   }
@@ -515,13 +535,24 @@ int runCommand(Arguments& args) {
     return kExitOk;
   }
   const RunArguments arguments = readRunArguments(args);
+  if (arguments.profile) profile::start();
+  std::optional<profile::PhaseScope> loading(std::in_place, profile::Phase::Load);
   // Everything that can be wrong with the request is found before anything is written.
   const io::LoadResult load = loadEffectReporting(arguments.effectPath, arguments.overrides);
   if (!load.ok()) return kExitUsage;
   const std::optional<RunSettings> settings = resolveRunSettings(arguments, load);
   if (!settings) return kExitUsage;
-  const std::unique_ptr<PreparedRun> run = prepareRun(*settings, *load.effect, load.fingerprint);
+  // --threads N holds every loop of the run to N threads, the caches' encoding too (the system
+  // keeps its ticks to N in its own arena; the rest would take every core).
+  const int threads = settings->threads.value_or(load.effect->simulation.threads);
+  std::optional<tbb::global_control> threadLimit;
+  if (threads > 0) {
+    threadLimit.emplace(tbb::global_control::max_allowed_parallelism,
+                        static_cast<std::size_t>(threads));
+  }
+  std::unique_ptr<PreparedRun> run = prepareRun(*settings, *load.effect, load.fingerprint);
   if (!run) return kExitUsage;
+  loading.reset();
 
   FrameLoop frames(*settings, *run);
   if (const std::optional<int> stopped = frames.run()) return *stopped;
@@ -531,6 +562,23 @@ int runCommand(Arguments& args) {
   if (settings->printHash) {
     std::printf("state-hash: %s\n", hashToHex(stateHash(*run->system)).c_str());
     std::printf("ticks: %lld\n", static_cast<long long>(run->system->tickCount()));
+  }
+  if (settings->profile) {
+    const double writerSeconds = run->writer->writeSeconds();
+    {
+      const profile::PhaseScope phase(profile::Phase::Release);
+      run.reset();
+    }
+    const profile::Report report = profile::stop();
+    std::fputs(
+        report.format(threads > 0 ? threads : tbb::this_task_arena::max_concurrency()).c_str(),
+        stdout);
+    if (settings->writesCaches() && settings->overlap) {
+      std::printf(
+          "  the cache writer's own thread: %.3f s encoding and writing, beside the "
+          "phases above\n",
+          writerSeconds);
+    }
   }
   return kExitOk;
 }

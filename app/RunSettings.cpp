@@ -147,6 +147,7 @@ RunArguments readRunArguments(Arguments& args) {
   a.overlap = !args.flag("--no-overlap");
   a.printHash = args.flag("--hash");
   a.quiet = args.flag("--quiet");
+  a.profile = args.flag("--profile");
   a.effectPath = args.positionals(1, "one effect file: tickfx run EFFECT.toml")[0];
   return a;
 }
@@ -203,6 +204,7 @@ std::optional<RunSettings> resolveRunSettings(const RunArguments& a, const io::L
                      .overlap = a.overlap,
                      .printHash = a.printHash,
                      .quiet = a.quiet,
+                     .profile = a.profile,
                      .shard = shard,
                      .framesPerSecond = static_cast<double>(rate.numerator) /
                                         static_cast<double>(rate.denominator)};

@@ -30,6 +30,7 @@ struct RunArguments {
   bool overlap = true;  // not --no-overlap
   bool printHash = false;
   bool quiet = false;
+  bool profile = false;
 };
 
 /// Reads every option of `tickfx run` (after --help) and the effect file; UsageError for an
@@ -55,6 +56,7 @@ struct RunSettings {
   bool overlap = true;
   bool printHash = false;
   bool quiet = false;
+  bool profile = false;  // --profile: print where the wall time went, phase by phase
   /// --shard I/N: the part of the run this one simulates (0/1 is the whole run, as a shard). A
   /// shard writes its final state (finalStatePath()) and manifest beside its caches.
   std::optional<Shard> shard;

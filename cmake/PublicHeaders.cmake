@@ -17,6 +17,7 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   particles/ParticleEvent.h
   particles/ParticlePool.h
   particles/ParticleSystem.h
+  particles/PhaseProfile.h
   particles/Random.h
   particles/RelaxedFlag.h
   particles/RenderDestination.h

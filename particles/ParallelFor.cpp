@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "particles/PhaseProfile.h"
 #include "particles/TaskExecutor.h"
 
 namespace tickfx {
@@ -79,6 +80,7 @@ void parallelForTasks(std::size_t tasks, const std::function<void(std::size_t)>&
     if (tasks == 1) task(0);
     return;
   }
+  const profile::ParallelScope parallel;
   if (tExecutor != nullptr) {
     tExecutor->run(tasks, task);
     return;

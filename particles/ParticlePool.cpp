@@ -11,6 +11,7 @@
 
 #include "particles/Assert.h"
 #include "particles/ParallelFor.h"
+#include "particles/PhaseProfile.h"
 
 namespace tickfx {
 namespace {
@@ -148,6 +149,7 @@ void ParticlePool::forEachColumn(const Visit& visit) {
 }
 
 void ParticlePool::setStorageRows(std::size_t rows) {
+  const profile::PhaseScope phase(profile::Phase::Growth);
   TICKFX_ASSERT(rows >= size_, "storage shorter than the live rows");
   // Columns are independent: each is a task (a move of the live rows at most).
   std::vector<FloatColumn*> floats;

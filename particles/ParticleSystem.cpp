@@ -12,6 +12,7 @@
 #include <emmintrin.h>
 #endif
 
+#include <optional>
 #include "fields/ColliderSet.h"
 #include "fields/ForceSet.h"
 #include "fields/SpringNetwork.h"
@@ -19,6 +20,7 @@
 #include "particles/Clock.h"
 #include "particles/ExactTime.h"
 #include "particles/ParallelFor.h"
+#include "particles/PhaseProfile.h"
 #include "particles/TaskExecutor.h"
 
 namespace tickfx {
@@ -246,6 +248,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
     bornBy[static_cast<std::size_t>(j)] = pool_.size();
   }
   const std::size_t rows = pool_.size();
+  std::optional<profile::PhaseScope> phase(std::in_place, profile::Phase::Step);
   integrator_->prepare(pool_, *forces_);
   forces_->beginTick(pool_, first);  // no module's own tables; whether any particle is pinned
   const bool stop = settings_.nonfinite == NonfinitePolicy::Stop;
@@ -300,6 +303,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
     return false;
   }
   pool_.markAllStepped();
+  phase.reset();
   endTicks(first + ticks, keepVelocities);
   if (keepPrevious) previousTick_ = tick_;
   fusedTicks_ += ticks;
@@ -307,6 +311,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
 }
 
 void ParticleSystem::emitTick(std::int64_t tick) {
+  const profile::PhaseScope phase(profile::Phase::Emission);
   const std::size_t firstNew = pool_.size();
   const std::size_t tag = pool_.findAttribute(kEmitterColumn);
   for (const Emitter& e : emitters_) {
@@ -337,6 +342,7 @@ void ParticleSystem::runTick(bool shown) {
     }
     if (p.tick <= tick_) p.build = {};  // born (or before a restored tick): not needed again
   }
+  std::optional<profile::PhaseScope> phase(std::in_place, profile::Phase::Step);
   if (keepVelocities) {
     const auto n = static_cast<Eigen::Index>(pool_.size());
     previousVelocity_.resize(n);
@@ -360,6 +366,7 @@ void ParticleSystem::runTick(bool shown) {
   if (colliders_) pathsTick_ = tick_ + 1;
   pool_.markAllStepped();
   forces_->endTick(pool_, time.stage(2));
+  phase.reset();
   endTicks(tick_ + 1, keepVelocities);
   if (keepPrevious) previousTick_ = tick_;
 }
@@ -381,6 +388,7 @@ void ParticleSystem::stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* 
 }
 
 void ParticleSystem::endTicks(std::int64_t tick, bool keepVelocities) {
+  const profile::PhaseScope phase(profile::Phase::Deaths);
   tick_ = tick;
   // Checked and not stopped, the rows left are finite: a kill removes the rows found below.
   nonfiniteCheck_.setSteppedRowsFinite(settings_.nonfinite != NonfinitePolicy::Keep &&

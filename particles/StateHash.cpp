@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "particles/ParticleSystem.h"
+#include "particles/PhaseProfile.h"
 
 namespace tickfx {
 namespace {
@@ -101,12 +102,14 @@ void addPool(Hasher& h, const ParticlePool& pool);
 }  // namespace
 
 std::uint64_t stateHash(const ParticlePool& pool) {
+  const profile::PhaseScope phase(profile::Phase::Hash);
   Hasher h;
   addPool(h, pool);
   return h.value();
 }
 
 std::uint64_t stateHash(const ParticleSystem& system) {
+  const profile::PhaseScope phase(profile::Phase::Hash);
   Hasher h;
   addPool(h, system.pool());
   const EventEmission* events = system.events();
