@@ -3,6 +3,7 @@
 #include <sys/utsname.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -139,6 +140,14 @@ LogComparison compareWithHashLog(const io::EffectSettings& effect, std::uint64_t
                                  const std::string& logName, const io::HashLog& log) {
   const io::HashLogHeader& h = log.header;
   checkLogIsOfEffect(effect, fingerprint, logName, h);
+  // tickfx 0.3.0 hashes each column in blocks (particles/StateHash.h): a log of an earlier
+  // version holds hashes of the same states that this build cannot reproduce.
+  int major = 0, minor = 0;
+  if (std::sscanf(h.version.c_str(), "%d.%d", &major, &minor) == 2 && major == 0 && minor < 3) {
+    throw HashLogRefused(logName + ": error: the log is of tickfx " + h.version +
+                         ", whose state hashes are defined otherwise (since 0.3.0 each column is "
+                         "hashed in blocks); record it again with this build");
+  }
   const auto system = io::buildOfflineSystem(effect, std::nullopt);
   const std::vector<std::string> columns = stateColumnNames(system->pool());
   if (columns != h.columns) {

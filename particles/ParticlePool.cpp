@@ -3,15 +3,22 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "particles/Assert.h"
 #include "particles/ParallelFor.h"
 #include "particles/PhaseProfile.h"
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 
 namespace tickfx {
 namespace {
@@ -148,6 +155,32 @@ void ParticlePool::forEachColumn(const Visit& visit) {
   visit(dead_);
 }
 
+ParticlePool::~ParticlePool() {
+  // Each column's pages, in chunks of 16 MiB, handed back to the kernel by parallel tasks
+  // (madvise(MADV_DONTNEED)): the free() that follows then unmaps no page. Only whole pages inside
+  // each column's live rows are released, and only of columns of two chunks or more, which every
+  // allocator maps on their own: the memory is about to be freed, so what it reads afterwards
+  // does not matter.
+#if defined(__linux__)
+  constexpr std::size_t kChunk = std::size_t{16} << 20;
+  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
+  std::vector<std::pair<std::uintptr_t, std::size_t>> chunks;
+  forEachColumn([&](auto& column) {
+    // The column's own row count: a moved-from pool's columns are empty.
+    const std::size_t bytes = static_cast<std::size_t>(column.size()) * sizeof(*column.data());
+    if (page == 0 || column.data() == nullptr || bytes < 2 * kChunk) return;
+    const auto start = reinterpret_cast<std::uintptr_t>(column.data());
+    const std::uintptr_t begin = (start + page - 1) / page * page;
+    const std::uintptr_t end = (start + bytes) / page * page;
+    for (std::uintptr_t c = begin; c < end; c += kChunk)
+      chunks.emplace_back(c, std::min(kChunk, end - c));
+  });
+  parallelForTasks(chunks.size(), [&](std::size_t i) {
+    ::madvise(reinterpret_cast<void*>(chunks[i].first), chunks[i].second, MADV_DONTNEED);
+  });
+#endif
+}
+
 void ParticlePool::setStorageRows(std::size_t rows) {
   const profile::PhaseScope phase(profile::Phase::Growth);
   TICKFX_ASSERT(rows >= size_, "storage shorter than the live rows");
@@ -221,14 +254,25 @@ std::size_t ParticlePool::appendRowsStrided(std::size_t count, std::int64_t tick
   makeRoom(first + count);
   size_ += count;
   TICKFX_ASSERT(size_ <= storageRows_, "rows appended past the pool's storage");
-  for (std::size_t i = first; i < size_; ++i) {
-    id_[i] = nextId_ + firstOffset + (i - first) * stride;
-    birthTick_[i] = static_cast<std::uint32_t>(tick);
-    dead_[i] = 0;
+  // New rows are first written here, by the threads of the blocks (first touch: a burst's pages
+  // are faulted in by every thread, not one).
+  const std::uint64_t firstId = nextId_ + firstOffset;
+  const auto fill = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      id_[first + i] = firstId + i * stride;
+      birthTick_[first + i] = static_cast<std::uint32_t>(tick);
+      dead_[first + i] = 0;
+    }
+    const auto head = static_cast<Eigen::Index>(first + begin);
+    const auto n = static_cast<Eigen::Index>(end - begin);
+    for (NamedColumn& a : attributes_) a.values.segment(head, n).setConstant(a.initial);
+  };
+  if (count <= kParallelBlockRows) {
+    fill(0, count);  // one spawn, or a few: no task to make
+  } else {
+    parallelForRows(count, fill);
   }
   nextId_ += idsUsed;
-  const auto head = static_cast<Eigen::Index>(first), n = static_cast<Eigen::Index>(count);
-  for (NamedColumn& a : attributes_) a.values.segment(head, n).setConstant(a.initial);
   return first;
 }
 

@@ -71,6 +71,13 @@ class ParticlePool {
  public:
   /// `maxParticles` is a hard cap: spawns past it are dropped and counted (droppedSpawns()).
   explicit ParticlePool(std::size_t maxParticles);
+  ParticlePool(const ParticlePool&) = default;
+  ParticlePool(ParticlePool&&) noexcept = default;
+  ParticlePool& operator=(const ParticlePool&) = default;
+  ParticlePool& operator=(ParticlePool&&) noexcept = default;
+  /// Gives the pages of large columns back in parallel before freeing them: unmapping gigabytes
+  /// on one thread takes a tenth of a second a gigabyte.
+  ~ParticlePool();
 
   std::size_t size() const { return size_; }
   std::size_t maxParticles() const { return maxParticles_; }

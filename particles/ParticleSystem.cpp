@@ -6,13 +6,13 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
-#include <optional>
 #include "fields/ColliderSet.h"
 #include "fields/ForceSet.h"
 #include "fields/SpringNetwork.h"
@@ -344,9 +344,10 @@ void ParticleSystem::runTick(bool shown) {
   }
   std::optional<profile::PhaseScope> phase(std::in_place, profile::Phase::Step);
   if (keepVelocities) {
-    const auto n = static_cast<Eigen::Index>(pool_.size());
-    previousVelocity_.resize(n);
-    for (int c = 0; c < 3; ++c) previousVelocity_[c] = pool_.velocity()[c].head(n);
+    previousVelocity_.resize(static_cast<Eigen::Index>(pool_.size()));
+    parallelForRows(pool_.size(), [&](std::size_t b, std::size_t e) {
+      previousVelocity_.copyRows(pool_.velocity(), b, e);
+    });
   }
   forces_->beginTick(pool_, tick_);
   const StepTime time{tick_, settings_.stepRateHz};

@@ -10,7 +10,11 @@
 namespace tickfx {
 
 /// A 64-bit hash over the bits of every column of rows [0, size()) in id order (the pool's row
-/// order), plus the row count, the next id and the dropped-spawn count. Ages and inverse masses
+/// order), plus the row count, the next id and the dropped-spawn count. Each column is hashed in
+/// fixed blocks of 65536 rows, in parallel: a block's words are dealt in turn to four chains, and
+/// its hash chains the four; a column's hash chains the row count and its blocks' hashes, and the
+/// state's chains the counters and the columns' hashes in stateColumnNames() order.
+/// The value depends on the bits alone, never on the thread count. Ages and inverse masses
 /// count as the columns they once were (worked out from birth ticks and masses); the previous
 /// position counts as zeros unless it is state (ParticlePool::previousIsState()). Two states hash
 /// equal only if (barring collisions) every float is bitwise equal; −0 and +0 differ, as they

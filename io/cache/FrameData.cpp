@@ -1,6 +1,9 @@
 #include "io/cache/FrameData.h"
 
+#include <algorithm>
+
 #include "io/util/Fingerprint.h"
+#include "particles/ParallelFor.h"
 #include "particles/ParticleSystem.h"
 
 namespace tickfx::io {
@@ -23,12 +26,19 @@ FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double 
   FrameData data;
   data.frame = frame;
   data.timeSeconds = timeSeconds;
-  data.id.assign(pool.id().begin(), pool.id().begin() + n);
+  const std::size_t rows = pool.size();
   system.renderPositions(data.position);
   system.renderVelocities(data.velocity);
   system.renderAges(data.age);
-  data.life = pool.lifetime().head(n);
-  data.mass = pool.mass().head(n);
+  // The stored columns are copied in parallel blocks (a frame of 10^8 rows is 2 GB of them).
+  data.id.resize(rows);
+  data.life.resize(n);
+  data.mass.resize(n);
+  parallelForRows(rows, [&](std::size_t b, std::size_t e) {
+    std::copy(pool.id().begin() + b, pool.id().begin() + e, data.id.begin() + b);
+    std::copy(pool.lifetime().data() + b, pool.lifetime().data() + e, data.life.data() + b);
+    std::copy(pool.mass().data() + b, pool.mass().data() + e, data.mass.data() + b);
+  });
   // Attributes over life are evaluated here, at the frame's ages: nothing of them is stored.
   const LifeAttributeSet& life = system.lifeAttributes();
   for (std::string& name : system.attributeNames()) {
@@ -39,7 +49,12 @@ FrameData captureFrame(const ParticleSystem& system, std::int64_t frame, double 
                     FloatDestination{values.data(), sizeof(float), pool.size()});
       data.attributes.push_back(std::move(values));
     } else {
-      data.attributes.emplace_back(pool.attribute(pool.findAttribute(name)).head(n));
+      const FloatColumn& stored = pool.attribute(pool.findAttribute(name));
+      FloatColumn values(n);
+      parallelForRows(rows, [&](std::size_t b, std::size_t e) {
+        std::copy(stored.data() + b, stored.data() + e, values.data() + b);
+      });
+      data.attributes.push_back(std::move(values));
     }
     data.attributeNames.push_back(std::move(name));
   }

@@ -70,7 +70,7 @@ TEST_F(HashLog, ALogComparedWithItselfIsIdentical) {
   const std::vector<std::string> log = lines(readAll(path("a.log")));
   ASSERT_GT(log.size(), 16u);
   EXPECT_EQ(log[0], "tickfx hash log 1");
-  for (const char* key : {"machine: ", "cpu: ", "compiler: ", "build: ", "tickfx: 0.2.0"})
+  for (const char* key : {"machine: ", "cpu: ", "compiler: ", "build: ", "tickfx: 0.3.0"})
     EXPECT_GE(find(log, key), 0) << key;
   EXPECT_EQ(log[find(log, "seed: ")], "seed: 7");
   EXPECT_EQ(log[find(log, "step_rate: ")], "step_rate: 120");
@@ -195,6 +195,25 @@ TEST_F(HashLog, ALogOfAnotherEffectSeedOrStepRateIsRefused) {
   EXPECT_EQ(r.exit, 2);
   EXPECT_EQ(r.err, log + ": error: the log is of another step rate (120 Hz, this run 240 Hz)\n");
   EXPECT_EQ(r.out, "");
+}
+
+TEST_F(HashLog, ALogOfAVersionThatHashedOtherwiseIsRefused) {
+  ASSERT_EQ(run("determinism samples/fountain.toml --seconds 0.5 --record " + path("a.log")).exit,
+            0);
+  // The same log as tickfx 0.2.0 wrote it: its hashes are of the same states, by the definition
+  // before columns were hashed in blocks.
+  std::string text = readAll(path("a.log"));
+  const std::size_t at = text.find("tickfx: 0.3.0\n");
+  ASSERT_NE(at, std::string::npos) << text.substr(0, 400);
+  text.replace(at, 14, "tickfx: 0.2.0\n");
+  const std::string old = path("old.log");
+  std::ofstream(old) << text;
+  const Result r = run("determinism samples/fountain.toml --compare " + old);
+  EXPECT_EQ(r.exit, 2) << r.out << r.err;
+  EXPECT_EQ(r.err, old +
+                       ": error: the log is of tickfx 0.2.0, whose state hashes are defined "
+                       "otherwise (since 0.3.0 each column is hashed in blocks); record it again "
+                       "with this build\n");
 }
 
 TEST_F(HashLog, TruncatedOrGarbledLogsAreRefusedWithFileAndLine) {
