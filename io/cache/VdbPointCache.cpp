@@ -12,13 +12,14 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
 #include <numeric>
 #include <optional>
-#include <sstream>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -28,6 +29,8 @@
 
 #include "fields/vdb/VdbGridFile.h"
 #include "io/cache/AttributeGroups.h"
+#include "io/cache/VdbPointCacheBytes.h"
+#include "io/cache/VdbPointsEncoder.h"
 #include "io/util/AtomicFile.h"
 #include "io/util/Fingerprint.h"
 
@@ -401,28 +404,25 @@ bool isIdentity(const openvdb::math::Transform& transform) {
   return true;
 }
 
-// The bytes io::File::write() would put in a file, made in memory: File writes through its own
-// std::ofstream and ignores its failures, so a full disk left a truncated .vdb under the frame's
-// name and the run went on. Archive::write() with a seekable stream is what File::write() calls.
-class ArchiveBytes final : public openvdb::io::Archive {
- public:
-  /// `expectedBytes`: room reserved up front (a stream that grows copies what it holds each time
-  /// it doubles; untouched room costs no memory).
-  std::string of(const openvdb::GridCPtrVec& grids, std::size_t expectedBytes) const {
-    std::string room;
-    room.reserve(expectedBytes);
-    std::ostringstream os(std::move(room), std::ios::binary);
-    Archive::write(os, grids, /*seekable=*/true);
-    if (!os) throw std::runtime_error("cannot encode the VDB points grid");
-    return std::move(os).str();
-  }
-};
+// The file's compression flags (openvdb::io::COMPRESS_*), as io::File would take them.
+std::uint32_t compressionFlags(const VdbCacheOptions& options) {
+  return options.compression == VdbCacheOptions::Compression::Blosc
+             ? openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK
+             : openvdb::io::COMPRESS_ACTIVE_MASK;
+}
+
+// Room for a whole file (uncompressed): the arrays' bytes, a leaf's offsets and masks (at most
+// 2 + 4 KiB), and the headers.
+std::size_t expectedFileBytes(const FrameData& frame, const vdbp::PointDataGrid& grid) {
+  const std::size_t bytesPerPoint = 12 + 12 + 8 + 4 * (3 + frame.attributes.size());
+  return frame.size() * bytesPerPoint + grid.constTree().leafCount() * (6 * 1024) + (64 << 10);
+}
 
 // OpenVDB stamps every file with a random UUID (36 characters after the header's version fields),
 // so two identical runs would write different bytes. A cache's UUID is made from what the file
 // holds instead: the effect's fingerprint, its seed and the frame (an RFC 9562 version-8 UUID).
 // The header layout is checked first; a layout this build does not know is left as written.
-void stampUuid(std::string& bytes, const VdbCacheMetadata& meta, std::int64_t frame) {
+void stampUuid(std::span<char> bytes, const VdbCacheMetadata& meta, std::int64_t frame) {
   constexpr std::size_t kUuidAt = 21;
   constexpr std::size_t kUuidLength = 36;
   if (bytes.size() < kUuidAt + kUuidLength) return;
@@ -439,7 +439,7 @@ void stampUuid(std::string& bytes, const VdbCacheMetadata& meta, std::int64_t fr
                 static_cast<unsigned>((hi >> 16) & 0xffff), static_cast<unsigned>(hi & 0xfff),
                 static_cast<unsigned>(0x8000 | ((lo >> 48) & 0x3fff)),
                 static_cast<unsigned long long>(lo & 0xffffffffffffULL));
-  bytes.replace(kUuidAt, kUuidLength, text, kUuidLength);
+  std::memcpy(bytes.data() + kUuidAt, text, kUuidLength);
 }
 
 // What OpenVDB reads without comparing (readVdbGrid has checked every size it trusts): a leaf's
@@ -471,18 +471,9 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
                         const std::filesystem::path& path, const VdbCacheOptions& options,
                         Durability durability) {
   openvdb::initialize();
-  const openvdb::GridCPtrVec grids{makeGrid(frame, meta, options)};
-  ArchiveBytes archive;
-  archive.setCompression(options.compression == VdbCacheOptions::Compression::Blosc
-                             ? openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK
-                             : openvdb::io::COMPRESS_ACTIVE_MASK);
-  // The arrays' bytes, a leaf's offsets and masks (at most 2 + 4 KiB), and the headers.
-  const std::size_t bytesPerPoint = 12 + 12 + 8 + 4 * (3 + frame.attributes.size());
-  const std::size_t leaves =
-      static_cast<const vdbp::PointDataGrid&>(*grids.front()).constTree().leafCount();
-  std::string bytes =
-      archive.of(grids, frame.size() * bytesPerPoint + leaves * (6 * 1024) + (64 << 10));
-  stampUuid(bytes, meta, frame.frame);
+  const vdbp::PointDataGrid::Ptr grid = makeGrid(frame, meta, options);
+  FileBytes bytes = encodePointsFile(*grid, compressionFlags(options));
+  stampUuid(std::span<char>(bytes.data(), bytes.size()), meta, frame.frame);
   writeFileAtomically(
       path,
       [&](std::ostream& out) {
@@ -490,6 +481,26 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
       },
       durability);
 }
+
+namespace detail {
+
+std::string vdbPointCacheBytes(const FrameData& frame, const VdbCacheMetadata& meta,
+                               const VdbCacheOptions& options, VdbEncoder encoder) {
+  openvdb::initialize();
+  const vdbp::PointDataGrid::Ptr grid = makeGrid(frame, meta, options);
+  std::string bytes;
+  if (encoder == VdbEncoder::Parallel) {
+    const FileBytes encoded = encodePointsFile(*grid, compressionFlags(options));
+    bytes.assign(encoded.data(), encoded.size());
+  } else {
+    bytes =
+        encodePointsFileSerially(grid, compressionFlags(options), expectedFileBytes(frame, *grid));
+  }
+  stampUuid(bytes, meta, frame.frame);
+  return bytes;
+}
+
+}  // namespace detail
 
 FrameData readVdbPointCache(const std::filesystem::path& path, VdbCacheContents* contents) {
   const std::string file = path.string();

@@ -1,0 +1,62 @@
+// A .vdb file of one PointDataGrid made in memory, its leaves' buffers encoded on every thread.
+// Internal to io/ (not installed): it includes OpenVDB's headers, which VdbPointCache.h keeps out.
+#pragma once
+
+#include <openvdb/points/PointDataGrid.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace tickfx::io {
+
+/// Bytes made in memory, in storage left uninitialised until they are written: the threads that
+/// fill its parts fault its pages in, where a std::string would be zeroed first, on one thread.
+/// Large storage asks Linux for transparent huge pages (madvise), so that filling it takes a
+/// page fault every 2 MiB rather than every 4 KiB: in a virtual machine these faults cost more
+/// than the copying itself.
+class FileBytes {
+ public:
+  struct Free {
+    void operator()(char* p) const;
+  };
+  using Storage = std::unique_ptr<char[], Free>;
+
+  /// Uninitialised storage for `size` bytes (std::bad_alloc when there is none).
+  static Storage allocate(std::size_t size);
+
+  FileBytes() = default;
+  FileBytes(Storage data, std::size_t size) : data_(std::move(data)), size_(size) {}
+  char* data() { return data_.get(); }
+  const char* data() const { return data_.get(); }
+  std::size_t size() const { return size_; }
+
+ private:
+  Storage data_;
+  std::size_t size_ = 0;
+};
+
+/// What openvdb::io::File::write() writes for `grid` alone (its name unique, no file metadata)
+/// with `compression` (openvdb::io::COMPRESS_* flags), made in memory: the bytes of
+/// io::Archive::write(os, {grid}, seekable = true), every one of them but the header's UUID, which
+/// OpenVDB draws at random each time. (File writes through its own std::ofstream and ignores its
+/// failures, so a full disk left a truncated .vdb under the frame's name and the run went on:
+/// writeVdbPointCache writes these bytes with writeFileAtomically instead.)
+/// OpenVDB writes the header, the grid's descriptor (and the offsets it patches in), its
+/// metadata, transform and topology, as ever; the leaves' buffers, nearly all of the file, are
+/// made by OpenVDB's own leaf and attribute writers on every thread (TBB), leaf range by leaf
+/// range and, with blosc, page by page, into place at offsets summed in advance. The bytes do not
+/// depend on the thread count. A grid this cannot split (leaves whose attributes differ, arrays
+/// not in memory) or without a leaf is written by OpenVDB alone, to the same bytes.
+/// `expectedBytes`: the room reserved for the header, metadata and topology.
+FileBytes encodePointsFile(openvdb::points::PointDataGrid& grid, std::uint32_t compression,
+                           std::size_t expectedBytes = 1 << 20);
+
+/// The same bytes made by io::Archive::write() alone, on one thread, into a std::ostringstream:
+/// the way tickfx wrote its caches before encodePointsFile, kept as the tests' reference.
+/// `expectedBytes`: the room reserved for the whole file.
+std::string encodePointsFileSerially(const openvdb::points::PointDataGrid::ConstPtr& grid,
+                                     std::uint32_t compression, std::size_t expectedBytes);
+
+}  // namespace tickfx::io
