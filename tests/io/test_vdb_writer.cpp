@@ -1,0 +1,230 @@
+// The parallel encoder of VDB point caches (io/cache/VdbPointsEncoder) against OpenVDB's own
+// serial writer: the same bytes for every option and size, on any number of threads, and files
+// that read back (through tickfx and through OpenVDB alone) to the points written.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "PointCacheTestSupport.h"
+#include "VdbTestData.h"
+#include "io/cache/FrameData.h"
+#include "io/cache/VdbCacheOptions.h"
+#include "io/cache/VdbPointCache.h"
+#include "io/cache/VdbPointCacheBytes.h"
+
+namespace tickfx::io {
+namespace {
+
+namespace fs = std::filesystem;
+namespace vdbt = tickfx::vdb_test;
+using detail::VdbEncoder;
+
+constexpr VdbCacheOptions kDefault{};
+constexpr VdbCacheOptions kFixed16{VdbCacheOptions::Compression::None,
+                                   VdbCacheOptions::Positions::Fixed16};
+constexpr VdbCacheOptions kBlosc{VdbCacheOptions::Compression::Blosc};
+constexpr VdbCacheOptions kFixed16Blosc{VdbCacheOptions::Compression::Blosc,
+                                        VdbCacheOptions::Positions::Fixed16};
+// The thread counts each encoding runs under: one, the bench's two, an odd count, more than
+// the machine may have.
+constexpr int kThreads[] = {1, 2, 3, 8};
+
+std::uint32_t bits(float x) { return std::bit_cast<std::uint32_t>(x); }
+
+VdbCacheMetadata metadata() {
+  return VdbCacheMetadata{"fedcba9876543210", 77, 120, "semi_implicit_euler", "0.1.0"};
+}
+
+// A pure function of (i, c) in [0, 1): splitmix64's finaliser, its top 24 bits.
+float unit(std::uint64_t i, std::uint64_t c) {
+  std::uint64_t z = i * 0x9e3779b97f4a7c15ULL + c * 0xbf58476d1ce4e5b9ULL + 0x2545f4914f6cdd1dULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return static_cast<float>(z >> 40) * 0x1p-24f;
+}
+
+// n particles in a box of `half` metres either side of 0 (so about (half / 4)³ leaves when dense
+// enough), ids 5, 7, 9, ... (rows in id order, as FrameData promises), every standard column
+// varying, and the custom attributes `names` (whole numbers for an int attribute).
+FrameData frameOf(std::size_t n, float half, const std::vector<std::string>& names = {}) {
+  FrameData f;
+  f.resize(n, names);
+  f.frame = 12;
+  f.timeSeconds = 0.5;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    f.id[k] = 2 * k + 5;
+    for (int c = 0; c < 3; ++c) {
+      const auto cc = static_cast<std::uint64_t>(c);
+      f.position[c][i] = half * (2.0f * unit(k, cc) - 1.0f);
+      f.velocity[c][i] = 3.0f * unit(k, 3 + cc) - 1.5f;
+    }
+    f.age[i] = unit(k, 6);
+    f.life[i] = k % 3 == 0 ? std::numeric_limits<float>::infinity() : 1.0f + unit(k, 7);
+    f.mass[i] = 0.5f + unit(k, 8);
+    for (std::size_t a = 0; a < names.size(); ++a) {
+      const float u = unit(k, 9 + a);
+      f.attributes[a][i] = names[a] == "hitnum" ? std::floor(100.0f * u) : u;
+    }
+  }
+  return f;
+}
+
+// Where two byte strings first differ (or the shorter one's length), for a failure's message.
+std::size_t firstDifference(const std::string& a, const std::string& b) {
+  const auto [ia, ib] = std::mismatch(
+      a.begin(), a.begin() + static_cast<std::ptrdiff_t>(std::min(a.size(), b.size())), b.begin());
+  return static_cast<std::size_t>(ia - a.begin());
+}
+
+std::string fileBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+class ioVdbWriter : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("tickfx_vdb_writer_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // The parallel encoder's bytes, and the file writeVdbPointCache writes, under each of
+  // kThreads, are the serial writer's bytes; the file reads back to `frame` (positions exactly,
+  // or within Fixed16's step) through tickfx and holds its points for OpenVDB alone.
+  void expectSameBytesAsOpenVdb(const FrameData& frame, const VdbCacheOptions& options) {
+    const std::string serial =
+        detail::vdbPointCacheBytes(frame, metadata(), options, VdbEncoder::Serial);
+    ASSERT_GT(serial.size(), 100u);
+    // Lets an arena have more threads than the machine has cores (TBB's default limit).
+    const tbb::global_control allowed(
+        tbb::global_control::max_allowed_parallelism,
+        static_cast<std::size_t>(*std::max_element(std::begin(kThreads), std::end(kThreads))));
+    for (const int threads : kThreads) {
+      SCOPED_TRACE(std::to_string(threads) + " threads");
+      tbb::task_arena arena(threads);
+      std::string parallel;
+      const fs::path file = dir_ / ("t" + std::to_string(threads) + ".vdb");
+      arena.execute([&] {
+        parallel = detail::vdbPointCacheBytes(frame, metadata(), options, VdbEncoder::Parallel);
+        writeVdbPointCache(frame, metadata(), file, options);
+      });
+      EXPECT_EQ(parallel.size(), serial.size());
+      EXPECT_TRUE(parallel == serial)
+          << "the encoders differ first at byte " << firstDifference(parallel, serial) << " of "
+          << serial.size();
+      const std::string written = fileBytes(file);
+      EXPECT_TRUE(written == serial)
+          << "the file differs first at byte " << firstDifference(written, serial);
+      if (threads == kThreads[0]) expectReadsBack(file, frame, options);
+    }
+  }
+
+  static void expectReadsBack(const fs::path& file, const FrameData& frame,
+                              const VdbCacheOptions& options) {
+    const FrameData back = readVdbPointCache(file);
+    ASSERT_EQ(back.size(), frame.size());
+    EXPECT_EQ(back.id, frame.id);
+    EXPECT_EQ(back.frame, frame.frame);
+    EXPECT_EQ(back.attributeNames, frame.attributeNames);
+    const bool fixed16 = options.positions == VdbCacheOptions::Positions::Fixed16;
+    std::size_t wrong = 0;
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(frame.size()); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        const float want = frame.position[c][i], got = back.position[c][i];
+        wrong += fixed16 ? !(std::abs(got - want) <= 2e-5f * (1.0f + std::abs(want)))
+                         : bits(got) != bits(want);
+        wrong += bits(back.velocity[c][i]) != bits(frame.velocity[c][i]);
+      }
+      wrong += bits(back.age[i]) != bits(frame.age[i]);
+      wrong += bits(back.life[i]) != bits(frame.life[i]);
+      wrong += bits(back.mass[i]) != bits(frame.mass[i]);
+      for (std::size_t a = 0; a < frame.attributes.size(); ++a)
+        wrong += bits(back.attributes[a][i]) != bits(frame.attributes[a][i]);
+    }
+    EXPECT_EQ(wrong, 0u) << "values that did not read back";
+    const vdbt::PointsGridRead grid = vdbt::readPointsGrid(file, "points");
+    EXPECT_EQ(grid.pointCount, frame.size());
+    EXPECT_EQ(grid.points.size(), frame.size());
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ioVdbWriter, DefaultOptionsGiveOpenVdbsBytes) {
+  expectSameBytesAsOpenVdb(frameOf(20000, 40.0f), kDefault);
+}
+
+TEST_F(ioVdbWriter, Fixed16PositionsGiveOpenVdbsBytes) {
+  expectSameBytesAsOpenVdb(frameOf(20000, 40.0f), kFixed16);
+}
+
+TEST_F(ioVdbWriter, BloscGivesOpenVdbsBytes) {
+  expectSameBytesAsOpenVdb(frameOf(20000, 40.0f), kBlosc);
+}
+
+TEST_F(ioVdbWriter, Fixed16WithBloscGivesOpenVdbsBytes) {
+  expectSameBytesAsOpenVdb(frameOf(20000, 40.0f), kFixed16Blosc);
+}
+
+// No leaf: OpenVDB's pass count 0, nothing else (written by OpenVDB alone, see encodePointsFile).
+TEST_F(ioVdbWriter, AnEmptyFrameGivesOpenVdbsBytes) {
+  for (const VdbCacheOptions& options : {kDefault, kFixed16Blosc}) {
+    const FrameData empty = frameOf(0, 1.0f);
+    expectSameBytesAsOpenVdb(empty, options);
+  }
+}
+
+// One leaf of one point: the descriptor and the page of every attribute in one piece each.
+TEST_F(ioVdbWriter, OnePointGivesOpenVdbsBytes) {
+  for (const VdbCacheOptions& options : {kDefault, kFixed16, kBlosc, kFixed16Blosc})
+    expectSameBytesAsOpenVdb(test::onePointFrame(), options);
+}
+
+// Every kind of custom attribute (float, int, vec3) after the standard ones.
+TEST_F(ioVdbWriter, CustomAttributesGiveOpenVdbsBytes) {
+  const FrameData frame = frameOf(30000, 30.0f, {"heat", "hitnum", "Cd_r", "Cd_g", "Cd_b", "w"});
+  for (const VdbCacheOptions& options : {kDefault, kBlosc})
+    expectSameBytesAsOpenVdb(frame, options);
+}
+
+// 10⁶ points over a 100 m box (about 2700 leaves, hundreds of leaf ranges): with blosc every
+// attribute takes several 1 MiB pages, each gathering the arrays of many leaves.
+TEST_F(ioVdbWriter, AMillionPointsGiveOpenVdbsBytes) {
+  const FrameData frame = frameOf(1000000, 50.0f);
+  for (const VdbCacheOptions& options : {kDefault, kBlosc})
+    expectSameBytesAsOpenVdb(frame, options);
+}
+
+// 2·10⁵ of 2.2·10⁵ points in one 8 m leaf, the others over an 80 m box: that leaf's P, v and id
+// arrays are larger than a page (pages of their own, closing the page before them), its float
+// arrays fill most of one, in both position encodings.
+TEST_F(ioVdbWriter, ArraysLargerThanAPageGiveOpenVdbsBytes) {
+  FrameData frame = frameOf(220000, 40.0f);
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(frame.size()); ++i) {
+    if (i % 11 == 0) continue;
+    for (int c = 0; c < 3; ++c) frame.position[c][i] = 4.0f + frame.position[c][i] * (3.4f / 40.0f);
+  }
+  for (const VdbCacheOptions& options : {kBlosc, kFixed16Blosc})
+    expectSameBytesAsOpenVdb(frame, options);
+}
+
+}  // namespace
+}  // namespace tickfx::io
