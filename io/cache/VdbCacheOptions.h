@@ -15,8 +15,9 @@ struct VdbCacheOptions {
     /// Attribute arrays stored as they are in memory (the default).
     None,
     /// OpenVDB's blosc (LZ4, byte shuffle) on every attribute array: lossless, smaller files
-    /// (velocities and ages compress well, positions little), slower to write: OpenVDB 10
-    /// compresses each array on one thread, and twice (once to size it, once to write it).
+    /// (velocities and ages compress well, positions little), slower to write: every 1 MiB page
+    /// of every attribute is compressed (tickfx compresses the pages in parallel, once each, where
+    /// OpenVDB 10's own writer compresses each on one thread, twice: once to size it).
     /// OpenVDB's zip reaches only the voxel offsets of point data, not its attributes, so it is
     /// not offered.
     Blosc,

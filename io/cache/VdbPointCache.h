@@ -54,8 +54,9 @@ struct VdbCacheContents {
 /// Grid metadata (vdb_print -m lists it): tickfx_effect_hash (string), tickfx_seed (int64),
 /// tickfx_step_rate (int64, Hz), tickfx_integrator (string), tickfx_frame (int64),
 /// tickfx_time (double, seconds), tickfx_version (string), tickfx_point_count (int64).
-/// The grid is built leaf by leaf in parallel (TBB) and the file's bytes do not depend on the
-/// thread count. Throws WriteError naming the file when it cannot be written.
+/// The grid is built and encoded leaf by leaf in parallel (TBB; the bytes are those of OpenVDB's
+/// own serial writer) and the file's bytes do not depend on the thread count. Throws WriteError
+/// naming the file when it cannot be written.
 void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
                         const std::filesystem::path& path, const VdbCacheOptions& options = {},
                         Durability durability = Durability::Renamed);
