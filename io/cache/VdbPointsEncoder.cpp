@@ -348,8 +348,10 @@ struct Part {
 
 // Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel, and
 // returns true; or writes nothing and returns false when the tree is not splittable() (or has no
-// leaf: two bytes that OpenVDB writes as fast).
+// leaf: two bytes that OpenVDB writes as fast) or `os` does not write into a MemorySink.
 bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::ostream& os) {
+  auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
+  if (sink == nullptr) return false;
   std::vector<const Leaf*> leaves;
   leaves.reserve(tree.leafCount());
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
@@ -411,18 +413,6 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
 
   const auto passes = static_cast<std::uint16_t>(leaves.front()->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
-  auto* sink = dynamic_cast<MemorySink*>(os.rdbuf());
-  if (sink == nullptr) {  // another stream: in order, on this thread
-    for (const Part& part : parts) {
-      if (part.data != nullptr) {
-        os.write(part.data, static_cast<std::streamsize>(part.size));
-      } else {
-        for (std::size_t l = part.begin; l < part.end; ++l)
-          leaves[l]->attributeSet().getConst(part.attribute)->writeBuffers(os, false);
-      }
-    }
-    return true;
-  }
   // Each part's place, summed in advance, then every part written there at once.
   std::vector<std::size_t> offsets(parts.size() + 1, 0);
   for (std::size_t p = 0; p < parts.size(); ++p) offsets[p + 1] = offsets[p] + parts[p].size;
