@@ -347,11 +347,18 @@ std::size_t ParticlePool::rowsThatMayExpire(std::int64_t tick, double secondsPer
   }
   if (floorRows_ < size_) {
     // The rows appended since the last tick (or all, after a mutable access): a minimum, the same
-    // in any order of its terms.
-    const float* life = lifetime_.data();
-    float floor = lifetimeFloor_;
-    for (std::size_t i = floorRows_; i < size_; ++i) floor = life[i] < floor ? life[i] : floor;
-    lifetimeFloor_ = floor;
+    // in any order of its terms (lifetimes are never NaN), so each block takes its own in
+    // parallel and the blocks' minima are taken after.
+    const float* life = lifetime_.data() + floorRows_;
+    const std::size_t rows = size_ - floorRows_;
+    std::vector<float> floors((rows + kParallelBlockRows - 1) / kParallelBlockRows);
+    parallelForRows(rows, [&](std::size_t b, std::size_t e) {
+      float floor = std::numeric_limits<float>::infinity();
+      for (std::size_t i = b; i < e; ++i) floor = life[i] < floor ? life[i] : floor;
+      floors[b / kParallelBlockRows] = floor;
+    });
+    for (const float floor : floors)
+      lifetimeFloor_ = floor < lifetimeFloor_ ? floor : lifetimeFloor_;
     floorRows_ = size_;
   }
   // Ages fall (weakly) from row to row: the rows whose age reached the floor are a prefix,
