@@ -152,7 +152,7 @@ class Writer {
 
   std::ostream* out_;
   std::uint64_t size_ = 0;
-  Fingerprinter checksum_;
+  PiecewiseFingerprinter checksum_;
 };
 
 // Only ever reached for a file whose checksum matched, i.e. one a writer of this version got
@@ -564,7 +564,7 @@ Parsed loadCheckpointFile(const std::filesystem::path& path) {
                    " bytes, found " + std::to_string(found) + ")");
   }
   const std::string_view covered(bytes.data(), found - kTrailerBytes);
-  if (fingerprint(covered) != loadU64(bytes.data() + found - kTrailerBytes)) {
+  if (piecewiseFingerprint(covered) != loadU64(bytes.data() + found - kTrailerBytes)) {
     fail(path, "checksum mismatch (the file is corrupted)");
   }
   Parsed parsed;

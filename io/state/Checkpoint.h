@@ -27,8 +27,10 @@ struct CheckpointInfo {
 
 /// The format version this build writes and the only one it reads. Version 3 no longer stores
 /// ages and inverse masses (worked out from birth ticks and masses) and narrows birth ticks to 32
-/// bits: a version 2 file is refused ("checkpoint format version 2 (this build reads 3)").
-inline constexpr std::uint32_t kCheckpointVersion = 3;
+/// bits; version 4 has the same layout with a checksum computed in parallel pieces
+/// (piecewiseFingerprint()). An earlier file is refused by its version ("checkpoint format
+/// version 3 (this build reads 4)").
+inline constexpr std::uint32_t kCheckpointVersion = 4;
 
 /// Writes the state of `system` (after its last completed tick) and `info` to `path`.
 ///
@@ -37,7 +39,7 @@ inline constexpr std::uint32_t kCheckpointVersion = 3;
 /// the old checkpoint or this one, whole). When writing fails, an existing `path` is left as it
 /// was and no temporary stays behind; throws io::WriteError "PATH: error: cannot write (REASON)".
 ///
-/// Layout, version 3, every integer little-endian, floats as their IEEE-754 bits:
+/// Layout, version 4, every integer little-endian, floats as their IEEE-754 bits:
 ///
 ///     header   "TICKFXCK"  u32 version  u32 flags  u64 file length  u64 effect hash
 ///     payload  i64 step rate (Hz)   str integrator   u64 max particles
@@ -62,7 +64,7 @@ inline constexpr std::uint32_t kCheckpointVersion = 3;
 ///              f32[e · k]: each event's inherited values
 ///              with flag 2 (one shard's state, particles/Shard.h; else nothing):
 ///              u32 shard index   u32 shard count
-///     trailer  u64 checksum: fingerprint() of every byte before it
+///     trailer  u64 checksum: piecewiseFingerprint() of every byte before it
 ///
 /// where str is a u32 byte count followed by that many UTF-8 bytes.
 void writeCheckpoint(const std::filesystem::path& path, const ParticleSystem& system,

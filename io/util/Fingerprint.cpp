@@ -5,6 +5,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "particles/ParallelFor.h"
+
 namespace tickfx::io {
 
 namespace {
@@ -57,6 +59,64 @@ std::uint64_t Fingerprinter::value() const {
   }
   // Without the length, inputs that differ only by trailing zero bytes would collide.
   return mix(h, count_);
+}
+
+namespace {
+
+// The pieces' fingerprints of whole pieces of `bytes` (and of a shorter last one when `last`).
+void fingerprintPieces(std::string_view bytes, bool last, std::vector<std::uint64_t>& out) {
+  const std::size_t whole = bytes.size() / kFingerprintPieceBytes;
+  const std::size_t count = whole + (last && bytes.size() % kFingerprintPieceBytes != 0 ? 1 : 0);
+  const std::size_t first = out.size();
+  out.resize(first + count);
+  parallelForTasks(count, [&](std::size_t i) {
+    out[first + i] = fingerprint(bytes.substr(i * kFingerprintPieceBytes, kFingerprintPieceBytes));
+  });
+}
+
+std::uint64_t combinePieces(std::uint64_t count, const std::vector<std::uint64_t>& pieces) {
+  Fingerprinter f;
+  char word[8];
+  const auto addWord = [&](std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) word[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    f.add(std::string_view(word, 8));
+  };
+  addWord(count);
+  for (const std::uint64_t piece : pieces) addWord(piece);
+  return f.value();
+}
+
+// Pieces fingerprinted at once by PiecewiseFingerprinter (64 MiB held at most).
+constexpr std::size_t kPiecesAtOnce = 64;
+
+}  // namespace
+
+std::uint64_t piecewiseFingerprint(std::string_view bytes) {
+  std::vector<std::uint64_t> pieces;
+  fingerprintPieces(bytes, /*last=*/true, pieces);
+  return combinePieces(bytes.size(), pieces);
+}
+
+void PiecewiseFingerprinter::add(std::string_view bytes) {
+  count_ += bytes.size();
+  while (!bytes.empty()) {
+    const std::size_t room = kPiecesAtOnce * kFingerprintPieceBytes - held_.size();
+    const std::size_t take = std::min(room, bytes.size());
+    held_.append(bytes.data(), take);
+    bytes.remove_prefix(take);
+    if (held_.size() == kPiecesAtOnce * kFingerprintPieceBytes) takeWholePieces();
+  }
+}
+
+void PiecewiseFingerprinter::takeWholePieces() {
+  fingerprintPieces(held_, /*last=*/false, pieces_);
+  held_.erase(0, held_.size() / kFingerprintPieceBytes * kFingerprintPieceBytes);
+}
+
+std::uint64_t PiecewiseFingerprinter::value() const {
+  std::vector<std::uint64_t> pieces = pieces_;
+  fingerprintPieces(held_, /*last=*/true, pieces);
+  return combinePieces(count_, pieces);
 }
 
 std::uint64_t effectFingerprint(std::string_view effectText,

@@ -33,6 +33,31 @@ class Fingerprinter {
   std::size_t pendingSize_ = 0;
 };
 
+/// Bytes a piece of piecewiseFingerprint() holds: 1 MiB.
+inline constexpr std::size_t kFingerprintPieceBytes = std::size_t{1} << 20;
+
+/// A 64-bit fingerprint of `bytes` whose work splits over threads: `bytes` cut into pieces of
+/// kFingerprintPieceBytes (the last one shorter, none for no bytes), each piece's fingerprint()
+/// taken in parallel, then the Fingerprinter of the byte count and the pieces' fingerprints in
+/// order, each as 8 little-endian bytes. Stable across versions and platforms (the checksum of
+/// checkpoint files since format 4), and the same on any thread count.
+std::uint64_t piecewiseFingerprint(std::string_view bytes);
+
+/// piecewiseFingerprint() of bytes given a piece at a time: add() them in order, then value() is
+/// piecewiseFingerprint() of them all joined. Bytes are held until 64 pieces are whole, which
+/// are then fingerprinted in parallel.
+class PiecewiseFingerprinter {
+ public:
+  void add(std::string_view bytes);
+  std::uint64_t value() const;
+
+ private:
+  void takeWholePieces();
+  std::string held_;                   // bytes not yet in a piece's fingerprint
+  std::vector<std::uint64_t> pieces_;  // fingerprints of the pieces so far
+  std::uint64_t count_ = 0;            // bytes added
+};
+
 /// The effect as a checkpoint, a VDB cache and a hash log know it: fingerprint() of the effect
 /// file's bytes and every override, in order, each after a zero byte. loadEffectFile() and
 /// parseEffect() give it for the text they parsed (LoadResult::fingerprint).

@@ -114,7 +114,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (bytes.size() >= kEffectHashOffset + 8 + kChecksumBytes) {
     storeU64(bytes, kEffectHashOffset, kEffectHash);
     const std::size_t covered = bytes.size() - kChecksumBytes;
-    storeU64(bytes, covered, tickfx::io::fingerprint(std::string_view(bytes).substr(0, covered)));
+    storeU64(bytes, covered,
+             tickfx::io::piecewiseFingerprint(std::string_view(bytes).substr(0, covered)));
   }
   const auto path = tickfx::fuzz::writeScratch(
       "state.ckpt", reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());

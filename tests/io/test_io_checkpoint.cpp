@@ -2,6 +2,8 @@
 // file that is truncated, corrupted or meant for another effect is refused without touching the
 // system it was to be read into.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -126,12 +128,25 @@ using test::loadU64;
 using test::storeU32;
 using test::storeU64;
 
+// The checksum of format 4 written out serially: fingerprint() of each 1 MiB piece, then the
+// fingerprint of the byte count and the pieces' fingerprints, each as 8 little-endian bytes.
+std::uint64_t referenceChecksum(std::string_view bytes) {
+  std::string words;
+  const auto word = [&](std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) words.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  };
+  word(bytes.size());
+  for (std::size_t at = 0; at < bytes.size(); at += std::size_t{1} << 20)
+    word(fingerprint(bytes.substr(at, std::size_t{1} << 20)));
+  return fingerprint(words);
+}
+
 // Makes an edited file self-consistent again (length and checksum), so that only the edit is
 // wrong with it.
 void reseal(std::string& bytes) {
   storeU64(bytes, 16, bytes.size());
   storeU64(bytes, bytes.size() - 8,
-           fingerprint(std::string_view(bytes).substr(0, bytes.size() - 8)));
+           referenceChecksum(std::string_view(bytes).substr(0, bytes.size() - 8)));
 }
 
 // Offset of the particle count: header, step rate, integrator name, then 68 bytes of scalars.
@@ -350,7 +365,7 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
                               + 8 + 8;             // no springs
   ASSERT_EQ(bytes.size(), 32 + payload + 8);
   EXPECT_EQ(bytes.substr(0, 8), "TICKFXCK");
-  EXPECT_EQ(bytes.substr(8, 8), std::string("\x03\0\0\0\0\0\0\0", 8));
+  EXPECT_EQ(bytes.substr(8, 8), std::string("\x04\0\0\0\0\0\0\0", 8));
   EXPECT_EQ(loadU64(bytes, 16), bytes.size());
   EXPECT_EQ(loadU64(bytes, 24), kEffect);
   EXPECT_EQ(loadU64(bytes, 32), 60u);
@@ -374,7 +389,7 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
   }
   EXPECT_EQ(loadU64(bytes, columns + 14 * 4 * n), pool.id()[0]);
   EXPECT_EQ(loadU64(bytes, bytes.size() - 8),
-            fingerprint(std::string_view(bytes).substr(0, bytes.size() - 8)));
+            referenceChecksum(std::string_view(bytes).substr(0, bytes.size() - 8)));
 }
 
 // ---- refusals -------------------------------------------------------------------------------
@@ -521,14 +536,14 @@ TEST_F(ioCheckpointRefusal, NotACheckpoint) {
 
 TEST_F(ioCheckpointRefusal, OtherFormatVersions) {
   // Version 1 lacks the driver's ticks due and the tick-start velocities; version 2 has age and
-  // inverse-mass columns and 64-bit birth ticks.
-  for (std::uint32_t version : {0u, 1u, 2u, 4u, 9u, 0xffffffffu}) {
+  // inverse-mass columns and 64-bit birth ticks; version 3 a serial checksum.
+  for (std::uint32_t version : {0u, 1u, 2u, 3u, 5u, 9u, 0xffffffffu}) {
     SCOPED_TRACE(version);
     std::string bad = bytes_;
     storeU32(bad, 8, version);
     reseal(bad);  // otherwise well-formed: the version alone is refused
     expectRefused(bad,
-                  "checkpoint format version " + std::to_string(version) + " (this build reads 3)");
+                  "checkpoint format version " + std::to_string(version) + " (this build reads 4)");
   }
 }
 
@@ -798,6 +813,41 @@ TEST(ioFingerprint, IsStable) {
   EXPECT_EQ(hashToHex(fingerprint("")), "0556470532b24426");
   EXPECT_EQ(hashToHex(fingerprint("tickfx")), "17ef229f63032e7f");
   EXPECT_EQ(hashToHex(fingerprint("[simulation]\nstep_rate = 60\n")), "78c5581e6d6768f3");
+}
+
+// The checkpoint checksum: its definition written out serially (referenceChecksum), on every
+// thread count, one shot or streamed in uneven parts, at the sizes around its pieces (1 MiB) and
+// past the 64 pieces the streaming form holds at once.
+TEST(ioFingerprint, PiecewiseIsItsDefinitionOnAnyThreadCountAndStreamed) {
+  const tbb::global_control workers(tbb::global_control::max_allowed_parallelism, 8);
+  std::string bytes((std::size_t{66} << 20) + 3, '\0');
+  std::uint64_t x = 0x9e3779b97f4a7c15ULL;
+  for (char& c : bytes) {
+    x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+    c = static_cast<char>(x);
+  }
+  constexpr std::size_t kMiB = std::size_t{1} << 20;
+  for (const std::size_t size :
+       {std::size_t{0}, std::size_t{1}, kMiB - 1, kMiB, kMiB + 1, 3 * kMiB + 5, bytes.size()}) {
+    SCOPED_TRACE(size);
+    const std::string_view view(bytes.data(), size);
+    const std::uint64_t expected = referenceChecksum(view);
+    for (const int threads : {1, 2, 3, 8}) {
+      tbb::task_arena arena(threads);
+      EXPECT_EQ(arena.execute([&] { return piecewiseFingerprint(view); }), expected) << threads;
+    }
+    PiecewiseFingerprinter streamed;
+    for (std::size_t at = 0, part = 1; at < size; at += part, part = part * 3 + 7)
+      streamed.add(view.substr(at, part));
+    EXPECT_EQ(streamed.value(), expected);
+  }
+  // One flipped bit in any piece changes it.
+  const std::uint64_t whole = piecewiseFingerprint(bytes);
+  for (const std::size_t at : {std::size_t{0}, kMiB - 1, kMiB, 65 * kMiB, bytes.size() - 1}) {
+    bytes[at] = static_cast<char>(bytes[at] ^ 4);
+    EXPECT_NE(piecewiseFingerprint(bytes), whole) << at;
+    bytes[at] = static_cast<char>(bytes[at] ^ 4);
+  }
 }
 
 // An effect's identity is the fingerprint of the very text parsed and its overrides, each after a
