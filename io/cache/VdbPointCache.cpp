@@ -73,9 +73,13 @@ std::string where(const std::string& path) { return vdbGridLabel(path, kGridName
 // Coord::round's rule, floor(x + 0.5), for a finite |x| < 2³⁰, and x's offset from that voxel,
 // in float alone (a float → double → float round trip is what g++ 12's vectoriser may fold
 // away): x − floor(x) is exact, and so is x − n for the nearest integer n.
+// The choice of n or n + 1 is made on the bits, not by a branch (on random positions it is a
+// coin toss the processor would guess wrong half the time) nor by adding 0 (−0.0 + 0 is +0.0).
 std::pair<openvdb::Int32, float> nearestVoxel(float x) {
-  float n = std::floor(x);
-  if (x - n >= 0.5f) n += 1.0f;
+  const float down = std::floor(x);
+  const std::uint32_t up = 0u - static_cast<std::uint32_t>(x - down >= 0.5f);
+  const float n = std::bit_cast<float>((std::bit_cast<std::uint32_t>(down + 1.0f) & up) |
+                                       (std::bit_cast<std::uint32_t>(down) & ~up));
   return {static_cast<openvdb::Int32>(n), x - n};
 }
 
