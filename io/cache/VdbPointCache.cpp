@@ -150,29 +150,36 @@ std::pair<openvdb::Int32, float> placeQuantised(float x) {
   return nearestVoxel(x);
 }
 
-// Each point's voxel offset within its leaf (0 to 511) and each row's offset in its voxel; the
-// points' slots in row order (sorted below).
-std::vector<PointSlot> slotsInRowOrder(const FrameData& frame, bool quantised,
-                                       std::vector<openvdb::Vec3f>& offset) {
+// The voxel of row r (and its offset in that voxel, when asked), placed as the positions' codec
+// places it.
+template <bool Quantised>
+openvdb::Coord voxelOf(const FrameData& frame, Eigen::Index r, openvdb::Vec3f* offset = nullptr) {
+  openvdb::Coord voxel;
+  for (int c = 0; c < 3; ++c) {
+    const float x = frame.position[c][r];
+    const auto [index, o] = Quantised ? placeQuantised(x) : place(x);
+    voxel[c] = index;
+    if (offset != nullptr) (*offset)[c] = o;
+  }
+  return voxel;
+}
+
+constexpr auto kLeafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
+
+// Each point's leaf and voxel offset within its leaf (0 to 511), in row order (sorted below).
+template <bool Quantised>
+std::vector<PointSlot> slotsInRowOrder(const FrameData& frame) {
   const std::size_t n = frame.size();
   std::vector<PointSlot> slots(n);
-  offset.resize(n);
-  const auto leafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                        openvdb::Coord voxel;
-                        for (int c = 0; c < 3; ++c) {
-                          const float x = frame.position[c][static_cast<Eigen::Index>(i)];
-                          const auto [index, o] = quantised ? placeQuantised(x) : place(x);
-                          voxel[c] = index;
-                          offset[i][c] = o;
-                        }
-                        slots[i] =
-                            PointSlot{voxel & leafMask,
-                                      static_cast<openvdb::Index32>(Leaf::coordToOffset(voxel)), i};
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+          const openvdb::Coord voxel = voxelOf<Quantised>(frame, static_cast<Eigen::Index>(i));
+          slots[i] = PointSlot{voxel & kLeafMask,
+                               static_cast<openvdb::Index32>(Leaf::coordToOffset(voxel)), i};
+        }
+      });
   return slots;
 }
 
@@ -247,12 +254,215 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
   return true;
 }
 
-// The points' slots in leaf, voxel and row order, and each row's offset in its voxel.
-std::vector<PointSlot> placePoints(const FrameData& frame, bool quantised,
-                                   std::vector<openvdb::Vec3f>& offset) {
-  std::vector<PointSlot> slots = slotsInRowOrder(frame, quantised, offset);
+// The points grouped by leaf, as the leaves will hold them but for the order within a leaf: the
+// leaves in Coord order, a leaf's points in row order within each of its voxels (makeLeaf orders
+// them by voxel, keeping that order). Each point's values are copied here in that order, so that
+// a leaf reads its points from one stretch of memory instead of from all over the frame.
+struct GroupedPoints {
+  std::vector<std::size_t> starts;  // each leaf's first point, and the end
+  std::vector<openvdb::Coord> origins;
+  std::unique_ptr<std::uint16_t[]> voxel;    // a point's voxel in its leaf (0 to 511)
+  std::unique_ptr<openvdb::Vec3f[]> offset;  // its position's offset in the voxel
+  std::unique_ptr<std::uint64_t[]> id;
+  // velocity x, y, z, age, life, mass, then the frame's attributes (pointFloatColumns' order)
+  std::vector<std::unique_ptr<float[]>> columns;
+
+  explicit GroupedPoints(std::size_t n, std::size_t floatColumnCount)
+      : voxel(std::make_unique_for_overwrite<std::uint16_t[]>(n)),
+        offset(std::make_unique_for_overwrite<openvdb::Vec3f[]>(n)),
+        id(std::make_unique_for_overwrite<std::uint64_t[]>(n)) {
+    for (std::size_t j = 0; j < floatColumnCount; ++j)
+      columns.push_back(std::make_unique_for_overwrite<float[]>(n));
+  }
+};
+
+constexpr std::size_t kStandardFloatColumns = 6;  // velocity x, y, z, age, life, mass
+
+std::vector<const float*> pointFloatColumns(const FrameData& frame) {
+  std::vector<const float*> columns = {frame.velocity[0].data(), frame.velocity[1].data(),
+                                       frame.velocity[2].data(), frame.age.data(),
+                                       frame.life.data(),        frame.mass.data()};
+  for (const FloatColumn& a : frame.attributes) columns.push_back(a.data());
+  return columns;
+}
+
+// The general way: every point's slot, sorted by (leaf, voxel, row).
+template <bool Quantised>
+GroupedPoints sortedPoints(const FrameData& frame) {
+  std::vector<PointSlot> slots = slotsInRowOrder<Quantised>(frame);
   if (!sortByKeys(slots)) tbb::parallel_sort(slots.begin(), slots.end());
-  return slots;
+  const std::vector<const float*> source = pointFloatColumns(frame);
+  GroupedPoints points(slots.size(), source.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        const std::size_t r = slots[k].row;
+                        points.voxel[k] = static_cast<std::uint16_t>(slots[k].voxel);
+                        voxelOf<Quantised>(frame, static_cast<Eigen::Index>(r), &points.offset[k]);
+                        points.id[k] = frame.id[r];
+                        for (std::size_t j = 0; j < source.size(); ++j)
+                          points.columns[j][k] = source[j][r];
+                      }
+                    });
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    if (k == 0 || slots[k].leaf != slots[k - 1].leaf) {
+      points.starts.push_back(k);
+      points.origins.push_back(slots[k].leaf);
+    }
+  }
+  points.starts.push_back(slots.size());
+  return points;
+}
+
+// Rows are bucketed in chunks of at least this many, at most kMaxChunks chunks.
+constexpr std::size_t kBucketChunk = 65536;
+constexpr std::size_t kMaxChunks = 64;
+
+// The fast way, when the leaves' bounding box holds few enough leaves to count them in a table
+// (any effect of sane size): a stable counting sort of the rows by the leaf's index in the box
+// (x, then y, then z: Coord's order), so rows ascend within each leaf. The chunks are fixed by
+// the point count alone (the order depends on neither them nor the threads). Nothing otherwise.
+template <bool Quantised>
+std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
+  const std::size_t n = frame.size();
+  if (n == 0 || n > std::numeric_limits<std::uint32_t>::max()) return std::nullopt;
+  // A box holding every point's leaf (a larger one would give the same order): the voxel of a
+  // finite coordinate within the bound rises with it, and any other is in voxel 0.
+  struct Range {
+    std::array<float, 3> low{}, high{};
+    bool placedAtZero = false;
+  };
+  Range init;
+  init.low.fill(std::numeric_limits<float>::infinity());
+  init.high.fill(-std::numeric_limits<float>::infinity());
+  const Range range = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kPlacementGrain), init,
+      [&](const tbb::blocked_range<std::size_t>& rows, Range r) {
+        for (int c = 0; c < 3; ++c) {
+          const float* x = frame.position[c].data();
+          float low = r.low[c], high = r.high[c];
+          bool outside = false;
+          for (std::size_t i = rows.begin(); i < rows.end(); ++i) {
+            const bool inside = std::abs(x[i]) < static_cast<float>(kLargestIndex);  // not NaN
+            low = std::min(low, inside ? x[i] : low);
+            high = std::max(high, inside ? x[i] : high);
+            outside |= !inside;
+          }
+          r.low[c] = low;
+          r.high[c] = high;
+          r.placedAtZero |= outside;
+        }
+        return r;
+      },
+      [](Range a, const Range& b) {  // min, max and or: the same answer in any grouping
+        for (std::size_t c = 0; c < 3; ++c) {
+          a.low[c] = std::min(a.low[c], b.low[c]);
+          a.high[c] = std::max(a.high[c], b.high[c]);
+        }
+        a.placedAtZero |= b.placedAtZero;
+        return a;
+      });
+  std::pair<openvdb::Coord, openvdb::Coord> box{openvdb::Coord::max(), openvdb::Coord::min()};
+  for (int c = 0; c < 3; ++c) {
+    const auto k = static_cast<std::size_t>(c);
+    if (range.low[k] <= range.high[k]) {
+      box.first[c] = std::min(box.first[c], nearestVoxel(range.low[k]).first & kLeafMask);
+      box.second[c] = std::max(box.second[c], nearestVoxel(range.high[k]).first & kLeafMask);
+    }
+    if (range.placedAtZero) {
+      box.first[c] = std::min(box.first[c], 0);
+      box.second[c] = std::max(box.second[c], 0);
+    }
+  }
+  const std::size_t chunks = std::clamp<std::size_t>(n / kBucketChunk, 1, kMaxChunks);
+  const std::size_t limit = 8 * n + (std::size_t{1} << 20);  // table entries, leaves × chunks
+  constexpr int kLeafLog2 = static_cast<int>(Leaf::LOG2DIM);
+  std::array<std::uint64_t, 3> extent{};
+  std::uint64_t leafCount = 1;
+  for (int c = 0; c < 3; ++c) {
+    const std::uint64_t e =
+        (static_cast<std::uint64_t>(static_cast<std::int64_t>(box.second[c]) - box.first[c]) >>
+         kLeafLog2) +
+        1;
+    extent[static_cast<std::size_t>(c)] = e;
+    if (e > limit || leafCount * e * chunks > limit) return std::nullopt;
+    leafCount *= e;
+  }
+  const std::size_t leaves = leafCount;
+  const auto leafIndex = [&](const openvdb::Coord& leaf) {
+    std::uint64_t index = 0;
+    for (int c = 0; c < 3; ++c) {
+      index = index * extent[static_cast<std::size_t>(c)] +
+              (static_cast<std::uint64_t>(static_cast<std::int64_t>(leaf[c]) - box.first[c]) >>
+               kLeafLog2);
+    }
+    return static_cast<std::uint32_t>(index);
+  };
+  const auto chunkRange = [&](std::size_t chunk) {
+    return std::pair{chunk * n / chunks, (chunk + 1) * n / chunks};
+  };
+  // Each row's leaf, and each chunk's count of rows a leaf.
+  std::vector<std::uint32_t> rowAt(n);
+  std::vector<std::uint32_t> table(leaves * chunks, 0);
+  std::vector<char> outsideBox(chunks, 0);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
+    std::uint32_t* count = table.data() + chunk * leaves;
+    const auto [begin, end] = chunkRange(chunk);
+    for (std::size_t i = begin; i < end; ++i) {
+      const openvdb::Coord leaf =
+          voxelOf<Quantised>(frame, static_cast<Eigen::Index>(i)) & kLeafMask;
+      // (Never, as the box is made; but a wrong box must not write past the table.)
+      if (openvdb::Coord::lessThan(leaf, box.first) || openvdb::Coord::lessThan(box.second, leaf)) {
+        outsideBox[chunk] = 1;
+        return;
+      }
+      const std::uint32_t l = leafIndex(leaf);
+      rowAt[i] = l;
+      ++count[l];
+    }
+  });
+  if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
+  const std::vector<const float*> source = pointFloatColumns(frame);
+  GroupedPoints points(n, source.size());
+  // Where each chunk's rows of a leaf go: leaf by leaf, chunk by chunk.
+  std::uint32_t sum = 0;
+  for (std::size_t l = 0; l < leaves; ++l) {
+    const std::uint32_t first = sum;
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      std::uint32_t& entry = table[chunk * leaves + l];
+      const std::uint32_t count = entry;
+      entry = sum;
+      sum += count;
+    }
+    if (sum == first) continue;
+    points.starts.push_back(first);
+    const std::uint64_t z = l % extent[2], y = (l / extent[2]) % extent[1],
+                        x = l / (extent[2] * extent[1]);
+    points.origins.push_back(box.first +
+                             openvdb::Coord(static_cast<openvdb::Int32>(x << kLeafLog2),
+                                            static_cast<openvdb::Int32>(y << kLeafLog2),
+                                            static_cast<openvdb::Int32>(z << kLeafLog2)));
+  }
+  points.starts.push_back(n);
+  // Each row's place (read in row order, written to one stretch a leaf), then its values, one
+  // column at a time.
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
+    std::uint32_t* next = table.data() + chunk * leaves;
+    const auto [begin, end] = chunkRange(chunk);
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t at = next[rowAt[i]]++;
+      rowAt[i] = at;
+      points.voxel[at] = static_cast<std::uint16_t>(Leaf::coordToOffset(
+          voxelOf<Quantised>(frame, static_cast<Eigen::Index>(i), &points.offset[at])));
+    }
+    for (std::size_t i = begin; i < end; ++i) points.id[rowAt[i]] = frame.id[i];
+    for (std::size_t j = 0; j < source.size(); ++j) {
+      float* to = points.columns[j].get();
+      const float* from = source[j];
+      for (std::size_t i = begin; i < end; ++i) to[rowAt[i]] = from[i];
+    }
+  });
+  return points;
 }
 
 // The array at `pos` of `leaf` as its own type, expanded to one value a point (each is then
@@ -264,88 +474,96 @@ Array& expandedArray(Leaf& leaf, std::size_t pos) {
   return array;
 }
 
-// One leaf holding slots [begin, end), every attribute filled.
+// Leaf l of `points`, every attribute filled. The leaf orders its points by voxel, keeping their
+// order within a voxel.
 template <typename PositionArray>
-std::unique_ptr<Leaf> makeLeaf(const FrameData& frame, const std::vector<PointSlot>& slots,
-                               std::size_t begin, std::size_t end,
-                               const std::vector<openvdb::Vec3f>& offset,
+std::unique_ptr<Leaf> makeLeaf(const GroupedPoints& points, std::size_t l,
+                               const std::vector<AttributeGroup>& groups,
                                const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
-  auto leaf = std::make_unique<Leaf>(slots[begin].leaf);
+  const std::size_t begin = points.starts[l];
+  const auto count = static_cast<openvdb::Index>(points.starts[l + 1] - begin);
+  auto leaf = std::make_unique<Leaf>(points.origins[l]);
+  std::array<openvdb::Index32, Leaf::SIZE> counts{};
+  for (openvdb::Index k = 0; k < count; ++k) ++counts[points.voxel[begin + k]];
   // Each voxel's value is the end of its points in the leaf's arrays.
-  std::vector<openvdb::Index32> counts(Leaf::SIZE, 0);
-  for (std::size_t k = begin; k < end; ++k) ++counts[slots[k].voxel];
   std::vector<openvdb::PointDataIndex32> offsets(Leaf::SIZE);
   openvdb::Index32 sum = 0;
-  for (std::size_t v = 0; v < counts.size(); ++v) offsets[v] = sum += counts[v];
-  const auto count = static_cast<openvdb::Index>(end - begin);
+  for (std::size_t v = 0; v < Leaf::SIZE; ++v) {
+    const openvdb::Index32 c = counts[v];
+    counts[v] = sum;  // now where the voxel's points begin
+    offsets[v] = sum += c;
+  }
   // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
   leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, count),
                             /*allowMismatchingDescriptors=*/true);
   leaf->setOffsets(offsets);
 
-  // The leaf's rows, then one pass an attribute: each pass gathers from one or three columns,
-  // independent loads the processor can have in flight together.
-  std::vector<Eigen::Index> rows(count);
-  for (openvdb::Index k = 0; k < count; ++k)
-    rows[k] = static_cast<Eigen::Index>(slots[begin + k].row);
+  // Where each of the leaf's points comes from (positions set on the way), then one pass an
+  // attribute.
+  std::vector<std::size_t> from(count);
   auto& p = expandedArray<PositionArray>(*leaf, 0);
-  for (openvdb::Index k = 0; k < count; ++k)
-    p.setUnsafe(k, offset[static_cast<std::size_t>(rows[k])]);
-  auto& v = expandedArray<VectorArray>(*leaf, 1);
   for (openvdb::Index k = 0; k < count; ++k) {
-    const Eigen::Index r = rows[k];
-    v.setUnsafe(k,
-                openvdb::Vec3f(frame.velocity[0][r], frame.velocity[1][r], frame.velocity[2][r]));
+    const openvdb::Index32 at = counts[points.voxel[begin + k]]++;
+    from[at] = begin + k;
+    p.setUnsafe(at, points.offset[begin + k]);
   }
+  const auto vectors = [&](std::size_t pos, std::size_t column) {
+    auto& a = expandedArray<VectorArray>(*leaf, pos);
+    const float* x = points.columns[column].get();
+    const float* y = points.columns[column + 1].get();
+    const float* z = points.columns[column + 2].get();
+    for (openvdb::Index k = 0; k < count; ++k) {
+      const std::size_t i = from[k];
+      a.setUnsafe(k, openvdb::Vec3f(x[i], y[i], z[i]));
+    }
+  };
+  vectors(1, 0);
   auto& id = expandedArray<IdArray>(*leaf, 2);
   for (openvdb::Index k = 0; k < count; ++k)
-    id.setUnsafe(k, static_cast<std::int64_t>(frame.id[static_cast<std::size_t>(rows[k])]));
-  const auto floats = [&](std::size_t pos, const FloatColumn& column) {
+    id.setUnsafe(k, static_cast<std::int64_t>(points.id[from[k]]));
+  const auto floats = [&](std::size_t pos, std::size_t column) {
     auto& a = expandedArray<FloatArray>(*leaf, pos);
-    for (openvdb::Index k = 0; k < count; ++k) a.setUnsafe(k, column[rows[k]]);
+    const float* c = points.columns[column].get();
+    for (openvdb::Index k = 0; k < count; ++k) a.setUnsafe(k, c[from[k]]);
   };
-  floats(3, frame.age);
-  floats(4, frame.life);
-  floats(5, frame.mass);
+  floats(3, 3);
+  floats(4, 4);
+  floats(5, 5);
   // The frame's columns as Houdini's typed attributes (hitnum an int32, hitpos a vec3s, ...).
   std::size_t pos = standardAttributes().size();
-  for (const AttributeGroup& g : attributeGroups(frame.attributeNames)) {
-    const FloatColumn* c = &frame.attributes[g.column];
+  for (const AttributeGroup& g : groups) {
+    const std::size_t column = kStandardFloatColumns + g.column;
     if (g.kind == AttributeKind::Float) {
-      floats(pos++, *c);
+      floats(pos++, column);
     } else if (g.kind == AttributeKind::Int) {
       auto& a = expandedArray<IntArray>(*leaf, pos++);
+      const float* c = points.columns[column].get();
       for (openvdb::Index k = 0; k < count; ++k)
-        a.setUnsafe(k, static_cast<std::int32_t>((*c)[rows[k]]));
+        a.setUnsafe(k, static_cast<std::int32_t>(c[from[k]]));
     } else {
-      auto& a = expandedArray<VectorArray>(*leaf, pos++);
-      for (openvdb::Index k = 0; k < count; ++k) {
-        const Eigen::Index r = rows[k];
-        a.setUnsafe(k, openvdb::Vec3f(c[0][r], c[1][r], c[2][r]));
-      }
+      vectors(pos++, column);
     }
   }
   return leaf;
 }
 
-template <typename PositionArray>
-vdbp::PointDataTree::Ptr makeTree(const FrameData& frame) {
-  std::vector<openvdb::Vec3f> offset;
-  const std::vector<PointSlot> slots =
-      placePoints(frame, !std::is_same_v<typename PositionArray::Codec, vdbp::NullCodec>, offset);
-  // Each leaf's first slot, and the end.
-  std::vector<std::size_t> starts;
-  for (std::size_t k = 0; k < slots.size(); ++k) {
-    if (k == 0 || slots[k].leaf != slots[k - 1].leaf) starts.push_back(k);
-  }
-  starts.push_back(slots.size());
+// Which way the points are grouped: only tests ask for the general way.
+enum class Grouping { Any, Sorted };
 
+template <typename PositionArray>
+vdbp::PointDataTree::Ptr makeTree(const FrameData& frame, Grouping grouping) {
+  constexpr bool kQuantised = !std::is_same_v<typename PositionArray::Codec, vdbp::NullCodec>;
+  std::optional<GroupedPoints> bucketed;
+  if (grouping == Grouping::Any) bucketed = bucketedPoints<kQuantised>(frame);
+  const GroupedPoints points = bucketed ? std::move(*bucketed) : sortedPoints<kQuantised>(frame);
+
+  const std::vector<AttributeGroup> groups = attributeGroups(frame.attributeNames);
   auto descriptor = vdbp::AttributeSet::Descriptor::create(PositionArray::attributeType());
   descriptor = descriptor->duplicateAppend("v", VectorArray::attributeType());
   descriptor = descriptor->duplicateAppend("id", IdArray::attributeType());
   for (const char* name : {"age", "life", "mass"})
     descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
-  for (const AttributeGroup& g : attributeGroups(frame.attributeNames)) {
+  for (const AttributeGroup& g : groups) {
     descriptor = descriptor->duplicateAppend(
         g.name, g.kind == AttributeKind::Int    ? IntArray::attributeType()
                 : g.kind == AttributeKind::Vec3 ? VectorArray::attributeType()
@@ -354,13 +572,11 @@ vdbp::PointDataTree::Ptr makeTree(const FrameData& frame) {
 
   // Leaves are independent: filled in parallel (as OpenVDB's point conversion does), then
   // handed to the tree in order.
-  std::vector<std::unique_ptr<Leaf>> leaves(starts.size() - 1);
+  std::vector<std::unique_ptr<Leaf>> leaves(points.origins.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t l = range.begin(); l < range.end(); ++l) {
-                        leaves[l] = makeLeaf<PositionArray>(frame, slots, starts[l], starts[l + 1],
-                                                            offset, descriptor);
-                      }
+                      for (std::size_t l = range.begin(); l < range.end(); ++l)
+                        leaves[l] = makeLeaf<PositionArray>(points, l, groups, descriptor);
                     });
   auto tree = std::make_shared<vdbp::PointDataTree>();
   for (std::unique_ptr<Leaf>& leaf : leaves) tree->addLeaf(leaf.release());
@@ -368,12 +584,13 @@ vdbp::PointDataTree::Ptr makeTree(const FrameData& frame) {
 }
 
 openvdb::points::PointDataGrid::Ptr makeGrid(const FrameData& frame, const VdbCacheMetadata& meta,
-                                             const VdbCacheOptions& options) {
+                                             const VdbCacheOptions& options,
+                                             Grouping grouping = Grouping::Any) {
   checkColumns(frame);
   const std::size_t n = frame.size();
   const vdbp::PointDataTree::Ptr tree = options.positions == VdbCacheOptions::Positions::Fixed16
-                                            ? makeTree<QuantisedPositionArray>(frame)
-                                            : makeTree<PositionArray>(frame);
+                                            ? makeTree<QuantisedPositionArray>(frame, grouping)
+                                            : makeTree<PositionArray>(frame, grouping);
   auto grid = vdbp::PointDataGrid::create(tree);
   grid->setName(kGridName);
   grid->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
@@ -489,9 +706,11 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
 namespace detail {
 
 std::string vdbPointCacheBytes(const FrameData& frame, const VdbCacheMetadata& meta,
-                               const VdbCacheOptions& options, VdbEncoder encoder) {
+                               const VdbCacheOptions& options, VdbEncoder encoder,
+                               VdbGrouping grouping) {
   openvdb::initialize();
-  const vdbp::PointDataGrid::Ptr grid = makeGrid(frame, meta, options);
+  const vdbp::PointDataGrid::Ptr grid = makeGrid(
+      frame, meta, options, grouping == VdbGrouping::Sorted ? Grouping::Sorted : Grouping::Any);
   std::string bytes;
   if (encoder == VdbEncoder::Parallel) {
     const FileBytes encoded = encodePointsFile(*grid, compressionFlags(options));

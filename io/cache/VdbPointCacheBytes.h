@@ -19,9 +19,20 @@ enum class VdbEncoder {
   Serial,
 };
 
+/// How the grid's points are grouped into leaves and voxels.
+enum class VdbGrouping {
+  /// A counting sort by leaf where the leaves' bounding box is small enough to count them in a
+  /// table, the sort below otherwise; what writeVdbPointCache does.
+  Fastest,
+  /// Every point's (leaf, voxel, row) sorted: the general way, how tickfx grouped them before.
+  Sorted,
+};
+
 /// The bytes writeVdbPointCache(frame, meta, path, options) puts in its file when its grid is
-/// encoded by `encoder` (the UUID stamped as it stamps it). Both encoders give the same bytes.
+/// built by `grouping` and encoded by `encoder` (the UUID stamped as it stamps it). Every
+/// grouping and encoder gives the same bytes.
 std::string vdbPointCacheBytes(const FrameData& frame, const VdbCacheMetadata& meta,
-                               const VdbCacheOptions& options, VdbEncoder encoder);
+                               const VdbCacheOptions& options, VdbEncoder encoder,
+                               VdbGrouping grouping = VdbGrouping::Fastest);
 
 }  // namespace tickfx::io::detail

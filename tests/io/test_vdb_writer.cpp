@@ -30,6 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 namespace vdbt = tickfx::vdb_test;
 using detail::VdbEncoder;
+using detail::VdbGrouping;
 
 constexpr VdbCacheOptions kDefault{};
 constexpr VdbCacheOptions kFixed16{VdbCacheOptions::Compression::None,
@@ -224,6 +225,96 @@ TEST_F(ioVdbWriter, ArraysLargerThanAPageGiveOpenVdbsBytes) {
   }
   for (const VdbCacheOptions& options : {kBlosc, kFixed16Blosc})
     expectSameBytesAsOpenVdb(frame, options);
+}
+
+// The counting sort by leaf that writeVdbPointCache groups points with, against the sort of
+// every point's (leaf, voxel, row) it replaced: the same leaves in the same order, the same
+// points in each voxel in the same order, so the same bytes.
+void expectGroupingsAgree(const FrameData& frame) {
+  const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism, 3);
+  for (const VdbCacheOptions& options : {kDefault, kFixed16}) {
+    SCOPED_TRACE(vdbPositionsName(options.positions));
+    const std::string sorted = detail::vdbPointCacheBytes(
+        frame, metadata(), options, VdbEncoder::Parallel, VdbGrouping::Sorted);
+    for (const int threads : {1, 2, 3}) {
+      SCOPED_TRACE(std::to_string(threads) + " threads");
+      tbb::task_arena arena(threads);
+      std::string fastest;
+      arena.execute([&] {
+        fastest = detail::vdbPointCacheBytes(frame, metadata(), options, VdbEncoder::Parallel,
+                                             VdbGrouping::Fastest);
+      });
+      EXPECT_EQ(fastest.size(), sorted.size());
+      EXPECT_TRUE(fastest == sorted)
+          << "the groupings differ first at byte " << firstDifference(fastest, sorted);
+    }
+  }
+}
+
+// Several chunks of rows (the counting sort's unit), custom attributes of every kind.
+TEST(ioVdbGrouping, ManyChunksGroupAsTheSortDid) {
+  expectGroupingsAgree(frameOf(300000, 30.0f, {"heat", "hitnum", "Cd_r", "Cd_g", "Cd_b"}));
+}
+
+// Points crowded into few voxels (rows interleaved between them), ties at half a voxel either
+// side of 0, −0.0, NaN, infinities and coordinates at and beyond ±2³⁰ (all placed in voxel 0),
+// the largest floats below 0.5 and 2³⁰: every way a point's voxel is chosen.
+TEST(ioVdbGrouping, AwkwardCoordinatesGroupAsTheSortDid) {
+  FrameData frame = frameOf(200000, 20.0f);
+  const float special[] = {0.5f,
+                           -0.5f,
+                           1.5f,
+                           -1.5f,
+                           -0.0f,
+                           0.0f,
+                           std::nextafter(0.5f, 0.0f),
+                           -std::nextafter(0.5f, 0.0f),
+                           std::numeric_limits<float>::quiet_NaN(),
+                           std::numeric_limits<float>::infinity(),
+                           -std::numeric_limits<float>::infinity(),
+                           1073741824.0f,
+                           -1073741824.0f,
+                           std::nextafter(1073741824.0f, 0.0f),
+                           3.5f,
+                           -7.5f,
+                           8.0f,
+                           -8.0f};
+  constexpr std::size_t kSpecial = std::size(special);
+  for (std::size_t k = 0; k < frame.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (k % 3 == 0) {  // a third in the voxels around the origin
+      for (int c = 0; c < 3; ++c)
+        frame.position[c][i] = std::round(frame.position[c][i] / 8.0f) * 0.5f;
+    } else if (k % 7 == 1) {
+      for (int c = 0; c < 3; ++c) {
+        frame.position[c][i] = special[(k / 7 + 5 * static_cast<std::size_t>(c)) % kSpecial];
+      }
+    }
+  }
+  expectGroupingsAgree(frame);
+  // The same without the far and non-finite ones: a box of leaves around the points alone.
+  for (std::size_t k = 0; k < frame.size(); ++k) {
+    for (int c = 0; c < 3; ++c) {
+      float& x = frame.position[c][static_cast<Eigen::Index>(k)];
+      if (!(std::abs(x) < 1e6f)) x = 0.25f;
+    }
+  }
+  expectGroupingsAgree(frame);
+}
+
+// Far from the origin (the box of leaves does not reach voxel 0), and spread so wide that the
+// leaves' box is too large to count in (the sort is used then; the bytes are the same anyway).
+TEST(ioVdbGrouping, FarAndWidelySpreadPointsGroupAsTheSortDid) {
+  FrameData frame = frameOf(50000, 40.0f);
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(frame.size()); ++i)
+    for (int c = 0; c < 3; ++c) frame.position[c][i] += c == 1 ? -100000.0f : 250000.0f;
+  expectGroupingsAgree(frame);
+  // (A few hundred such leaves: each far leaf costs OpenVDB a tree's nodes of its own.)
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(frame.size()); i += 200)
+    for (int c = 0; c < 3; ++c) frame.position[c][i] = -frame.position[c][i] * 1000.0f;
+  expectGroupingsAgree(frame);
+  expectGroupingsAgree(frameOf(0, 1.0f));
+  expectGroupingsAgree(test::onePointFrame());
 }
 
 }  // namespace
