@@ -375,7 +375,9 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     }
   }
   const std::size_t chunks = std::clamp<std::size_t>(n / kBucketChunk, 1, kMaxChunks);
-  const std::size_t limit = 8 * n + (std::size_t{1} << 20);  // table entries, leaves × chunks
+  // Table entries, leaves × chunks (leaf indices and the table's offsets fit 32 bits).
+  const std::uint64_t limit = std::min<std::uint64_t>(8 * std::uint64_t{n} + (1u << 20),
+                                                      std::numeric_limits<std::uint32_t>::max());
   constexpr int kLeafLog2 = static_cast<int>(Leaf::LOG2DIM);
   std::array<std::uint64_t, 3> extent{};
   std::uint64_t leafCount = 1;
@@ -385,7 +387,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
          kLeafLog2) +
         1;
     extent[static_cast<std::size_t>(c)] = e;
-    if (e > limit || leafCount * e * chunks > limit) return std::nullopt;
+    if (e > limit / (leafCount * chunks)) return std::nullopt;  // (no product overflows)
     leafCount *= e;
   }
   const std::size_t leaves = leafCount;
