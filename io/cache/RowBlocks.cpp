@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <memory>
 
+#include "io/util/ProfiledTbb.h"
+
 namespace tickfx::io {
 namespace {
 
@@ -49,7 +51,7 @@ void writeRowsInBlocks(std::ostream& out, std::size_t rows, std::size_t rowsPerB
   const auto put = [&](const BlockPtr& block) {
     if (out) out.write(block->bytes.get(), static_cast<std::streamsize>(block->size));
   };
-  tbb::parallel_pipeline(
+  par::parallel_pipeline(
       tokens, tbb::make_filter<void, BlockPtr>(tbb::filter_mode::serial_in_order, take) &
                   tbb::make_filter<BlockPtr, BlockPtr>(tbb::filter_mode::parallel, make) &
                   tbb::make_filter<BlockPtr, void>(tbb::filter_mode::serial_in_order, put));

@@ -33,6 +33,7 @@
 #include "io/cache/VdbPointsEncoder.h"
 #include "io/util/AtomicFile.h"
 #include "io/util/Fingerprint.h"
+#include "io/util/ProfiledTbb.h"
 
 namespace tickfx::io {
 namespace {
@@ -171,7 +172,7 @@ template <bool Quantised>
 std::vector<PointSlot> slotsInRowOrder(const FrameData& frame) {
   const std::size_t n = frame.size();
   std::vector<PointSlot> slots(n);
-  tbb::parallel_for(
+  par::parallel_for(
       tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
       [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
@@ -191,7 +192,7 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
   const std::size_t n = slots.size();
   if (n == 0) return true;
   using Box = std::pair<openvdb::Coord, openvdb::Coord>;
-  const auto leafBox = tbb::parallel_reduce(
+  const auto leafBox = par::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
       Box{openvdb::Coord::max(), openvdb::Coord::min()},
       [&](const tbb::blocked_range<std::size_t>& range, Box box) {
@@ -231,7 +232,7 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
     return index;
   };
   std::vector<std::uint64_t> keys(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i < range.end(); ++i) {
                         const PointSlot& s = slots[i];
@@ -239,12 +240,12 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
                                   (std::uint64_t{s.voxel} << rowBits) | s.row;
                       }
                     });
-  tbb::parallel_sort(keys.begin(), keys.end());
+  par::parallel_sort(keys.begin(), keys.end());
   // Rebuilt from the keys, in their order: the row names the point, whose leaf and voxel are
   // those of its unsorted slot.
   std::vector<PointSlot> sorted(n);
   const std::uint64_t rowMask = (std::uint64_t{1} << rowBits) - 1;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t k = range.begin(); k < range.end(); ++k) {
                         sorted[k] = slots[static_cast<std::size_t>(keys[k] & rowMask)];
@@ -290,10 +291,10 @@ std::vector<const float*> pointFloatColumns(const FrameData& frame) {
 template <bool Quantised>
 GroupedPoints sortedPoints(const FrameData& frame) {
   std::vector<PointSlot> slots = slotsInRowOrder<Quantised>(frame);
-  if (!sortByKeys(slots)) tbb::parallel_sort(slots.begin(), slots.end());
+  if (!sortByKeys(slots)) par::parallel_sort(slots.begin(), slots.end());
   const std::vector<const float*> source = pointFloatColumns(frame);
   GroupedPoints points(slots.size(), source.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t k = range.begin(); k < range.end(); ++k) {
                         const std::size_t r = slots[k].row;
@@ -335,7 +336,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   Range init;
   init.low.fill(std::numeric_limits<float>::infinity());
   init.high.fill(-std::numeric_limits<float>::infinity());
-  const Range range = tbb::parallel_reduce(
+  const Range range = par::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, kPlacementGrain), init,
       [&](const tbb::blocked_range<std::size_t>& rows, Range r) {
         for (int c = 0; c < 3; ++c) {
@@ -407,7 +408,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   std::vector<std::uint32_t> rowAt(n);
   std::vector<std::uint32_t> table(leaves * chunks, 0);
   std::vector<char> outsideBox(chunks, 0);
-  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
+  par::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
     std::uint32_t* count = table.data() + chunk * leaves;
     const auto [begin, end] = chunkRange(chunk);
     for (std::size_t i = begin; i < end; ++i) {
@@ -448,7 +449,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   points.starts.push_back(n);
   // Each row's place (read in row order, written to one stretch a leaf), then its values, one
   // column at a time.
-  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
+  par::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
     std::uint32_t* next = table.data() + chunk * leaves;
     const auto [begin, end] = chunkRange(chunk);
     for (std::size_t i = begin; i < end; ++i) {
@@ -575,7 +576,7 @@ vdbp::PointDataTree::Ptr makeTree(const FrameData& frame, Grouping grouping) {
   // Leaves are independent: filled in parallel (as OpenVDB's point conversion does), then
   // handed to the tree in order.
   std::vector<std::unique_ptr<Leaf>> leaves(points.origins.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t l = range.begin(); l < range.end(); ++l)
                         leaves[l] = makeLeaf<PositionArray>(points, l, groups, descriptor);

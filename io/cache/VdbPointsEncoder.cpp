@@ -26,6 +26,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/util/ProfiledTbb.h"
+
 namespace tickfx::io {
 
 void FileBytes::Free::operator()(char* p) const { std::free(p); }
@@ -371,7 +373,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
     for (Page& page : attributePages) allPages.push_back(&page);
 
   // Leaf ranges then pages, one task each, one loop so that neither waits for the other.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ranges + allPages.size(), 1),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, ranges + allPages.size(), 1),
                     [&](const tbb::blocked_range<std::size_t>& tasks) {
                       for (std::size_t t = tasks.begin(); t < tasks.end(); ++t) {
                         if (t < ranges) {
@@ -417,7 +419,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
   std::vector<std::size_t> offsets(parts.size() + 1, 0);
   for (std::size_t p = 0; p < parts.size(); ++p) offsets[p + 1] = offsets[p] + parts[p].size;
   char* const to = sink->append(offsets.back());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, parts.size(), 1),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, parts.size(), 1),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t p = r.begin(); p < r.end(); ++p) {
                         const Part& part = parts[p];
