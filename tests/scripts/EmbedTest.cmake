@@ -57,7 +57,7 @@ foreach(header ${installed})
 endforeach()
 file(WRITE ${headers_dir}/CMakeLists.txt "cmake_minimum_required(VERSION 3.22)
 project(tickfx_headers LANGUAGES CXX)
-find_package(tickfx 0.2 CONFIG REQUIRED COMPONENTS effects vdb)
+find_package(tickfx 0.3 CONFIG REQUIRED COMPONENTS effects vdb)
 add_library(headers OBJECT ${sources})
 target_link_libraries(headers PRIVATE tickfx::effects)
 ")
@@ -68,7 +68,7 @@ run(${CMAKE_COMMAND} --build ${headers_dir}/build)
 # A component the package does not have is refused by name.
 file(WRITE ${WORK_DIR}/nocomponent/CMakeLists.txt "cmake_minimum_required(VERSION 3.22)
 project(nocomponent LANGUAGES CXX)
-find_package(tickfx 0.2 CONFIG REQUIRED COMPONENTS usd)
+find_package(tickfx 0.3 CONFIG REQUIRED COMPONENTS usd)
 ")
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${WORK_DIR}/nocomponent -B ${WORK_DIR}/nocomponent/build
                 -G ${GENERATOR} -DCMAKE_PREFIX_PATH=${prefix}
