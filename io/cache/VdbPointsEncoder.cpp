@@ -453,7 +453,8 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
 class PointsArchive final : public openvdb::io::Archive {
  public:
   explicit PointsArchive(std::uint32_t compression) { setCompression(compression); }
-  void write(std::ostream& os, const openvdb::GridCPtrVec& grids) const {
+  // Not named write(): that would hide Archive's virtual write(grids, metadata).
+  void writeSeekable(std::ostream& os, const openvdb::GridCPtrVec& grids) const {
     Archive::write(os, grids, /*seekable=*/true);
   }
 };
@@ -465,7 +466,7 @@ FileBytes encodePointsFile(vdbp::PointDataGrid& grid, std::uint32_t compression,
   const openvdb::GridCPtrVec grids{std::make_shared<const ParallelBuffersGrid>(grid)};
   MemorySink sink(expectedBytes);
   std::ostream os(&sink);
-  PointsArchive(compression).write(os, grids);
+  PointsArchive(compression).writeSeekable(os, grids);
   if (!os) throw std::runtime_error("cannot encode the VDB points grid");
   return std::move(sink).release();
 }
@@ -475,7 +476,7 @@ std::string encodePointsFileSerially(const vdbp::PointDataGrid::ConstPtr& grid,
   std::string room;
   room.reserve(expectedBytes);
   std::ostringstream os(std::move(room), std::ios::binary);
-  PointsArchive(compression).write(os, openvdb::GridCPtrVec{grid});
+  PointsArchive(compression).writeSeekable(os, openvdb::GridCPtrVec{grid});
   if (!os) throw std::runtime_error("cannot encode the VDB points grid");
   return std::move(os).str();
 }
