@@ -1,7 +1,6 @@
 #include "particles/Emitter.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -15,7 +14,8 @@
 namespace tickfx {
 namespace {
 
-// Rows emit() draws at once (sampleBatch) before setting them: a few KiB on the stack.
+// Rows emit() writes (spawnRows) before finishing them (ParticlePool::finishRows), while they are
+// still in the cache.
 constexpr std::size_t kSpawnBatchRows = 256;
 
 // Two unit vectors completing `n` (unit) to a right-handed orthonormal basis, without a branch
@@ -213,11 +213,10 @@ std::uint64_t Emitter::emit(ParticlePool& pool, std::uint64_t seed, std::int64_t
   TICKFX_ASSERT(firstRow + tried == pool.size(), "an emitter's rows not at the pool's end");
   const SpawnRecipe recipe = spawnRecipe(seed);
   parallelForRows(static_cast<std::size_t>(tried), [&](std::size_t begin, std::size_t end) {
-    std::array<ParticleInit, kSpawnBatchRows> batch;
-    for (std::size_t k = begin; k < end; k += batch.size()) {
-      const std::size_t n = std::min(batch.size(), end - k);
-      spawnBatch(recipe, own + k * shard.count, shard.count, std::span(batch.data(), n));
-      for (std::size_t i = 0; i < n; ++i) pool.setRow(firstRow + k + i, batch[i]);
+    for (std::size_t k = begin; k < end; k += kSpawnBatchRows) {
+      const std::size_t n = std::min(kSpawnBatchRows, end - k);
+      spawnRows(recipe, own + k * shard.count, shard.count, n, pool.spawnTargets(firstRow + k));
+      pool.finishRows(firstRow + k, firstRow + k + n);
     }
   });
   pool.refuseSpawns(owned - tried);

@@ -50,6 +50,16 @@ struct ParticleInit {
   float mass = 1.0f;
 };
 
+/// Where spawned rows' values are written, column by column: pointers to one row of each column a
+/// spawn sets (ParticlePool::spawnTargets()); row k of the run is element k of each. Borrowed:
+/// valid while the pool's storage stays where it is.
+struct SpawnTargets {
+  float* position[3];
+  float* velocity[3];
+  float* lifetime;
+  float* mass;
+};
+
 /// The particle pool: one column per attribute, rows [0, size()) live, in the order of their ids.
 ///
 /// A tick reads and writes only what it needs: ages are not stored but worked out from the birth
@@ -111,6 +121,11 @@ class ParticlePool {
   /// velocity, lifetime and mass; acceleration (when kept) 0. Different rows may be set at once
   /// from different threads.
   void setRow(std::size_t row, const ParticleInit& init);
+  /// setRow() for runs of rows: the caller writes the position, velocity, lifetime and mass of
+  /// appended rows [row, row + k) through the pointers, then calls finishRows() on them, which
+  /// sets the rest as setRow() does. Different runs may be written at once from different threads.
+  SpawnTargets spawnTargets(std::size_t row);
+  void finishRows(std::size_t begin, std::size_t end);
   /// Counts `count` spawns refused without trying them (the caller saw the pool was full).
   void refuseSpawns(std::uint64_t count) { droppedSpawns_ += count; }
   /// Takes back the newest rows, [size, size()), and the ids they were given, so that ids from

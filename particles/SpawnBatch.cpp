@@ -2,11 +2,20 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <bit>
 #include <cmath>
 
+#include "particles/Assert.h"
 #include "particles/DetMath.h"
 #include "particles/DetMathBlock.h"
+#include "particles/DetMathKernels.h"
 #include "particles/Random.h"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define TICKFX_SPAWN_AVX2 1
+#include <immintrin.h>
+#endif
 
 namespace tickfx {
 namespace {
@@ -29,9 +38,20 @@ void drawKeys(std::uint64_t emitterKey, std::uint64_t first, std::uint64_t strid
   for (std::size_t i = 0; i < c.n; ++i) c.key[i] = particleKey(emitterKey, first + i * stride);
 }
 
+// uniformFromBits(bits), exactly, in operations every vector unit has: the 53-bit integer is
+// split into its high 21 and low 32 bits, each made a double by the exponent trick (exact), and
+// the two summed (exact: the sum has 53 bits). A cast from a 64-bit integer has no SSE2 or AVX2
+// vector form, so a loop of them stays scalar.
+double uniformOfBits(std::uint64_t bits) {
+  const std::uint64_t v = bits >> 11;
+  const double low = std::bit_cast<double>(0x4330000000000000ULL | (v & 0xffffffffULL)) - 0x1p52;
+  const double high = std::bit_cast<double>(0x4530000000000000ULL | (v >> 32)) - 0x1p84;
+  return (high + low) * 0x1p-53;
+}
+
 // out[k][i] = ParticleRandom::uniform(purposes[k]) of particle i, for every particle of the chunk.
-// The draws are 64-bit integer multiplies, which SSE2 lacks (emulated they are no faster): a
-// scalar loop, a few purposes in each to share the key's load and the loop's overhead.
+// The draws are 64-bit integer multiplies: scalar in the SSE2 build (emulated they are no faster
+// there), four lanes wide in the AVX2 path. A few purposes a loop share the key's load.
 template <std::size_t K>
 void drawUniforms(const Chunk& c, const std::array<RandomPurpose, K>& purposes,
                   const std::array<double*, K>& out) {
@@ -39,7 +59,7 @@ void drawUniforms(const Chunk& c, const std::array<RandomPurpose, K>& purposes,
   for (std::size_t k = 0; k < K; ++k) p[k] = static_cast<std::uint32_t>(purposes[k]);
   for (std::size_t i = 0; i < c.n; ++i) {
     const std::uint64_t key = c.key[i];
-    for (std::size_t k = 0; k < K; ++k) out[k][i] = uniformFromBits(purposeBits(key, p[k]));
+    for (std::size_t k = 0; k < K; ++k) out[k][i] = uniformOfBits(purposeBits(key, p[k]));
   }
 }
 
@@ -47,9 +67,36 @@ void drawUniform(const Chunk& c, RandomPurpose purpose, double* out) {
   drawUniforms<1>(c, {purpose}, {out});
 }
 
+// det::sincos() of 2π · turns for uniform `turns` in [0, 1): arguments below 2π, far inside the
+// range of the vectorised reduction (det::kernel::sincosSmall, |x| < 2^19), so none needs
+// det::sincosBlock()'s fallback. Inline, so that the AVX2 path vectorises it with its width.
 void sincosOfTurns(const double* turns, Chunk& c) {
+  static_assert(kTwoPi < det::kernel::kCodyWaiteLimit);
   for (std::size_t i = 0; i < c.n; ++i) c.w[i] = kTwoPi * turns[i];
-  det::sincosBlock(c.w, c.sine, c.cosine, c.n);
+  det::kernel::sincosSmall(c.w, c.sine, c.cosine, c.n);
+}
+
+#ifdef TICKFX_SPAWN_AVX2
+// det::sqrtClampedBlock() four lanes wide: the same max (0 for nan and −0) and IEEE square root.
+[[gnu::target("avx2")]] void sqrtClampedAvx2(double* x, std::size_t n) {
+  std::size_t i = 0;
+  const __m256d zero = _mm256_setzero_pd();
+  for (; i + 4 <= n; i += 4)
+    _mm256_storeu_pd(x + i, _mm256_sqrt_pd(_mm256_max_pd(_mm256_loadu_pd(x + i), zero)));
+  for (; i < n; ++i) x[i] = std::sqrt(std::max(0.0, x[i]));
+}
+#endif
+
+// x[i] = sqrt(max(0, x[i])), on the path's vector width.
+template <bool kAvx2>
+void sqrtClamped(double* x, std::size_t n) {
+#ifdef TICKFX_SPAWN_AVX2
+  if constexpr (kAvx2) {
+    sqrtClampedAvx2(x, n);
+    return;
+  }
+#endif
+  det::sqrtClampedBlock(x, n);
 }
 
 void boxOffsets(const SpawnRecipe& r, Chunk& c) {
@@ -61,6 +108,7 @@ void boxOffsets(const SpawnRecipe& r, Chunk& c) {
   }
 }
 
+template <bool kAvx2>
 void sphereOffsets(const SpawnRecipe& r, Chunk& c) {
   drawUniforms<2>(c, {RandomPurpose::PositionU, RandomPurpose::PositionV}, {c.u, c.v});
   sincosOfTurns(c.v, c);
@@ -69,14 +117,14 @@ void sphereOffsets(const SpawnRecipe& r, Chunk& c) {
     c.u[i] = 1.0 - 2.0 * c.u[i];
     c.v[i] = 1.0 - c.u[i] * c.u[i];
   }
-  det::sqrtClampedBlock(c.v, c.n);
+  sqrtClamped<kAvx2>(c.v, c.n);
   // c.w becomes the radius: the sphere's, or the cube root's share of it inside.
   if (r.surface) {
     std::fill_n(c.w, c.n, r.radius);
   } else {
     double uniform[kChunk];
     drawUniform(c, RandomPurpose::PositionW, uniform);
-    det::cbrtBlock(uniform, c.w, c.n);
+    det::kernel::cbrtBlock(uniform, c.w, c.n);  // inline: the AVX2 path vectorises it
     for (std::size_t i = 0; i < c.n; ++i) c.w[i] = r.radius * c.w[i];
   }
   for (std::size_t i = 0; i < c.n; ++i) {
@@ -86,9 +134,10 @@ void sphereOffsets(const SpawnRecipe& r, Chunk& c) {
   }
 }
 
+template <bool kAvx2>
 void discOffsets(const SpawnRecipe& r, Chunk& c) {
   drawUniforms<2>(c, {RandomPurpose::PositionU, RandomPurpose::PositionV}, {c.u, c.v});
-  det::sqrtClampedBlock(c.u, c.n);  // a uniform number is >= 0: the clamp changes nothing
+  sqrtClamped<kAvx2>(c.u, c.n);  // a uniform number is >= 0: the clamp changes nothing
   sincosOfTurns(c.v, c);
   for (std::size_t i = 0; i < c.n; ++i) {
     const double radius = r.radius * c.u[i];
@@ -98,16 +147,17 @@ void discOffsets(const SpawnRecipe& r, Chunk& c) {
   }
 }
 
+template <bool kAvx2>
 void shapeOffsets(const SpawnRecipe& r, Chunk& c) {
   switch (r.shape) {
     case SpawnRecipe::Shape::Sphere:
-      sphereOffsets(r, c);
+      sphereOffsets<kAvx2>(r, c);
       return;
     case SpawnRecipe::Shape::Box:
       boxOffsets(r, c);
       return;
     case SpawnRecipe::Shape::Disc:
-      discOffsets(r, c);
+      discOffsets<kAvx2>(r, c);
       return;
     case SpawnRecipe::Shape::Point:
     case SpawnRecipe::Shape::PointList:
@@ -117,6 +167,7 @@ void shapeOffsets(const SpawnRecipe& r, Chunk& c) {
 }
 
 // Uniform over the spherical cap of half-angle `spread` around the direction.
+template <bool kAvx2>
 void spreadDirections(const SpawnRecipe& r, Chunk& c) {
   drawUniforms<2>(c, {RandomPurpose::DirectionU, RandomPurpose::DirectionV}, {c.u, c.v});
   sincosOfTurns(c.v, c);
@@ -125,7 +176,7 @@ void spreadDirections(const SpawnRecipe& r, Chunk& c) {
     c.u[i] = 1.0 - c.u[i] * (1.0 - r.cosSpread);
     c.v[i] = 1.0 - c.u[i] * c.u[i];
   }
-  det::sqrtClampedBlock(c.v, c.n);
+  sqrtClamped<kAvx2>(c.v, c.n);
   for (std::size_t i = 0; i < c.n; ++i) {
     const double along1 = c.v[i] * c.cosine[i], along2 = c.v[i] * c.sine[i];
     for (int axis = 0; axis < 3; ++axis) {
@@ -149,11 +200,12 @@ void jittered(const Chunk& c, RandomPurpose purpose, double value, double jitter
 
 // The emitter's position plus the offset, rounded to float once; for a point list, its point.
 void writePositions(const SpawnRecipe& r, const Chunk& c, std::uint64_t first, std::uint64_t stride,
-                    ParticleInit* out) {
+                    const SpawnTargets& out) {
   if (r.shape != SpawnRecipe::Shape::PointList) {
-    for (std::size_t i = 0; i < c.n; ++i) {
-      for (int axis = 0; axis < 3; ++axis)
-        out[i].position[axis] = static_cast<float>(r.position[axis] + c.offset[axis][i]);
+    for (int axis = 0; axis < 3; ++axis) {
+      const double origin = r.position[axis];
+      float* __restrict to = out.position[axis];
+      for (std::size_t i = 0; i < c.n; ++i) to[i] = static_cast<float>(origin + c.offset[axis][i]);
     }
     return;
   }
@@ -170,50 +222,140 @@ void writePositions(const SpawnRecipe& r, const Chunk& c, std::uint64_t first, s
   for (std::size_t i = 0; i < c.n; ++i) {
     if (wraps) point = (first + i * stride) % count;
     const Eigen::Vector3f& p = r.points[static_cast<std::size_t>(point)];
-    out[i].position = atOrigin ? p : Eigen::Vector3f(origin + p);
-    if (!r.pointVelocities.empty())
-      out[i].velocity = r.pointVelocities[static_cast<std::size_t>(point)];
+    const Eigen::Vector3f at = atOrigin ? p : Eigen::Vector3f(origin + p);
+    for (int axis = 0; axis < 3; ++axis) out.position[axis][i] = at[axis];
+    if (!r.pointVelocities.empty()) {
+      const Eigen::Vector3f& v = r.pointVelocities[static_cast<std::size_t>(point)];
+      for (int axis = 0; axis < 3; ++axis) out.velocity[axis][i] = v[axis];
+    }
     point += step;
     if (point >= count) point -= count;
   }
 }
 
+template <bool kAvx2>
 void spawnChunk(const SpawnRecipe& r, std::uint64_t first, std::uint64_t stride, Chunk& c,
-                ParticleInit* out) {
+                const SpawnTargets& out) {
   drawKeys(r.emitterKey, first, stride, c);
-  shapeOffsets(r, c);
+  shapeOffsets<kAvx2>(r, c);
   // A point list with velocities gives them in writePositions(): no direction or speed drawn.
   const bool listVelocities = !r.pointVelocities.empty();
   if (!listVelocities) {
-    if (r.spreadDegrees > 0.0) spreadDirections(r, c);
+    if (r.spreadDegrees > 0.0) spreadDirections<kAvx2>(r, c);
     jittered(c, RandomPurpose::Speed, r.speed, r.speedJitter, c.speed, c.u);
   }
   jittered(c, RandomPurpose::Lifetime, r.lifetime, r.lifetimeJitter, c.life, c.u);
   const auto mass = static_cast<float>(r.mass);
+  float* __restrict life = out.lifetime;
+  float* __restrict masses = out.mass;
   for (std::size_t i = 0; i < c.n; ++i) {
-    out[i].lifetime = static_cast<float>(c.life[i]);
-    out[i].mass = mass;
+    life[i] = static_cast<float>(c.life[i]);
+    masses[i] = mass;
   }
   if (!listVelocities) {
     const bool spread = r.spreadDegrees > 0.0;
-    for (std::size_t i = 0; i < c.n; ++i) {
-      for (int axis = 0; axis < 3; ++axis) {
-        const double d = spread ? c.dir[axis][i] : r.direction[axis];
-        out[i].velocity[axis] = static_cast<float>(c.speed[i] * d);
+    for (int axis = 0; axis < 3; ++axis) {
+      float* __restrict to = out.velocity[axis];
+      if (spread) {
+        for (std::size_t i = 0; i < c.n; ++i)
+          to[i] = static_cast<float>(c.speed[i] * c.dir[axis][i]);
+      } else {
+        const double d = r.direction[axis];
+        for (std::size_t i = 0; i < c.n; ++i) to[i] = static_cast<float>(c.speed[i] * d);
       }
     }
   }
   writePositions(r, c, first, stride, out);
 }
 
+#ifdef TICKFX_SPAWN_AVX2
+// spawnChunk() compiled for AVX2: everything it calls in this file (and the sine and cosine
+// kernels) is inlined here and vectorised four doubles wide, where the baseline build has two.
+// The same operations in the same order: integer ones, and IEEE ones that AVX2 rounds as SSE2
+// does (no FMA here, and -ffp-contract=off), so the same bits.
+[[gnu::target("avx2"), gnu::flatten]] void spawnChunkAvx2(const SpawnRecipe& r, std::uint64_t first,
+                                                          std::uint64_t stride, Chunk& c,
+                                                          const SpawnTargets& out) {
+  spawnChunk<true>(r, first, stride, c, out);
+}
+
+bool avx2Here() {
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return has;
+}
+#else
+bool avx2Here() { return false; }
+#endif
+
+// -1: the widest path available; else a forced SpawnIsa (forceSpawnIsa()).
+std::atomic<int> forcedIsa{-1};
+
+SpawnIsa chosenIsa() {
+  const int forced = forcedIsa.load(std::memory_order_relaxed);
+  if (forced >= 0) return static_cast<SpawnIsa>(forced);
+  return avx2Here() ? SpawnIsa::Avx2 : SpawnIsa::Baseline;
+}
+
+SpawnTargets advanced(const SpawnTargets& t, std::size_t rows) {
+  SpawnTargets out = t;
+  for (int axis = 0; axis < 3; ++axis) {
+    out.position[axis] += rows;
+    out.velocity[axis] += rows;
+  }
+  out.lifetime += rows;
+  out.mass += rows;
+  return out;
+}
+
 }  // namespace
+
+void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
+               std::size_t count, const SpawnTargets& out) {
+  Chunk chunk;
+  const bool avx2 = chosenIsa() == SpawnIsa::Avx2;
+  for (std::size_t k = 0; k < count; k += kChunk) {
+    chunk.n = std::min(kChunk, count - k);
+#ifdef TICKFX_SPAWN_AVX2
+    if (avx2) {
+      spawnChunkAvx2(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
+      continue;
+    }
+#endif
+    spawnChunk<false>(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
+  }
+  (void)avx2;
+}
+
+bool spawnIsaAvailable(SpawnIsa isa) { return isa == SpawnIsa::Baseline || avx2Here(); }
+
+void forceSpawnIsa(std::optional<SpawnIsa> isa) {
+  TICKFX_ASSERT(!isa || spawnIsaAvailable(*isa), "forcing a SpawnIsa this processor lacks");
+  forcedIsa.store(isa ? static_cast<int>(*isa) : -1, std::memory_order_relaxed);
+}
 
 void spawnBatch(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
                 std::span<ParticleInit> out) {
-  Chunk chunk;
+  // Through columns of one chunk, then gathered into the rows: the values spawnRows() writes.
+  float columns[8][kChunk];
+  const SpawnTargets targets{{columns[0], columns[1], columns[2]},
+                             {columns[3], columns[4], columns[5]},
+                             columns[6],
+                             columns[7]};
   for (std::size_t k = 0; k < out.size(); k += kChunk) {
-    chunk.n = std::min(kChunk, out.size() - k);
-    spawnChunk(recipe, firstSerial + k * stride, stride, chunk, out.data() + k);
+    const std::size_t n = std::min(kChunk, out.size() - k);
+    spawnRows(recipe, firstSerial + k * stride, stride, n, targets);
+    for (std::size_t i = 0; i < n; ++i) {
+      ParticleInit& p = out[k + i];
+      for (int axis = 0; axis < 3; ++axis) {
+        p.position[axis] = columns[axis][i];
+        p.velocity[axis] = columns[3 + axis][i];
+      }
+      p.lifetime = columns[6][i];
+      p.mass = columns[7][i];
+    }
   }
 }
 

@@ -19,6 +19,7 @@
 #include "particles/ParticlePool.h"
 #include "particles/Random.h"
 #include "particles/Shard.h"
+#include "particles/SpawnBatch.h"
 
 namespace tickfx {
 namespace {
@@ -85,6 +86,33 @@ std::string describe(const ParticleInit& p) {
   return s.str();
 }
 
+// The paths spawnRows() can take on this processor (SpawnBatch.h): the tests that compare the
+// batch sampler with sample() run on each, so every path is pinned to the reference.
+std::vector<SpawnIsa> isasHere() {
+  std::vector<SpawnIsa> out{SpawnIsa::Baseline};
+  if (spawnIsaAvailable(SpawnIsa::Avx2)) out.push_back(SpawnIsa::Avx2);
+  return out;
+}
+
+std::string isaName(SpawnIsa isa) { return isa == SpawnIsa::Avx2 ? "AVX2" : "baseline"; }
+
+// Runs spawnRows() on one path while alive.
+struct ForcedIsa {
+  explicit ForcedIsa(SpawnIsa isa) { forceSpawnIsa(isa); }
+  ~ForcedIsa() { forceSpawnIsa(std::nullopt); }
+  ForcedIsa(const ForcedIsa&) = delete;
+  ForcedIsa& operator=(const ForcedIsa&) = delete;
+};
+
+#if defined(__x86_64__)
+// The AVX2 path is chosen where the processor has it, and only there.
+TEST(EmitterBatch, TheAvx2PathIsAvailableExactlyWhereTheProcessorHasIt) {
+  __builtin_cpu_init();
+  EXPECT_EQ(spawnIsaAvailable(SpawnIsa::Avx2), __builtin_cpu_supports("avx2") != 0);
+  EXPECT_TRUE(spawnIsaAvailable(SpawnIsa::Baseline));
+}
+#endif
+
 // Batch sizes around the sampler's chunk of 128 and emit()'s batch of 256, serials from 0, from
 // far along and from just below 2^64 (the serials wrap there, and a point list's s mod N jumps),
 // strides of a whole run and of shards.
@@ -92,22 +120,26 @@ TEST(EmitterBatch, SampleBatchGivesTheBitsOfSampleForEveryShapeSizeAndStride) {
   const std::uint64_t firsts[] = {0, 5, 123'456'789'012ULL, ~std::uint64_t{0} - 200};
   const std::uint64_t strides[] = {1, 2, 7, 65536};
   const std::size_t sizes[] = {1, 2, 127, 128, 129, 300};
-  for (const Case& c : cases()) {
-    for (const std::uint32_t index : {0u, 3u}) {
-      const Emitter emitter(c.settings, index, 60);
-      for (const std::uint64_t seed : {1ULL, 0xdeadbeefULL}) {
-        for (const std::uint64_t first : firsts) {
-          for (const std::uint64_t stride : strides) {
-            for (const std::size_t n : sizes) {
-              std::vector<ParticleInit> got(n);
-              emitter.sampleBatch(seed, first, stride, got);
-              for (std::size_t k = 0; k < n; ++k) {
-                const std::uint64_t serial = first + k * stride;
-                const ParticleInit want = emitter.sample(seed, serial);
-                ASSERT_TRUE(test::sameBits(got[k], want))
-                    << c.name << ", emitter " << index << ", seed " << seed << ", serial " << serial
-                    << " (batch of " << n << " from " << first << " by " << stride << "): got "
-                    << describe(got[k]) << ", want " << describe(want);
+  for (const SpawnIsa isa : isasHere()) {
+    const ForcedIsa forced(isa);
+    for (const Case& c : cases()) {
+      for (const std::uint32_t index : {0u, 3u}) {
+        const Emitter emitter(c.settings, index, 60);
+        for (const std::uint64_t seed : {1ULL, 0xdeadbeefULL}) {
+          for (const std::uint64_t first : firsts) {
+            for (const std::uint64_t stride : strides) {
+              for (const std::size_t n : sizes) {
+                std::vector<ParticleInit> got(n);
+                emitter.sampleBatch(seed, first, stride, got);
+                for (std::size_t k = 0; k < n; ++k) {
+                  const std::uint64_t serial = first + k * stride;
+                  const ParticleInit want = emitter.sample(seed, serial);
+                  ASSERT_TRUE(test::sameBits(got[k], want))
+                      << isaName(isa) << ", " << c.name << ", emitter " << index << ", seed "
+                      << seed << ", serial " << serial << " (batch of " << n << " from " << first
+                      << " by " << stride << "): got " << describe(got[k]) << ", want "
+                      << describe(want);
+                }
               }
             }
           }
@@ -172,33 +204,88 @@ ParticleInit rowOf(const ParticlePool& pool, std::size_t row) {
 // several parallel blocks and a rate: every row holds sample() of its serial (an emitter alone
 // from tick 0 gives the particle of serial s the id s), on 1 and 3 threads.
 TEST(EmitterBatch, ShardedEmitFillsEachRowWithTheSampleOfItsSerial) {
-  for (const Case& c : cases()) {
-    EmitterSettings s = c.settings;
-    s.bursts = {Burst{0.0, 2 * kParallelBlockRows + 301}, Burst{0.05, 999}};
-    s.rate = 1234.5;
-    const Emitter emitter(s, 1, 60);
-    for (const std::uint32_t count : {1u, 2u, 3u, 5u}) {
-      for (std::uint32_t index = 0; index < count; ++index) {
-        const Shard shard{index, count};
-        for (const int threads : {1, 3}) {
-          ParticlePool pool(1'000'000);
-          tbb::task_arena arena(threads);
-          for (std::int64_t tick = 0; tick < 5; ++tick)
-            arena.execute([&] { emitter.emit(pool, 31, tick, shard); });
-          const std::uint64_t made = emitter.serialBefore(5);
-          ASSERT_EQ(pool.nextId(), made);
-          std::uint64_t owned = 0;
-          for (std::uint64_t serial = 0; serial < made; ++serial)
-            owned += shard.ownerOfSerial(1, serial) == index;
-          ASSERT_EQ(pool.size(), owned) << c.name << ", shard " << shard.text();
-          for (std::size_t row = 0; row < pool.size(); ++row) {
-            const std::uint64_t serial = pool.id()[row];
-            ASSERT_EQ(shard.ownerOfSerial(1, serial), index) << c.name << ", row " << row;
-            const ParticleInit want = emitter.sample(31, serial);
-            ASSERT_TRUE(test::sameBits(rowOf(pool, row), want))
-                << c.name << ", shard " << shard.text() << ", " << threads << " threads, row "
-                << row << ", serial " << serial << ": got " << describe(rowOf(pool, row))
-                << ", want " << describe(want);
+  for (const SpawnIsa isa : isasHere()) {
+    const ForcedIsa forced(isa);
+    for (const Case& c : cases()) {
+      EmitterSettings s = c.settings;
+      s.bursts = {Burst{0.0, 2 * kParallelBlockRows + 301}, Burst{0.05, 999}};
+      s.rate = 1234.5;
+      const Emitter emitter(s, 1, 60);
+      for (const std::uint32_t count : {1u, 2u, 3u, 5u}) {
+        for (std::uint32_t index = 0; index < count; ++index) {
+          const Shard shard{index, count};
+          for (const int threads : {1, 3}) {
+            ParticlePool pool(1'000'000);
+            tbb::task_arena arena(threads);
+            for (std::int64_t tick = 0; tick < 5; ++tick)
+              arena.execute([&] { emitter.emit(pool, 31, tick, shard); });
+            const std::uint64_t made = emitter.serialBefore(5);
+            ASSERT_EQ(pool.nextId(), made);
+            std::uint64_t owned = 0;
+            for (std::uint64_t serial = 0; serial < made; ++serial)
+              owned += shard.ownerOfSerial(1, serial) == index;
+            ASSERT_EQ(pool.size(), owned) << c.name << ", shard " << shard.text();
+            for (std::size_t row = 0; row < pool.size(); ++row) {
+              const std::uint64_t serial = pool.id()[row];
+              ASSERT_EQ(shard.ownerOfSerial(1, serial), index) << c.name << ", row " << row;
+              const ParticleInit want = emitter.sample(31, serial);
+              ASSERT_TRUE(test::sameBits(rowOf(pool, row), want))
+                  << isaName(isa) << ", " << c.name << ", shard " << shard.text() << ", " << threads
+                  << " threads, row " << row << ", serial " << serial << ": got "
+                  << describe(rowOf(pool, row)) << ", want " << describe(want);
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+// emit() writes rows by columns (spawnRows, then ParticlePool::finishRows), where a spawn sets a
+// row (setRow): the previous position, the acceleration and the pool's flags must come out as
+// setRow() leaves them, for pools with and without those columns and for finite and infinite
+// lifetimes and masses.
+TEST(EmitterBatch, EmitFinishesRowsAsSetRowDoes) {
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const bool history : {false, true}) {
+    for (const double lifetime : {2.0, inf}) {
+      for (const double mass : {0.7, inf}) {
+        EmitterSettings s = moving(BoxShape{Eigen::Vector3d(2.0, 1.0, 0.25)}, 30.0);
+        s.lifetime = lifetime;
+        s.lifetimeJitter = 0.0;
+        s.mass = mass;
+        s.bursts = {Burst{0.0, kParallelBlockRows + 77}};
+        const Emitter emitter(s, 0, 60);
+        ParticlePool emitted(100'000), set(100'000);
+        for (ParticlePool* pool : {&emitted, &set}) {
+          if (history) {
+            pool->keepPrevious();
+            pool->keepAcceleration();
+          }
+        }
+        // Stale values where the new rows go: finishRows() must overwrite them.
+        emitted.appendRows(kParallelBlockRows + 77, 0);
+        for (int c = 0; c < 3 && history; ++c) {
+          emitted.previousPosition()[c].setConstant(-7.0f);
+          emitted.acceleration()[c].setConstant(9.0f);
+        }
+        emitted.dropNewest(0, 0);
+        emitter.emit(emitted, 5, 0);
+        const std::size_t first = set.appendRows(kParallelBlockRows + 77, 0);
+        for (std::size_t k = 0; k < set.size(); ++k) set.setRow(first + k, emitter.sample(5, k));
+        const std::string label = std::string(history ? "history" : "no history") + ", lifetime " +
+                                  std::to_string(lifetime) + ", mass " + std::to_string(mass);
+        ASSERT_EQ(emitted.size(), set.size()) << label;
+        EXPECT_EQ(emitted.mayHaveFiniteLifetimes(), set.mayHaveFiniteLifetimes()) << label;
+        EXPECT_EQ(emitted.mayHaveFiniteLifetimes(), lifetime != inf) << label;
+        EXPECT_EQ(emitted.mayHavePinned(), set.mayHavePinned()) << label;
+        EXPECT_EQ(emitted.mayHavePinned(), mass == inf) << label;
+        for (std::size_t row = 0; row < set.size(); ++row) {
+          ASSERT_TRUE(test::sameBits(rowOf(emitted, row), rowOf(set, row)))
+              << label << ", row " << row;
+          for (int c = 0; c < 3 && history; ++c) {
+            ASSERT_EQ(emitted.previousPosition()[c][row], set.position()[c][row]) << label;
+            ASSERT_EQ(emitted.acceleration()[c][row], 0.0f) << label;
           }
         }
       }
