@@ -134,7 +134,10 @@ int main(int argc, char** argv) {
     auto resting = scene(n, threads, plane, /*resting=*/true);
     auto withLevelSet = scene(n, threads, levelSet);
     for (int k = 0; k < 3; ++k) resting->step();  // settled on the ground
-    const tickfx::ParticlePool spray = none->pool(), heap = resting->pool();
+    // Snapshots with the previous positions colliders' paths start from (the collider-free
+    // system's pool does not keep them).
+    tickfx::ParticlePool spray = none->pool(), heap = resting->pool();
+    spray.keepPrevious();
     // The level set's grid and box, and the paths whose box meets it (chosen once, as the
     // collision pass would choose them: both ends inside the grown box test).
     const tickfx::LevelSetInfo info = *tickfx::levelSetInfo(withLevelSet->colliders()->collider(0));

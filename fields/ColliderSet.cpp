@@ -1,6 +1,7 @@
 #include "fields/ColliderSet.h"
 
 #include <cstring>
+#include <stdexcept>
 
 #include "particles/Assert.h"
 #include "particles/ParallelFor.h"
@@ -62,6 +63,11 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
   paths_.clear();
   contacts_ = 0;
   if (colliders_.empty()) return;
+  if (!pool.keepsPrevious()) {
+    // A path starts at the previous position: without the column there is no path to test.
+    throw std::invalid_argument(
+        "colliders need the pool's previous positions: call ParticlePool::keepPrevious() first");
+  }
   for (auto& c : colliders_) c->beginTick(tick, stepRateHz);
   TickState& t = tick_;
   t.dt = static_cast<float>(1.0 / static_cast<double>(stepRateHz));

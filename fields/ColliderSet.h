@@ -73,6 +73,8 @@ class ColliderSet {
   /// previous position is its velocity), a row that touched gets previous = position − v·dt, so
   /// that its next step carries the responded velocity. Hits are recorded in the pool's hit
   /// columns where it has them (addHitColumns), the tick starting at tick / stepRateHz seconds.
+  /// The pool must keep previous positions (ParticlePool::keepPrevious(); a ParticleSystem with
+  /// colliders does): std::invalid_argument otherwise.
   void collide(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz, bool history);
 
   /// collide() in three parts, for a caller that collides each block of rows right after its

@@ -330,6 +330,9 @@ void ParticleSystem::emitTick(std::int64_t tick) {
 void ParticleSystem::runTick(bool shown) {
   const bool keepVelocities = shown;
   const bool keepPrevious = keepsPrevious(shown);
+  // The column the tick writes, before any path reads it: the pool may have been replaced since
+  // the last tick (editPool()) by one that never kept it.
+  if (keepPrevious) pool_.keepPrevious();
   emitTick(tick_);
   for (std::size_t k = 0; k < structures_.size(); ++k) {
     PendingStructure& p = structures_[k];

@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -565,6 +566,59 @@ TEST(CollisionDeterminism, TheStateIsTheSameForAnyFramesAndThreadCount) {
   EXPECT_EQ(runHash(2, uneven, ticks), reference);
   EXPECT_EQ(runHash(3, std::vector<Flicks>(48, kFlicksPerSecond / 24), ticks), reference);
   EXPECT_EQ(runHash(2, std::vector<Flicks>(288, kFlicksPerSecond / 144), ticks), reference);
+}
+
+// A host may replace the whole pool between ticks (editPool() = a snapshot), with a pool made
+// by a system without colliders: it has no previous-position column, which colliders' paths
+// start from. The next tick gives it one (it used to write past a column of no rows), and the
+// state is that of a system whose own pool held the same particles.
+TEST(CollisionRestore, APoolWithoutPreviousPositionsTicksAsTheSystemsOwn) {
+  const std::vector<ColliderSettings> plane{groundPlane(ColliderResponse::Bounce, 0.5, 0.0)};
+  auto plain = systemWith("semi_implicit_euler", 60, gravityOnly(), {});
+  auto restored = systemWith("semi_implicit_euler", 60, gravityOnly(), plane);
+  auto own = systemWith("semi_implicit_euler", 60, gravityOnly(), plane);
+  for (ParticleSystem* s : {plain.get(), own.get()}) {
+    for (int i = 0; i < 20000; ++i) {
+      ParticleInit init;
+      init.position = Eigen::Vector3f(0.001f * static_cast<float>(i), 0.05f, 0.0f);
+      init.velocity = Eigen::Vector3f(0.0f, -3.0f - 0.0001f * static_cast<float>(i), 0.0f);
+      s->editPool().spawn(init, 0);
+    }
+  }
+  ASSERT_FALSE(plain->pool().keepsPrevious());
+  restored->editPool() = plain->pool();
+  const auto ticks = [&](int count) {
+    for (int t = 0; t < count; ++t) {
+      restored->step();
+      own->step();
+    }
+  };
+  ticks(2);
+  EXPECT_TRUE(restored->pool().keepsPrevious());
+  // The plane was met: every particle hit it in the first tick and is rising.
+  std::size_t rising = 0;
+  for (std::size_t r = 0; r < restored->pool().size(); ++r)
+    rising += restored->pool().velocity().y[static_cast<Eigen::Index>(r)] > 0.0f;
+  EXPECT_EQ(rising, restored->pool().size());
+  ticks(28);
+  EXPECT_EQ(stateHash(restored->pool()), stateHash(own->pool()));
+}
+
+// ColliderSet::collide() on a pool with no previous positions says what is missing.
+TEST(CollisionRestore, CollidingAPoolWithoutPreviousPositionsIsRefused) {
+  ColliderSet set = setOf({groundPlane(ColliderResponse::Bounce, 0.5, 0.0)});
+  ParticlePool pool(10);
+  pool.spawn(ParticleInit{}, 0);
+  try {
+    set.collide(pool, 0, 60, false);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(),
+                 "colliders need the pool's previous positions: call "
+                 "ParticlePool::keepPrevious() first");
+  }
+  pool.keepPrevious();
+  EXPECT_NO_THROW(set.collide(pool, 0, 60, false));
 }
 
 // ---------------------------------------------------------------------------------------------
