@@ -264,7 +264,8 @@ std::size_t ParticlePool::appendRowsStrided(std::size_t count, std::int64_t tick
     std::uint64_t id = firstId + begin * stride;
     for (std::size_t i = begin; i < end; ++i, id += stride) ids[i] = id;
     std::fill(births + begin, births + end, static_cast<std::uint32_t>(tick));
-    std::memset(dead_.data() + first + begin, 0, end - begin);
+    std::uint8_t* dead = dead_.data() + first;
+    std::fill(dead + begin, dead + end, std::uint8_t{0});  // (memset's pointer may not be null)
     const auto head = static_cast<Eigen::Index>(first + begin);
     const auto n = static_cast<Eigen::Index>(end - begin);
     for (NamedColumn& a : attributes_) a.values.segment(head, n).setConstant(a.initial);
