@@ -281,27 +281,14 @@ std::size_t ParticlePool::appendRowsStrided(std::size_t count, std::int64_t tick
 
 void ParticlePool::setRow(std::size_t row, const ParticleInit& init) {
   TICKFX_ASSERT(row < size_, "a row set past the pool's size");
-  const auto r = static_cast<Eigen::Index>(row);
-  position_.x[r] = init.position.x();
-  position_.y[r] = init.position.y();
-  position_.z[r] = init.position.z();
-  velocity_.x[r] = init.velocity.x();
-  velocity_.y[r] = init.velocity.y();
-  velocity_.z[r] = init.velocity.z();
-  if (keepsPrevious_) {
-    previous_.x[r] = init.position.x();
-    previous_.y[r] = init.position.y();
-    previous_.z[r] = init.position.z();
+  const SpawnTargets to = spawnTargets(row);
+  for (int c = 0; c < 3; ++c) {
+    *to.position[c] = init.position[c];
+    *to.velocity[c] = init.velocity[c];
   }
-  if (keepsAcceleration_) {
-    acceleration_.x[r] = 0.0f;
-    acceleration_.y[r] = 0.0f;
-    acceleration_.z[r] = 0.0f;
-  }
-  lifetime_[r] = init.lifetime;
-  mass_[r] = init.mass;
-  if (!std::isinf(init.lifetime)) mayExpire_.raise();
-  if (std::isinf(init.mass)) mayPin_.raise();
+  *to.lifetime = init.lifetime;
+  *to.mass = init.mass;
+  finishRows(row, row + 1);
 }
 
 SpawnTargets ParticlePool::spawnTargets(std::size_t row) {
