@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 
@@ -10,6 +9,7 @@
 #include "particles/DetMath.h"
 #include "particles/DetMathBlock.h"
 #include "particles/DetMathKernels.h"
+#include "particles/Isa.h"
 #include "particles/Random.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -278,26 +278,7 @@ void spawnChunk(const SpawnRecipe& r, std::uint64_t first, std::uint64_t stride,
                                                           const SpawnTargets& out) {
   spawnChunk<true>(r, first, stride, c, out);
 }
-
-bool avx2Here() {
-  static const bool has = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
-  }();
-  return has;
-}
-#else
-bool avx2Here() { return false; }
 #endif
-
-// -1: the widest path available; else a forced SpawnIsa (forceSpawnIsa()).
-std::atomic<int> forcedIsa{-1};
-
-SpawnIsa chosenIsa() {
-  const int forced = forcedIsa.load(std::memory_order_relaxed);
-  if (forced >= 0) return static_cast<SpawnIsa>(forced);
-  return avx2Here() ? SpawnIsa::Avx2 : SpawnIsa::Baseline;
-}
 
 SpawnTargets advanced(const SpawnTargets& t, std::size_t rows) {
   SpawnTargets out = t;
@@ -315,7 +296,7 @@ SpawnTargets advanced(const SpawnTargets& t, std::size_t rows) {
 void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
                std::size_t count, const SpawnTargets& out) {
   Chunk chunk;
-  const bool avx2 = chosenIsa() == SpawnIsa::Avx2;
+  const bool avx2 = activeIsa() == Isa::Avx2;
   for (std::size_t k = 0; k < count; k += kChunk) {
     chunk.n = std::min(kChunk, count - k);
 #ifdef TICKFX_SPAWN_AVX2
@@ -327,13 +308,6 @@ void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64
     spawnChunk<false>(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
   }
   (void)avx2;
-}
-
-bool spawnIsaAvailable(SpawnIsa isa) { return isa == SpawnIsa::Baseline || avx2Here(); }
-
-void forceSpawnIsa(std::optional<SpawnIsa> isa) {
-  TICKFX_ASSERT(!isa || spawnIsaAvailable(*isa), "forcing a SpawnIsa this processor lacks");
-  forcedIsa.store(isa ? static_cast<int>(*isa) : -1, std::memory_order_relaxed);
 }
 
 void spawnBatch(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,

@@ -43,22 +43,10 @@ struct SpawnRecipe {
 void spawnBatch(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
                 std::span<ParticleInit> out);
 
-/// The instructions spawnRows() runs on: the build's baseline (SSE2 on x86-64, NEON on aarch64),
-/// or AVX2 on an x86-64 processor that has it, chosen at run time. Both give the same bits: the
-/// draws are integer operations, the rest IEEE operations rounded alike at any vector width (no
-/// FMA, -ffp-contract=off); tests run both against Emitter::sample().
-enum class SpawnIsa { Baseline = 0, Avx2 = 1 };
-
-/// Whether `isa` can run on this processor (Baseline always).
-bool spawnIsaAvailable(SpawnIsa isa);
-
-/// Makes spawnRows() run on `isa` (available here) from now on, in every thread; nullopt: the
-/// widest available, the default. For tests that pin each path.
-void forceSpawnIsa(std::optional<SpawnIsa> isa);
-
 /// spawnBatch() written column by column: row k of each of `out`'s columns gets the position,
 /// velocity, lifetime and mass of the particle of serial firstSerial + k · stride, for k < count.
 /// The same bits; the columns are written in runs (no per-row gather), as emit() fills a pool.
+/// Runs on activeIsa() (particles/Isa.h): the same bits on every path.
 void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
                std::size_t count, const SpawnTargets& out);
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
+#include "ForcedIsa.h"
 #include "particles/Emitter.h"
 #include "particles/ParallelFor.h"
 #include "particles/ParticlePool.h"
@@ -23,6 +24,9 @@
 
 namespace tickfx {
 namespace {
+
+using test::ForcedIsa;
+using test::isasHere;
 
 struct Case {
   std::string name;
@@ -86,30 +90,12 @@ std::string describe(const ParticleInit& p) {
   return s.str();
 }
 
-// The paths spawnRows() can take on this processor (SpawnBatch.h): the tests that compare the
-// batch sampler with sample() run on each, so every path is pinned to the reference.
-std::vector<SpawnIsa> isasHere() {
-  std::vector<SpawnIsa> out{SpawnIsa::Baseline};
-  if (spawnIsaAvailable(SpawnIsa::Avx2)) out.push_back(SpawnIsa::Avx2);
-  return out;
-}
-
-std::string isaName(SpawnIsa isa) { return isa == SpawnIsa::Avx2 ? "AVX2" : "baseline"; }
-
-// Runs spawnRows() on one path while alive.
-struct ForcedIsa {
-  explicit ForcedIsa(SpawnIsa isa) { forceSpawnIsa(isa); }
-  ~ForcedIsa() { forceSpawnIsa(std::nullopt); }
-  ForcedIsa(const ForcedIsa&) = delete;
-  ForcedIsa& operator=(const ForcedIsa&) = delete;
-};
-
 #if defined(__x86_64__)
 // The AVX2 path is chosen where the processor has it, and only there.
 TEST(EmitterBatch, TheAvx2PathIsAvailableExactlyWhereTheProcessorHasIt) {
   __builtin_cpu_init();
-  EXPECT_EQ(spawnIsaAvailable(SpawnIsa::Avx2), __builtin_cpu_supports("avx2") != 0);
-  EXPECT_TRUE(spawnIsaAvailable(SpawnIsa::Baseline));
+  EXPECT_EQ(isaAvailable(Isa::Avx2), __builtin_cpu_supports("avx2") != 0);
+  EXPECT_TRUE(isaAvailable(Isa::Baseline));
 }
 #endif
 
@@ -120,7 +106,7 @@ TEST(EmitterBatch, SampleBatchGivesTheBitsOfSampleForEveryShapeSizeAndStride) {
   const std::uint64_t firsts[] = {0, 5, 123'456'789'012ULL, ~std::uint64_t{0} - 200};
   const std::uint64_t strides[] = {1, 2, 7, 65536};
   const std::size_t sizes[] = {1, 2, 127, 128, 129, 300};
-  for (const SpawnIsa isa : isasHere()) {
+  for (const Isa isa : isasHere()) {
     const ForcedIsa forced(isa);
     for (const Case& c : cases()) {
       for (const std::uint32_t index : {0u, 3u}) {
@@ -204,7 +190,7 @@ ParticleInit rowOf(const ParticlePool& pool, std::size_t row) {
 // several parallel blocks and a rate: every row holds sample() of its serial (an emitter alone
 // from tick 0 gives the particle of serial s the id s), on 1 and 3 threads.
 TEST(EmitterBatch, ShardedEmitFillsEachRowWithTheSampleOfItsSerial) {
-  for (const SpawnIsa isa : isasHere()) {
+  for (const Isa isa : isasHere()) {
     const ForcedIsa forced(isa);
     for (const Case& c : cases()) {
       EmitterSettings s = c.settings;

@@ -1,0 +1,30 @@
+// The instruction sets tickfx's widest loops are compiled for, chosen at run time. A loop has a
+// baseline form (SSE2 on x86-64, NEON on aarch64: what the build targets) and, on x86-64, an AVX2
+// clone; both give the same bits, because the loops use integer operations and IEEE arithmetic
+// that rounds alike at any vector width (no FMA: -ffp-contract=off, and the clones do not enable
+// it). Tests force each path and compare them bit for bit.
+#pragma once
+
+#include <optional>
+
+namespace tickfx {
+
+enum class Isa { Baseline = 0, Avx2 = 1 };
+
+/// Whether `isa` can run on this processor (Baseline always; Avx2 on an x86-64 processor with
+/// AVX2, in a build by GCC or Clang).
+bool isaAvailable(Isa isa);
+
+/// The path the loops take now: the forced one (forceIsa()), else the widest available. Cheap:
+/// one relaxed atomic load after the first call.
+Isa activeIsa();
+
+/// Makes every dispatching loop run on `isa` (available here) from now on, in every thread;
+/// nullopt: the widest available, the default. For tests and benches that pin each path; not
+/// to be called while a loop runs.
+void forceIsa(std::optional<Isa> isa);
+
+/// "baseline" or "AVX2", for messages and bench labels.
+const char* isaName(Isa isa);
+
+}  // namespace tickfx
