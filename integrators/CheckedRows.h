@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -16,6 +17,7 @@
 #include "fields/ForceSet.h"
 #include "integrators/NonfiniteExceptions.h"
 #include "integrators/StagePasses.h"
+#include "particles/Isa.h"
 #include "particles/NonfiniteState.h"
 
 namespace tickfx {
@@ -24,6 +26,27 @@ namespace tickfx {
 /// lane and IEEE (no contraction: -ffp-contract=off), so rows computed four at a time have the
 /// bits of the rows computed one by one.
 using Lanes4 = float __attribute__((vector_size(16)));
+
+/// Eight rows: the register of AVX, used only inside the AVX2 clones of the update loops
+/// (updateRowsAvx2), where every function taking or returning one is inlined. The same lane by
+/// lane IEEE arithmetic: the bits of the rows computed one by one.
+using Lanes8 = float __attribute__((vector_size(32)));
+
+/// The integer lanes of a Lane, for its bits.
+template <class Lane>
+struct LaneBits;
+template <>
+struct LaneBits<Lanes4> {
+  using type = std::int32_t __attribute__((vector_size(16)));
+};
+template <>
+struct LaneBits<Lanes8> {
+  using type = std::int32_t __attribute__((vector_size(32)));
+};
+
+/// The number of rows a Lane holds (1 for float).
+template <class Lane>
+inline constexpr Eigen::Index kLanes = static_cast<Eigen::Index>(sizeof(Lane) / sizeof(float));
 
 /// Lane by lane, `value` with every subnormal replaced by a zero of its sign; normal values,
 /// zeros, infinities and NaNs unchanged. The integrators store state through this, so that no
@@ -40,7 +63,7 @@ Lane flushTiny(Lane value) {
     const bool tiny = (bits & 0x7fffffffU) < 0x00800000U;
     return std::bit_cast<float>(tiny ? bits & 0x80000000U : bits);
   } else {
-    using Bits = std::int32_t __attribute__((vector_size(16)));
+    using Bits = typename LaneBits<Lane>::type;
     const auto bits = std::bit_cast<Bits>(value);
     const Bits keep = (bits & 0x7fffffff) >= 0x00800000;  // all ones where normal, inf or NaN
     return std::bit_cast<Lane>(bits & (keep | std::int32_t{-0x7fffffff - 1}));
@@ -48,8 +71,9 @@ Lane flushTiny(Lane value) {
 }
 
 /// Where a row kernel reads and writes: row `i` of each column it is given (Lane = float), or
-/// rows i..i+3 (Lane = Lanes4). A kernel is written once over `auto row` and `auto` values, and
-/// runs four rows at a time in the loop's body and one at a time in its tail.
+/// rows i..i+kLanes-1 (Lane = Lanes4 or Lanes8). A kernel is written once over `auto row` and
+/// `auto` values, and runs a Lane of rows at a time in the loop's body and one at a time in its
+/// tail.
 template <class Lane>
 struct RowsAt {
   Eigen::Index i;
@@ -83,13 +107,16 @@ struct RowsAt {
   }
 };
 
-/// `value` in every lane: a value a kernel computes that is the same for every row.
+/// `value` in every lane: a value a kernel computes that is the same for every row (its bits
+/// unchanged, a negative zero included).
 template <class Lane>
 Lane broadcast(float value) {
   if constexpr (std::is_same_v<Lane, float>) {
     return value;
   } else {
-    return Lane{value, value, value, value};
+    Lane out;
+    for (Eigen::Index k = 0; k < kLanes<Lane>; ++k) out[k] = value;
+    return out;
   }
 }
 
@@ -114,29 +141,27 @@ Lane checkedValue(const CheckedPair<Lane>& pair) {
   return pair.position + pair.velocity;
 }
 
-/// Runs `kernel(row, columns...)` over rows [0, n): four rows at a time (RowsAt<Lanes4>), then
-/// the tail one by one (RowsAt<float>), reading and writing through `columns` (each a distinct
-/// column: they are __restrict here, which lets the compiler keep values in registers across a
-/// row's stores). With kCheck, sums what each call returns (see checkedValue) lane by lane: a sum
-/// with a NaN or an infinity among its terms is not finite, whatever its order, so a finite sum
-/// clears every row; a sum of finite terms can also overflow, and then the caller's exact scan
-/// finds nothing and only time is lost. Returns whether some returned value may be non-finite
-/// (always false without kCheck).
+/// Runs `kernel(row, columns...)` over rows [0, n): kLanes<Lane> rows at a time (RowsAt<Lane>),
+/// then the tail one by one (RowsAt<float>), reading and writing through `columns` (each a
+/// distinct column: they are __restrict here, which lets the compiler keep values in registers
+/// across a row's stores). With kCheck, sums what each call returns (see checkedValue) lane by
+/// lane: a sum with a NaN or an infinity among its terms is not finite, whatever its order, so a
+/// finite sum clears every row; a sum of finite terms can also overflow, and then the caller's
+/// exact scan finds nothing and only time is lost. Returns whether some returned value may be
+/// non-finite (always false without kCheck).
 ///
-/// The sums are two Lanes4 that must stay in registers, one for each half of an 8-row group, so
+/// The sums are two Lanes that must stay in registers, one for each half of a two-Lane group, so
 /// each is one add an iteration from its last value; sums the compiler keeps on the stack cost
 /// loads and stores every iteration.
-///
-/// Not inlined, so that the checked and unchecked loops are compiled and placed alike and a
-/// measured difference between them is the check's (docs/performance.md).
-template <bool kCheck, class Kernel, class... Column>
-[[gnu::noinline]] bool updateRowsChecked(Eigen::Index n, const Kernel& kernel,
-                                         Column* __restrict... columns) {
-  Lanes4 low = {}, high = {};
+template <class Lane, bool kCheck, class Kernel, class... Column>
+[[gnu::always_inline]] inline bool updateRowsAs(Eigen::Index n, const Kernel& kernel,
+                                                Column* __restrict... columns) {
+  constexpr Eigen::Index w = kLanes<Lane>;
+  Lane low = {}, high = {};
   Eigen::Index i = 0;
-  for (; i + 8 <= n; i += 8) {
-    const Lanes4 first = checkedValue(kernel(RowsAt<Lanes4>{i}, columns...));
-    const Lanes4 second = checkedValue(kernel(RowsAt<Lanes4>{i + 4}, columns...));
+  for (; i + 2 * w <= n; i += 2 * w) {
+    const Lane first = checkedValue(kernel(RowsAt<Lane>{i}, columns...));
+    const Lane second = checkedValue(kernel(RowsAt<Lane>{i + w}, columns...));
     if constexpr (kCheck) {
       low += first;
       high += second;
@@ -150,41 +175,104 @@ template <bool kCheck, class Kernel, class... Column>
   if constexpr (!kCheck) {
     return false;
   } else {
-    const Lanes4 sum = low + high;
-    return !std::isfinite(((sum[0] + sum[1]) + (sum[2] + sum[3])) + tail);
+    const Lane sum = low + high;
+    for (Eigen::Index k = 0; k < w; ++k) tail += sum[k];
+    return !std::isfinite(tail);
   }
 }
 
-/// updateRowsChecked() with the check on when `check` is set (the step checks this tick).
-template <class Kernel, class... Column>
-bool updateRows(const NonfiniteCheck* check, Eigen::Index n, const Kernel& kernel,
-                Column*... columns) {
-  return check != nullptr ? updateRowsChecked<true>(n, kernel, columns...)
-                          : updateRowsChecked<false>(n, kernel, columns...);
+/// One path's row loop, handed to an UpdateComponent: `loop(n, kernel, columns...)` is
+/// updateRowsAs<Lane, kCheck>.
+template <class Lane, bool kCheck>
+struct RowLoop {
+  template <class Kernel, class... Column>
+  [[gnu::always_inline]] bool operator()(Eigen::Index n, const Kernel& kernel,
+                                         Column* __restrict... columns) const {
+    return updateRowsAs<Lane, kCheck>(n, kernel, columns...);
+  }
+};
+
+/// Rows one component's update loop takes before the next component's (updateComponents()). A
+/// tile's components in turn, each over the whole tile, would read two or three columns at a
+/// time and restart the processor's prefetch streams at every turn; in blocks of this many rows
+/// all the tile's columns stream at once, and a tick of 10⁶ rows runs about twice as fast
+/// (docs/performance.md). A multiple of every loop's group of rows (2 · Lanes8).
+inline constexpr Eigen::Index kComponentBlockRows = 128;
+
+/// `updateComponent(c, offset, count, loop)` for the three components c, block by block
+/// (kComponentBlockRows) over n rows; whether some call returned true. A row's components are
+/// independent, so the order changes no bit.
+template <class Lane, bool kCheck, class UpdateComponent>
+[[gnu::always_inline]] inline bool updateBlocksAs(Eigen::Index n,
+                                                  const UpdateComponent& updateComponent) {
+  bool suspect = false;
+  for (Eigen::Index offset = 0; offset < n; offset += kComponentBlockRows) {
+    const Eigen::Index count = std::min(kComponentBlockRows, n - offset);
+    for (int c = 0; c < 3; ++c) {
+      suspect |= updateComponent(c, offset, count, RowLoop<Lane, kCheck>{});
+    }
+  }
+  return suspect;
 }
 
-/// `updateComponent(c)` (updateRows() over component c of `rows`, returning whether some value
-/// may be non-finite) for the three components, then, when one may be, the exact scan that flags
-/// the rows.
+/// updateBlocksAs() four rows a register (SSE2, NEON). Not inlined, so that the checked and
+/// unchecked loops are compiled and placed alike and a measured difference between them is the
+/// check's (docs/performance.md).
+template <bool kCheck, class UpdateComponent>
+[[gnu::noinline]] bool updateBlocksBaseline(Eigen::Index n,
+                                            const UpdateComponent& updateComponent) {
+  return updateBlocksAs<Lanes4, kCheck>(n, updateComponent);
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define TICKFX_ROWS_AVX2 1
+/// updateBlocksAs() compiled for AVX2, eight rows a register: the kernels and everything they
+/// call are inlined here (flatten). The same operations on the same values as the baseline
+/// loops, so the same bits (test_passes runs every scheme on both paths).
+template <bool kCheck, class UpdateComponent>
+[[gnu::noinline, gnu::target("avx2"), gnu::flatten]] bool updateBlocksAvx2(
+    Eigen::Index n, const UpdateComponent& updateComponent) {
+  return updateBlocksAs<Lanes8, kCheck>(n, updateComponent);
+}
+#endif
+
+/// updateBlocksAs() on the path activeIsa() names, checked (summing what the kernels return)
+/// when `check` is set.
+template <bool kCheck, class UpdateComponent>
+bool updateBlocks(Eigen::Index n, const UpdateComponent& updateComponent) {
+#ifdef TICKFX_ROWS_AVX2
+  if (activeIsa() == Isa::Avx2) return updateBlocksAvx2<kCheck>(n, updateComponent);
+#endif
+  return updateBlocksBaseline<kCheck>(n, updateComponent);
+}
+
+/// `updateComponent(c, offset, count, loop)` (`loop`, a RowLoop, over rows [offset, offset +
+/// count) of the tile `rows`, component c, returning whether some value may be non-finite) for
+/// the three components, in blocks of rows on the path activeIsa() names, then, when one may
+/// be, the exact scan that flags the rows. Checked (the loops sum what the kernels return) when
+/// `check` is set.
 template <class UpdateComponent>
 void updateComponents(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
                       const UpdateComponent& updateComponent) {
-  bool suspect = false;
-  for (int c = 0; c < 3; ++c) suspect |= updateComponent(c);
+  const Eigen::Index n = rows.count();
+  const bool suspect = check != nullptr ? updateBlocks<true>(n, updateComponent)
+                                        : updateBlocks<false>(n, updateComponent);
   if (suspect) check->scan(pool, rows.begin, rows.end);
 }
 
-/// An integrator's checked update of one tile: updateRows() over the three components of `rows`
-/// (`columnsOf(c)` gives component c's columns, in the kernel's order, as a tuple of pointers),
-/// then, when some value may be non-finite, the exact scan that flags the tile's rows.
+/// An integrator's checked update of one tile: `kernel` over the three components of `rows`
+/// (`columnsOf(c)` gives component c's columns from the tile's first row, in the kernel's order,
+/// as a tuple of pointers), then, when some value may be non-finite, the exact scan that flags
+/// the tile's rows.
 template <class Kernel, class ColumnsOf>
 void updateTile(NonfiniteCheck* check, ParticlePool& pool, RowRange rows, const Kernel& kernel,
                 const ColumnsOf& columnsOf) {
-  const Eigen::Index n = rows.count();
-  updateComponents(check, pool, rows, [&](int c) {
-    return std::apply([&](auto*... columns) { return updateRows(check, n, kernel, columns...); },
-                      columnsOf(c));
-  });
+  updateComponents(
+      check, pool, rows, [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
+        return std::apply(
+            [&](auto*... columns) { return loop(count, kernel, (columns + offset)...); },
+            columnsOf(c));
+      });
 }
 
 /// The check of a tile by exceptions (see NonfiniteCheck::steppedRowsFinite()), once its passes

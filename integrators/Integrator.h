@@ -77,8 +77,8 @@ class Integrator {
 
  protected:
   /// The scheme itself, under forces that add acceleration, over `rows`. With `check` set, the
-  /// scheme checks the values its last update loop writes, in that loop (updateRows()), or by the
-  /// exception flags after each tile (tileCheck(); both in integrators/CheckedRows.h). Called
+  /// scheme checks the values its last update loop writes, in that loop (updateComponents()), or by
+  /// the exception flags after each tile (tileCheck(); both in integrators/CheckedRows.h). Called
   /// concurrently for disjoint blocks (see stepRows()): it writes nothing of the integrator's own
   /// but its scratch in split passes.
   virtual void integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,

@@ -15,7 +15,7 @@ namespace tickfx {
 
 /// Advances `rows` one tick: `row(acceleration, at, pos, vel, last)` updates the rows `at` (a
 /// RowsAt) of one component (acceleration in m/s², a value of at's lane type; the columns as
-/// updateRowsChecked passes them) and returns what the check sums. `scratch` holds the acceleration
+/// updateRowsAs passes them) and returns what the check sums. `scratch` holds the acceleration
 /// of the force pass (one stage value).
 template <class Row>
 void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const StepTime& time,

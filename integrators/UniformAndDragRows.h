@@ -96,20 +96,21 @@ auto withFormAccelerations(const TickForms& forms, int c, const Body& body) {
 }
 
 /// A one-pass update of a tile: for each component c, `kernelFor(accelerations)` (a row kernel,
-/// see updateRowsChecked) over the columns `columnsOf(c)` gives, then, when some value may be
+/// see updateRowsAs) over the columns `columnsOf(c)` gives, then, when some value may be
 /// non-finite, the exact scan that flags the tile's rows.
 template <class KernelFor, class ColumnsOf>
 void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
                           const TickForms& forms, const KernelFor& kernelFor,
                           const ColumnsOf& columnsOf) {
-  const Eigen::Index n = rows.count();
-  updateComponents(check, pool, rows, [&](int c) {
-    return withFormAccelerations(forms, c, [&](const auto& accelerations) {
-      const auto kernel = kernelFor(accelerations);
-      return std::apply([&](auto*... columns) { return updateRows(check, n, kernel, columns...); },
-                        columnsOf(c));
-    });
-  });
+  updateComponents(
+      check, pool, rows, [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
+        return withFormAccelerations(forms, c, [&](const auto& accelerations) {
+          const auto kernel = kernelFor(accelerations);
+          return std::apply(
+              [&](auto*... columns) { return loop(count, kernel, (columns + offset)...); },
+              columnsOf(c));
+        });
+      });
 }
 
 /// The one pass of a scheme over every tile of `rows`: `beforeTile(tile)` first (the rows spawned

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "CoreTestSupport.h"
+#include "ForcedIsa.h"
 #include "fields/AnchorSpring.h"
 #include "fields/Gravity.h"
 #include "fields/LinearDrag.h"
@@ -25,8 +26,10 @@ class NonLocalNothing final : public ForceModule {
   void accumulate(const ForceInput&, RowRange, Vec3Rows&) const override {}
 };
 
-std::uint64_t runHash(const std::string& integrator, int threads, bool split) {
+std::uint64_t runHash(const std::string& integrator, int threads, bool split,
+                      NonfinitePolicy nonfinite = NonfinitePolicy::Stop) {
   SystemSettings settings;
+  settings.nonfinite = nonfinite;
   settings.stepRateHz = 60;
   settings.integrator = integrator;
   settings.seed = 99;
@@ -86,6 +89,43 @@ TEST_P(PassScheduling, FusedSplitAndThreadCountsGiveTheSameBits) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllIntegrators, PassScheduling, ::testing::ValuesIn(integratorNames()),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// The update loops' AVX2 clones (CheckedRows.h) give the baseline loops' bits, for every scheme,
+// in its one pass (with and without a drag), its force passes, its split passes, checked by sums,
+// by exceptions and unchecked, on 1 and 3 threads (tiles cut into component blocks and tails).
+class EveryIsa : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EveryIsa, GivesTheBitsOfTheBaselineLoops) {
+  struct Run {
+    std::uint64_t onePassDrag, onePass, generic, split, unchecked, threads;
+  };
+  const auto run = [&] {
+    return Run{uniformAndDragHash(GetParam(), 1, true, false),
+               uniformAndDragHash(GetParam(), 1, false, false),
+               uniformAndDragHash(GetParam(), 1, true, true),
+               runHash(GetParam(), 1, true),
+               runHash(GetParam(), 1, false, NonfinitePolicy::Keep),
+               runHash(GetParam(), 3, false)};
+  };
+  Run baseline{};
+  {
+    const test::ForcedIsa forced(Isa::Baseline);
+    baseline = run();
+  }
+  for (const Isa isa : test::isasHere()) {
+    const test::ForcedIsa forced(isa);
+    const Run r = run();
+    EXPECT_EQ(r.onePassDrag, baseline.onePassDrag) << isaName(isa);
+    EXPECT_EQ(r.onePass, baseline.onePass) << isaName(isa);
+    EXPECT_EQ(r.generic, baseline.generic) << isaName(isa);
+    EXPECT_EQ(r.split, baseline.split) << isaName(isa);
+    EXPECT_EQ(r.unchecked, baseline.unchecked) << isaName(isa);
+    EXPECT_EQ(r.threads, baseline.threads) << isaName(isa);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllIntegrators, EveryIsa, ::testing::ValuesIn(integratorNames()),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 // The fused passes keep every stage column of a tile in one stack buffer of kMaxColumns columns:
