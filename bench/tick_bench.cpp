@@ -13,11 +13,15 @@
 // lifetime, so the count never changes):
 //   AoS loop          std::vector<{Vector3f position, velocity}>, one thread: what a user writes.
 //   hand SoA loop     six float arrays through __restrict pointers, 1 thread and all threads:
-//                     the best hand loop (48 bytes moved a particle-step), the same bits as AoS.
+//                     the best hand loop (48 bytes moved a particle-step), the same bits as AoS;
+//                     where the processor has AVX2, also compiled for it (1 thread), since
+//                     tickfx's update loops take their AVX2 clones there (particles/Isa.h).
 //   tickfx integrate  SemiImplicitEuler::step on the pool: force evaluation and state update
 //                     only, the part of a tick that does the physics.
 //   tickfx step()     ParticleSystem::step(): the above plus emitters, ForceSet::beginTick, age
 //                     recomputation and removal of the dead, i.e. what a tick costs a user.
+//   tickfx step() SSE2  step() with the loops forced to their baseline path (where AVX2 is the
+//                     default): what the AVX2 clones gain.
 //   tickfx fused x4   stepTicks(4): frames of four ticks, each block of rows taken through all
 //                     four while in cache (fused frames), the same bits as four step() calls.
 // Each tickfx case runs with 1 thread and with all threads, so the table separates the gain of
@@ -54,6 +58,7 @@
 #include "fields/PeriodicWind.h"
 #include "fields/SpringNetwork.h"
 #include "integrators/SemiImplicitEuler.h"
+#include "particles/Isa.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Random.h"
 
@@ -155,7 +160,9 @@ class HandWrittenLoop {
 // 24 bytes read and 24 written a particle-step.
 class HandSoaLoop {
  public:
-  explicit HandSoaLoop(std::size_t n) : wind_(windSettings()) {
+  /// With `avx2`, the same loop compiled for AVX2 (the compiler vectorises it eight floats wide):
+  /// what tickfx's own AVX2 path is measured against too.
+  explicit HandSoaLoop(std::size_t n, bool avx2 = false) : avx2_(avx2), wind_(windSettings()) {
     for (auto* column : {&px_, &py_, &pz_, &vx_, &vy_, &vz_}) column->resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       const Particle p = initialParticle(i);
@@ -219,12 +226,29 @@ class HandSoaLoop {
     float ax, ay, az, k, airX, airY, airZ, dt;
   };
   void rows(const Accel& a, std::size_t begin, std::size_t end) {
+#if defined(__x86_64__)
+    if (avx2_) {
+      rowsOfAvx2(px_.data(), py_.data(), pz_.data(), vx_.data(), vy_.data(), vz_.data(), a, begin,
+                 end);
+      return;
+    }
+#endif
     rowsOf(px_.data(), py_.data(), pz_.data(), vx_.data(), vy_.data(), vz_.data(), a, begin, end);
   }
+#if defined(__x86_64__)
+  [[gnu::target("avx2"), gnu::flatten]] static void rowsOfAvx2(
+      float* __restrict px, float* __restrict py, float* __restrict pz, float* __restrict vx,
+      float* __restrict vy, float* __restrict vz, const Accel a, std::size_t begin,
+      std::size_t end) {
+    rowsOf(px, py, pz, vx, vy, vz, a, begin, end);
+  }
+#endif
   // A function of its own: `__restrict` holds for parameters, not for a lambda's captures.
-  static void rowsOf(float* __restrict px, float* __restrict py, float* __restrict pz,
-                     float* __restrict vx, float* __restrict vy, float* __restrict vz,
-                     const Accel a, std::size_t begin, std::size_t end) {
+  [[gnu::always_inline]] static inline void rowsOf(float* __restrict px, float* __restrict py,
+                                                   float* __restrict pz, float* __restrict vx,
+                                                   float* __restrict vy, float* __restrict vz,
+                                                   const Accel a, std::size_t begin,
+                                                   std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       vx[i] += (a.ax + a.k * (a.airX - vx[i])) * a.dt;
       vy[i] += (a.ay + a.k * (a.airY - vy[i])) * a.dt;
@@ -235,6 +259,7 @@ class HandSoaLoop {
     }
   }
 
+  bool avx2_;
   std::vector<float> px_, py_, pz_, vx_, vy_, vz_;
   tickfx::PeriodicWind wind_;
   Eigen::Vector3f windDirection_;
@@ -242,6 +267,14 @@ class HandSoaLoop {
 };
 
 // ---- tickfx side -----------------------------------------------------------------------------
+
+// tickfx's loops on their baseline path (SSE2) while alive, the widest again after.
+struct ForcedBaseline {
+  ForcedBaseline() { tickfx::forceIsa(tickfx::Isa::Baseline); }
+  ~ForcedBaseline() { tickfx::forceIsa(std::nullopt); }
+  ForcedBaseline(const ForcedBaseline&) = delete;
+  ForcedBaseline& operator=(const ForcedBaseline&) = delete;
+};
 
 // Forces after the tick's own (gravity, wind, drag), which every scheme forms in its one update
 // loop (ForceSet::uniformAndDrag): with kTether an anchor spring (local: the force passes, tile
@@ -344,7 +377,13 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   std::fflush(stdout);
   HandWrittenLoop aos(n);
   HandSoaLoop soaOne(n), soaAll(n);
+  // The hand loop and step() on the other path of the processor: AVX2 for the hand loop where
+  // the processor has it, the baseline (SSE2) for tickfx, whose default is AVX2 there.
+  const bool avx2 = tickfx::isaAvailable(tickfx::Isa::Avx2);
+  std::optional<HandSoaLoop> soaAvx2;
+  if (avx2) soaAvx2.emplace(n, true);
   std::unique_ptr<tickfx::ParticleSystem> one = makeSystem(n, 1);
+  std::unique_ptr<tickfx::ParticleSystem> baselineOne = avx2 ? makeSystem(n, 1) : nullptr;
   std::unique_ptr<tickfx::ParticleSystem> all = allThreads > 1 ? makeSystem(n, 0) : nullptr;
   // The same system without the per-tick non-finite check: what the check costs a tick.
   std::unique_ptr<tickfx::ParticleSystem> unchecked =
@@ -358,11 +397,17 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   aos.tick();
   soaOne.tick(arenaOne);
   soaAll.tick(arenaAll);
-  const bool soaSame = soaOne.sameBitsAs(aos) && soaAll.sameBitsAs(aos);
+  if (soaAvx2) soaAvx2->tick(arenaOne);
+  const bool soaSame =
+      soaOne.sameBitsAs(aos) && soaAll.sameBitsAs(aos) && (!soaAvx2 || soaAvx2->sameBitsAs(aos));
   std::printf("  check after one tick, hand SoA vs AoS: %s\n",
               soaSame ? "the same bits" : "MISMATCH");
   one->step();
   unchecked->step();
+  if (baselineOne) {
+    const ForcedBaseline forced;
+    baselineOne->step();
+  }
   Difference d = compare(aos, one->pool());
   if (all) {
     all->step();
@@ -396,6 +441,11 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
       for (std::int64_t i = 0; i < ticks; ++i) soaAll.tick(arenaAll);
     });
   }
+  if (soaAvx2) {
+    cases.emplace_back("hand SoA loop AVX2, " + threadsLabel(1), [&](std::int64_t ticks) {
+      for (std::int64_t i = 0; i < ticks; ++i) soaAvx2->tick(arenaOne);
+    });
+  }
   cases.emplace_back("tickfx integrate, " + threadsLabel(1), [&](std::int64_t ticks) {
     integrate(arenaOne, integrateOne, *one, tickOne, ticks);
   });
@@ -412,6 +462,12 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   cases.emplace_back("tickfx step(), 1 t., no check", [&](std::int64_t ticks) {
     for (std::int64_t i = 0; i < ticks; ++i) unchecked->step();
   });
+  if (baselineOne) {
+    cases.emplace_back("tickfx step(), 1 t., SSE2", [&](std::int64_t ticks) {
+      const ForcedBaseline forced;
+      for (std::int64_t i = 0; i < ticks; ++i) baselineOne->step();
+    });
+  }
   if (all) {
     cases.emplace_back("tickfx step(), " + threadsLabel(allThreads), [&](std::int64_t ticks) {
       for (std::int64_t i = 0; i < ticks; ++i) all->step();
@@ -443,6 +499,8 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   }
   std::fflush(stdout);
 
+  checksum += (soaAvx2 ? soaAvx2->positionSum() : 0.0) +
+              (baselineOne ? positionSum(baselineOne->pool()) : 0.0);
   checksum += positionSum(aos) + soaOne.positionSum() + soaAll.positionSum() +
               positionSum(one->pool()) + positionSum(unchecked->pool()) +
               (all ? positionSum(all->pool()) : 0.0) + positionSum(fusedOne->pool()) +
@@ -566,6 +624,20 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
         "tick step 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread, target >= 0.9x; "
         "%.2fx AoS)\n",
         z, rate(step).c_str(), step.stepsPerSecond / h, step.stepsPerSecond / a);
+    const Row soaAvx2 = row("hand SoA loop AVX2, 1 thread"),
+              stepSse2 = row("tickfx step(), 1 t., SSE2");
+    if (soaAvx2.stepsPerSecond > 0.0) {
+      std::printf(
+          "tick hand SoA AVX2 1 thread %s: %s particle-steps/s (%.2fx hand SoA; tickfx step() "
+          "%.2fx it)\n",
+          z, rate(soaAvx2).c_str(), soaAvx2.stepsPerSecond / h,
+          step.stepsPerSecond / soaAvx2.stepsPerSecond);
+      std::printf(
+          "tick step SSE2 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread; %.2fx step() "
+          "on AVX2)\n",
+          z, rate(stepSse2).c_str(), stepSse2.stepsPerSecond / h,
+          stepSse2.stepsPerSecond / step.stepsPerSecond);
+    }
     const Row fused = row(fusedLabel(1));
     std::printf(
         "tick fused %lld ticks a frame 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread, "
