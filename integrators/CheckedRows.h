@@ -73,8 +73,8 @@ Lane flushTiny(Lane value) {
 /// Where a row kernel reads and writes: row `i` of each column it is given (Lane = float), or
 /// rows i..i+kLanes-1 (Lane = Lanes4 or Lanes8). A kernel is written once over `auto row` and
 /// `auto` values, and runs a Lane of rows at a time in the loop's body and one at a time in its
-/// tail.
-template <class Lane>
+/// tail. Without kCopies, copy() writes nothing: the loop's previous positions go to no reader.
+template <class Lane, bool kCopies = true>
 struct RowsAt {
   Eigen::Index i;
 
@@ -89,7 +89,10 @@ struct RowsAt {
   }
   /// Writes `value` unchanged: a copy of a value already stored (the previous position).
   void copy(float* column, Lane value) const {
-    if constexpr (std::is_same_v<Lane, float>) {
+    if constexpr (!kCopies) {
+      static_cast<void>(column);
+      static_cast<void>(value);
+    } else if constexpr (std::is_same_v<Lane, float>) {
       column[i] = value;
     } else {
       std::memcpy(column + i, &value, sizeof value);
@@ -153,15 +156,15 @@ Lane checkedValue(const CheckedPair<Lane>& pair) {
 /// The sums are two Lanes that must stay in registers, one for each half of a two-Lane group, so
 /// each is one add an iteration from its last value; sums the compiler keeps on the stack cost
 /// loads and stores every iteration.
-template <class Lane, bool kCheck, class Kernel, class... Column>
+template <class Lane, bool kCheck, bool kCopies, class Kernel, class... Column>
 [[gnu::always_inline]] inline bool updateRowsAs(Eigen::Index n, const Kernel& kernel,
                                                 Column* __restrict... columns) {
   constexpr Eigen::Index w = kLanes<Lane>;
   Lane low = {}, high = {};
   Eigen::Index i = 0;
   for (; i + 2 * w <= n; i += 2 * w) {
-    const Lane first = checkedValue(kernel(RowsAt<Lane>{i}, columns...));
-    const Lane second = checkedValue(kernel(RowsAt<Lane>{i + w}, columns...));
+    const Lane first = checkedValue(kernel(RowsAt<Lane, kCopies>{i}, columns...));
+    const Lane second = checkedValue(kernel(RowsAt<Lane, kCopies>{i + w}, columns...));
     if constexpr (kCheck) {
       low += first;
       high += second;
@@ -169,7 +172,7 @@ template <class Lane, bool kCheck, class Kernel, class... Column>
   }
   float tail = 0.0f;
   for (; i < n; ++i) {
-    const float value = checkedValue(kernel(RowsAt<float>{i}, columns...));
+    const float value = checkedValue(kernel(RowsAt<float, kCopies>{i}, columns...));
     if constexpr (kCheck) tail += value;
   }
   if constexpr (!kCheck) {
@@ -182,13 +185,13 @@ template <class Lane, bool kCheck, class Kernel, class... Column>
 }
 
 /// One path's row loop, handed to an UpdateComponent: `loop(n, kernel, columns...)` is
-/// updateRowsAs<Lane, kCheck>.
-template <class Lane, bool kCheck>
+/// updateRowsAs<Lane, kCheck, kCopies>.
+template <class Lane, bool kCheck, bool kCopies>
 struct RowLoop {
   template <class Kernel, class... Column>
   [[gnu::always_inline]] bool operator()(Eigen::Index n, const Kernel& kernel,
                                          Column* __restrict... columns) const {
-    return updateRowsAs<Lane, kCheck>(n, kernel, columns...);
+    return updateRowsAs<Lane, kCheck, kCopies>(n, kernel, columns...);
   }
 };
 
@@ -202,14 +205,14 @@ inline constexpr Eigen::Index kComponentBlockRows = 128;
 /// `updateComponent(c, offset, count, loop)` for the three components c, block by block
 /// (kComponentBlockRows) over n rows; whether some call returned true. A row's components are
 /// independent, so the order changes no bit.
-template <class Lane, bool kCheck, class UpdateComponent>
+template <class Lane, bool kCheck, bool kCopies, class UpdateComponent>
 [[gnu::always_inline]] inline bool updateBlocksAs(Eigen::Index n,
                                                   const UpdateComponent& updateComponent) {
   bool suspect = false;
   for (Eigen::Index offset = 0; offset < n; offset += kComponentBlockRows) {
     const Eigen::Index count = std::min(kComponentBlockRows, n - offset);
     for (int c = 0; c < 3; ++c) {
-      suspect |= updateComponent(c, offset, count, RowLoop<Lane, kCheck>{});
+      suspect |= updateComponent(c, offset, count, RowLoop<Lane, kCheck, kCopies>{});
     }
   }
   return suspect;
@@ -218,10 +221,10 @@ template <class Lane, bool kCheck, class UpdateComponent>
 /// updateBlocksAs() four rows a register (SSE2, NEON). Not inlined, so that the checked and
 /// unchecked loops are compiled and placed alike and a measured difference between them is the
 /// check's (docs/performance.md).
-template <bool kCheck, class UpdateComponent>
+template <bool kCheck, bool kCopies, class UpdateComponent>
 [[gnu::noinline]] bool updateBlocksBaseline(Eigen::Index n,
                                             const UpdateComponent& updateComponent) {
-  return updateBlocksAs<Lanes4, kCheck>(n, updateComponent);
+  return updateBlocksAs<Lanes4, kCheck, kCopies>(n, updateComponent);
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -229,34 +232,36 @@ template <bool kCheck, class UpdateComponent>
 /// updateBlocksAs() compiled for AVX2, eight rows a register: the kernels and everything they
 /// call are inlined here (flatten). The same operations on the same values as the baseline
 /// loops, so the same bits (test_passes runs every scheme on both paths).
-template <bool kCheck, class UpdateComponent>
+template <bool kCheck, bool kCopies, class UpdateComponent>
 [[gnu::noinline, gnu::target("avx2"), gnu::flatten]] bool updateBlocksAvx2(
     Eigen::Index n, const UpdateComponent& updateComponent) {
-  return updateBlocksAs<Lanes8, kCheck>(n, updateComponent);
+  return updateBlocksAs<Lanes8, kCheck, kCopies>(n, updateComponent);
 }
 #endif
 
 /// updateBlocksAs() on the path activeIsa() names, checked (summing what the kernels return)
 /// when `check` is set.
-template <bool kCheck, class UpdateComponent>
+template <bool kCheck, bool kCopies, class UpdateComponent>
 bool updateBlocks(Eigen::Index n, const UpdateComponent& updateComponent) {
 #ifdef TICKFX_ROWS_AVX2
-  if (activeIsa() == Isa::Avx2) return updateBlocksAvx2<kCheck>(n, updateComponent);
+  if (activeIsa() == Isa::Avx2) return updateBlocksAvx2<kCheck, kCopies>(n, updateComponent);
 #endif
-  return updateBlocksBaseline<kCheck>(n, updateComponent);
+  return updateBlocksBaseline<kCheck, kCopies>(n, updateComponent);
 }
 
 /// `updateComponent(c, offset, count, loop)` (`loop`, a RowLoop, over rows [offset, offset +
 /// count) of the tile `rows`, component c, returning whether some value may be non-finite) for
 /// the three components, in blocks of rows on the path activeIsa() names, then, when one may
 /// be, the exact scan that flags the rows. Checked (the loops sum what the kernels return) when
-/// `check` is set.
+/// `check` is set. Without `copies` (unchecked only), the kernels' copies of the previous
+/// position are not written: the caller's previous rows are a sink (previousRowsOf()).
 template <class UpdateComponent>
 void updateComponents(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
-                      const UpdateComponent& updateComponent) {
+                      const UpdateComponent& updateComponent, bool copies = true) {
   const Eigen::Index n = rows.count();
-  const bool suspect = check != nullptr ? updateBlocks<true>(n, updateComponent)
-                                        : updateBlocks<false>(n, updateComponent);
+  const bool suspect = check != nullptr ? updateBlocks<true, true>(n, updateComponent)
+                       : copies         ? updateBlocks<false, true>(n, updateComponent)
+                                        : updateBlocks<false, false>(n, updateComponent);
   if (suspect) check->scan(pool, rows.begin, rows.end);
 }
 

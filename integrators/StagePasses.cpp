@@ -102,7 +102,7 @@ RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position,
 }
 
 Vec3Rows previousRowsOf(ParticlePool& pool, const StepRows& rows, RowRange r) {
-  if (rows.keepPrevious || pool.previousIsState()) return Vec3Rows::of(pool.previousPosition(), r);
+  if (writesPreviousRows(pool, rows)) return Vec3Rows::of(pool.previousPosition(), r);
   // One sink for all three components: written, never read. A tile's rows at most (a fused
   // tile, or a parallel block of split passes).
   thread_local std::vector<float> sink;

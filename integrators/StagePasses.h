@@ -92,6 +92,12 @@ RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position,
 /// Rows of `r` that are also in [begin, end).
 RowRange intersect(RowRange r, std::size_t begin, std::size_t end);
 
+/// Whether a step of `rows` writes its rows' starting positions to the pool's previousPosition():
+/// when the step keeps them (a frame interpolates across it) or the scheme reads them as state.
+inline bool writesPreviousRows(const ParticlePool& pool, const StepRows& rows) {
+  return rows.keepPrevious || pool.previousIsState();
+}
+
 /// Where a step of `rows` writes the starting positions of tile rows `r`: the pool's
 /// previousPosition() rows when the step keeps them or the scheme reads them as state, else a sink
 /// on the calling thread that nothing reads (the same stores, into L1: the column is not touched).

@@ -97,20 +97,22 @@ auto withFormAccelerations(const TickForms& forms, int c, const Body& body) {
 
 /// A one-pass update of a tile: for each component c, `kernelFor(accelerations)` (a row kernel,
 /// see updateRowsAs) over the columns `columnsOf(c)` gives, then, when some value may be
-/// non-finite, the exact scan that flags the tile's rows.
+/// non-finite, the exact scan that flags the tile's rows. `copies`: see updateComponents().
 template <class KernelFor, class ColumnsOf>
 void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
                           const TickForms& forms, const KernelFor& kernelFor,
-                          const ColumnsOf& columnsOf) {
+                          const ColumnsOf& columnsOf, bool copies) {
   updateComponents(
-      check, pool, rows, [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
+      check, pool, rows,
+      [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
         return withFormAccelerations(forms, c, [&](const auto& accelerations) {
           const auto kernel = kernelFor(accelerations);
           return std::apply(
               [&](auto*... columns) { return loop(count, kernel, (columns + offset)...); },
               columnsOf(c));
         });
-      });
+      },
+      copies);
 }
 
 /// The one pass of a scheme over every tile of `rows`: `beforeTile(tile)` first (the rows spawned
@@ -132,14 +134,19 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
               beforeTile(tile);
               const RowRange r = tile.rows();
               Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = previousRowsOf(pool, rows, r);
+              const bool copies = writesPreviousRows(pool, rows);
               std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
-              updateTileUnderForms(tiles.sums, pool, r, forms, kernelFor, [&](int c) {
-                return std::apply(
-                    [&](auto&... e) {
-                      return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), e[c].data()...);
-                    },
-                    more);
-              });
+              updateTileUnderForms(
+                  tiles.sums, pool, r, forms, kernelFor,
+                  [&](int c) {
+                    return std::apply(
+                        [&](auto&... e) {
+                          return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
+                                            e[c].data()...);
+                        },
+                        more);
+                  },
+                  copies);
             }},
             tiles.afterEachTile);
 }
