@@ -226,7 +226,7 @@ class HandSoaLoop {
     float ax, ay, az, k, airX, airY, airZ, dt;
   };
   void rows(const Accel& a, std::size_t begin, std::size_t end) {
-#if defined(__x86_64__)
+#ifdef TICKFX_AVX2_CLONES
     if (avx2_) {
       rowsOfAvx2(px_.data(), py_.data(), pz_.data(), vx_.data(), vy_.data(), vz_.data(), a, begin,
                  end);
@@ -235,7 +235,7 @@ class HandSoaLoop {
 #endif
     rowsOf(px_.data(), py_.data(), pz_.data(), vx_.data(), vy_.data(), vz_.data(), a, begin, end);
   }
-#if defined(__x86_64__)
+#ifdef TICKFX_AVX2_CLONES
   [[gnu::target("avx2"), gnu::flatten]] static void rowsOfAvx2(
       float* __restrict px, float* __restrict py, float* __restrict pz, float* __restrict vx,
       float* __restrict vy, float* __restrict vz, const Accel a, std::size_t begin,
@@ -267,14 +267,6 @@ class HandSoaLoop {
 };
 
 // ---- tickfx side -----------------------------------------------------------------------------
-
-// tickfx's loops on their baseline path (SSE2) while alive, the widest again after.
-struct ForcedBaseline {
-  ForcedBaseline() { tickfx::forceIsa(tickfx::Isa::Baseline); }
-  ~ForcedBaseline() { tickfx::forceIsa(std::nullopt); }
-  ForcedBaseline(const ForcedBaseline&) = delete;
-  ForcedBaseline& operator=(const ForcedBaseline&) = delete;
-};
 
 // Forces after the tick's own (gravity, wind, drag), which every scheme forms in its one update
 // loop (ForceSet::uniformAndDrag): with kTether an anchor spring (local: the force passes, tile
@@ -405,7 +397,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   one->step();
   unchecked->step();
   if (baselineOne) {
-    const ForcedBaseline forced;
+    const tickfx::ForcedIsa forced(tickfx::Isa::Baseline);
     baselineOne->step();
   }
   Difference d = compare(aos, one->pool());
@@ -464,7 +456,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   });
   if (baselineOne) {
     cases.emplace_back("tickfx step(), 1 t., SSE2", [&](std::int64_t ticks) {
-      const ForcedBaseline forced;
+      const tickfx::ForcedIsa forced(tickfx::Isa::Baseline);
       for (std::int64_t i = 0; i < ticks; ++i) baselineOne->step();
     });
   }

@@ -28,7 +28,7 @@ namespace tickfx {
 using Lanes4 = float __attribute__((vector_size(16)));
 
 /// Eight rows: the register of AVX, used only inside the AVX2 clones of the update loops
-/// (updateRowsAvx2), where every function taking or returning one is inlined. The same lane by
+/// (updateBlocksAvx2), where every function taking or returning one is inlined. The same lane by
 /// lane IEEE arithmetic: the bits of the rows computed one by one.
 using Lanes8 = float __attribute__((vector_size(32)));
 
@@ -195,6 +195,15 @@ struct RowLoop {
   }
 };
 
+/// `loop` (a RowLoop) with `kernel` over rows [offset, offset + count) of `columns`, a tuple of
+/// pointers to their row 0: what an UpdateComponent does once it has its kernel and columns.
+template <class Loop, class Kernel, class Columns>
+bool loopAt(const Loop& loop, const Kernel& kernel, Eigen::Index offset, Eigen::Index count,
+            const Columns& columns) {
+  return std::apply([&](auto*... column) { return loop(count, kernel, (column + offset)...); },
+                    columns);
+}
+
 /// Rows one component's update loop takes before the next component's (updateComponents()). A
 /// tile's components in turn, each over the whole tile, would read two or three columns at a
 /// time and restart the processor's prefetch streams at every turn; in blocks of this many rows
@@ -227,8 +236,7 @@ template <bool kCheck, bool kCopies, class UpdateComponent>
   return updateBlocksAs<Lanes4, kCheck, kCopies>(n, updateComponent);
 }
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define TICKFX_ROWS_AVX2 1
+#ifdef TICKFX_AVX2_CLONES
 /// updateBlocksAs() compiled for AVX2, eight rows a register: the kernels and everything they
 /// call are inlined here (flatten). The same operations on the same values as the baseline
 /// loops, so the same bits (test_passes runs every scheme on both paths).
@@ -243,7 +251,7 @@ template <bool kCheck, bool kCopies, class UpdateComponent>
 /// when `check` is set.
 template <bool kCheck, bool kCopies, class UpdateComponent>
 bool updateBlocks(Eigen::Index n, const UpdateComponent& updateComponent) {
-#ifdef TICKFX_ROWS_AVX2
+#ifdef TICKFX_AVX2_CLONES
   if (activeIsa() == Isa::Avx2) return updateBlocksAvx2<kCheck, kCopies>(n, updateComponent);
 #endif
   return updateBlocksBaseline<kCheck, kCopies>(n, updateComponent);
@@ -272,12 +280,10 @@ void updateComponents(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
 template <class Kernel, class ColumnsOf>
 void updateTile(NonfiniteCheck* check, ParticlePool& pool, RowRange rows, const Kernel& kernel,
                 const ColumnsOf& columnsOf) {
-  updateComponents(
-      check, pool, rows, [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
-        return std::apply(
-            [&](auto*... columns) { return loop(count, kernel, (columns + offset)...); },
-            columnsOf(c));
-      });
+  updateComponents(check, pool, rows,
+                   [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
+                     return loopAt(loop, kernel, offset, count, columnsOf(c));
+                   });
 }
 
 /// The check of a tile by exceptions (see NonfiniteCheck::steppedRowsFinite()), once its passes

@@ -106,10 +106,7 @@ void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange ro
       check, pool, rows,
       [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
         return withFormAccelerations(forms, c, [&](const auto& accelerations) {
-          const auto kernel = kernelFor(accelerations);
-          return std::apply(
-              [&](auto*... columns) { return loop(count, kernel, (columns + offset)...); },
-              columnsOf(c));
+          return loopAt(loop, kernelFor(accelerations), offset, count, columnsOf(c));
         });
       },
       copies);
@@ -130,11 +127,11 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
   Vec3Column& v = pool.velocity();
   // Fused tiles whose only other inputs are the forms: by exceptions when those are finite.
   const TileCheck tiles = tileCheck(check, pool, rows, forms.finite());
+  const bool copies = writesPreviousRows(pool, rows);
   runPasses(rows, true, scratch, {[&](const Tile& tile) {
               beforeTile(tile);
               const RowRange r = tile.rows();
               Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = previousRowsOf(pool, rows, r);
-              const bool copies = writesPreviousRows(pool, rows);
               std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
               updateTileUnderForms(
                   tiles.sums, pool, r, forms, kernelFor,

@@ -8,7 +8,7 @@ namespace tickfx {
 namespace {
 
 bool avx2Here() {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#ifdef TICKFX_AVX2_CLONES
   static const bool has = [] {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") != 0;

@@ -7,6 +7,12 @@
 
 #include <optional>
 
+/// Defined where the build can compile AVX2 clones (x86-64 with GCC or Clang): the one condition
+/// every dispatching loop and Isa.cpp test.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define TICKFX_AVX2_CLONES 1
+#endif
+
 namespace tickfx {
 
 enum class Isa { Baseline = 0, Avx2 = 1 };
@@ -26,5 +32,14 @@ void forceIsa(std::optional<Isa> isa);
 
 /// "baseline" or "AVX2", for messages and bench labels.
 const char* isaName(Isa isa);
+
+/// forceIsa(isa) while alive, the default (the widest) again after: a test's or a bench's path.
+class ForcedIsa {
+ public:
+  explicit ForcedIsa(Isa isa) { forceIsa(isa); }
+  ~ForcedIsa() { forceIsa(std::nullopt); }
+  ForcedIsa(const ForcedIsa&) = delete;
+  ForcedIsa& operator=(const ForcedIsa&) = delete;
+};
 
 }  // namespace tickfx

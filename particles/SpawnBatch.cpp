@@ -12,8 +12,7 @@
 #include "particles/Isa.h"
 #include "particles/Random.h"
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define TICKFX_SPAWN_AVX2 1
+#ifdef TICKFX_AVX2_CLONES
 #include <immintrin.h>
 #endif
 
@@ -76,7 +75,7 @@ void sincosOfTurns(const double* turns, Chunk& c) {
   det::kernel::sincosSmall(c.w, c.sine, c.cosine, c.n);
 }
 
-#ifdef TICKFX_SPAWN_AVX2
+#ifdef TICKFX_AVX2_CLONES
 // det::sqrtClampedBlock() four lanes wide: the same max (0 for nan and −0) and IEEE square root.
 [[gnu::target("avx2")]] void sqrtClampedAvx2(double* x, std::size_t n) {
   std::size_t i = 0;
@@ -90,7 +89,7 @@ void sincosOfTurns(const double* turns, Chunk& c) {
 // x[i] = sqrt(max(0, x[i])), on the path's vector width.
 template <bool kAvx2>
 void sqrtClamped(double* x, std::size_t n) {
-#ifdef TICKFX_SPAWN_AVX2
+#ifdef TICKFX_AVX2_CLONES
   if constexpr (kAvx2) {
     sqrtClampedAvx2(x, n);
     return;
@@ -268,7 +267,7 @@ void spawnChunk(const SpawnRecipe& r, std::uint64_t first, std::uint64_t stride,
   writePositions(r, c, first, stride, out);
 }
 
-#ifdef TICKFX_SPAWN_AVX2
+#ifdef TICKFX_AVX2_CLONES
 // spawnChunk() compiled for AVX2: everything it calls in this file (and the sine and cosine
 // kernels) is inlined here and vectorised four doubles wide, where the baseline build has two.
 // The same operations in the same order: integer ones, and IEEE ones that AVX2 rounds as SSE2
@@ -299,7 +298,7 @@ void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64
   const bool avx2 = activeIsa() == Isa::Avx2;
   for (std::size_t k = 0; k < count; k += kChunk) {
     chunk.n = std::min(kChunk, count - k);
-#ifdef TICKFX_SPAWN_AVX2
+#ifdef TICKFX_AVX2_CLONES
     if (avx2) {
       spawnChunkAvx2(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
       continue;

@@ -25,7 +25,6 @@
 namespace tickfx {
 namespace {
 
-using test::ForcedIsa;
 using test::isasHere;
 
 struct Case {

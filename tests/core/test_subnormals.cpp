@@ -63,60 +63,62 @@ TEST(FlushTiny, SubnormalsBecomeSignedZerosAndNothingElseChanges) {
   }
 }
 
-// Particles at the origin with tiny speeds, under a strong drag alone: without the flush their
-// velocities and positions would be subnormal for tens of ticks. Every scheme, with the position
-// Verlet history kept, goes from normal values straight to exact zeros, and every stored value of
-// every tick is normal or zero: on every path of the update loops (particles/Isa.h), with rows in
-// a loop's vector body (the first 16) and in its tail.
-TEST(Subnormals, ADecayGoesFromNormalValuesToExactZerosInEveryScheme) {
+// Particles with the velocities `speeds` (scaled per axis) at the origin, under a strong drag
+// alone, stepped by the scheme `name`: every stored value of every tick is normal or zero, and
+// each speed goes from a normal value straight to exact zeros.
+void expectDecayToExactZeros(const std::string& name, const std::vector<float>& speeds) {
   constexpr std::int64_t kRate = 60;
   constexpr int kTicks = 400;
+  ParticlePool pool(speeds.size());
+  for (float s : speeds) {
+    ParticleInit init;
+    init.velocity = Eigen::Vector3f(s, -0.5f * s, 0.25f * s);
+    pool.spawn(init, 0);
+  }
+  ForceSet forces;
+  forces.add(std::make_unique<LinearDrag>(20.0f));
+  std::unique_ptr<Integrator> scheme = makeIntegrator(name);
+  std::vector<float> last = speeds;
+  std::vector<bool> crossed(speeds.size(), false);
+  for (std::int64_t k = 0; k < kTicks; ++k) {
+    scheme->step(pool, forces, StepTime{k, kRate});
+    pool.markAllStepped();
+    for (std::size_t i = 0; i < pool.size(); ++i) {
+      const auto r = static_cast<Eigen::Index>(i);
+      for (int c = 0; c < 3; ++c) {
+        for (float value : {pool.position()[c][r], pool.velocity()[c][r]}) {
+          ASSERT_TRUE(value == 0.0f || std::fabs(value) >= FLT_MIN)
+              << name << ", tick " << k + 1 << ", row " << i << ": " << value;
+        }
+      }
+      const float v = pool.velocity().x[r];
+      // A crossing: a normal speed within a few of FLT_MIN, then exactly zero.
+      if (v == 0.0f && last[i] != 0.0f && std::fabs(last[i]) < 64.0f * FLT_MIN) crossed[i] = true;
+      last[i] = v;
+    }
+  }
+  for (std::size_t i = 0; i < pool.size(); ++i) {
+    // Position Verlet's velocity is a difference of positions: where a position is far above
+    // its steps (5e-32 m, steps of 1e-39), it moves by whole ulps and never settles to zero.
+    const auto r = static_cast<Eigen::Index>(i);
+    if (name == "position_verlet" && pool.position().x[r] != 0.0f) continue;
+    EXPECT_TRUE(crossed[i]) << name << ", row " << i;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(pool.velocity()[c][r], 0.0f) << name << ", row " << i;
+  }
+}
+
+// Without the flush these velocities and positions would be subnormal for tens of ticks. Every
+// scheme, with the position Verlet history kept, on every path of the update loops
+// (particles/Isa.h), with rows in a loop's vector body (the first 16) and in its tail.
+TEST(Subnormals, ADecayGoesFromNormalValuesToExactZerosInEveryScheme) {
   std::vector<float> speeds;
   for (int copy = 0; copy < 4; ++copy) {
     for (const float s : {1e-30f, 3e-35f, 1e-36f, -2.5e-37f, 1.2e-38f}) speeds.push_back(s);
   }
   for (const Isa isa : test::isasHere()) {
-    const test::ForcedIsa forced(isa);
+    const ForcedIsa forced(isa);
     SCOPED_TRACE(isaName(isa));
-    for (const std::string& name : kSchemes) {
-      ParticlePool pool(speeds.size());
-      for (float s : speeds) {
-        ParticleInit init;
-        init.velocity = Eigen::Vector3f(s, -0.5f * s, 0.25f * s);
-        pool.spawn(init, 0);
-      }
-      ForceSet forces;
-      forces.add(std::make_unique<LinearDrag>(20.0f));
-      std::unique_ptr<Integrator> scheme = makeIntegrator(name);
-      std::vector<float> last = speeds;
-      std::vector<bool> crossed(speeds.size(), false);
-      for (std::int64_t k = 0; k < kTicks; ++k) {
-        scheme->step(pool, forces, StepTime{k, kRate});
-        pool.markAllStepped();
-        for (std::size_t i = 0; i < pool.size(); ++i) {
-          const auto r = static_cast<Eigen::Index>(i);
-          for (int c = 0; c < 3; ++c) {
-            for (float value : {pool.position()[c][r], pool.velocity()[c][r]}) {
-              ASSERT_TRUE(value == 0.0f || std::fabs(value) >= FLT_MIN)
-                  << name << ", tick " << k + 1 << ", row " << i << ": " << value;
-            }
-          }
-          const float v = pool.velocity().x[r];
-          // A crossing: a normal speed within a few of FLT_MIN, then exactly zero.
-          if (v == 0.0f && last[i] != 0.0f && std::fabs(last[i]) < 64.0f * FLT_MIN)
-            crossed[i] = true;
-          last[i] = v;
-        }
-      }
-      for (std::size_t i = 0; i < pool.size(); ++i) {
-        // Position Verlet's velocity is a difference of positions: where a position is far above
-        // its steps (5e-32 m, steps of 1e-39), it moves by whole ulps and never settles to zero.
-        const auto r = static_cast<Eigen::Index>(i);
-        if (name == "position_verlet" && pool.position().x[r] != 0.0f) continue;
-        EXPECT_TRUE(crossed[i]) << name << ", row " << i;
-        for (int c = 0; c < 3; ++c) EXPECT_EQ(pool.velocity()[c][r], 0.0f) << name << ", row " << i;
-      }
-    }
+    for (const std::string& name : kSchemes) expectDecayToExactZeros(name, speeds);
   }
 }
 
