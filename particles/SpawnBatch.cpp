@@ -37,42 +37,42 @@ void drawKeys(std::uint64_t emitterKey, std::uint64_t first, std::uint64_t strid
   for (std::size_t i = 0; i < c.n; ++i) c.key[i] = particleKey(emitterKey, first + i * stride);
 }
 
-// uniformFromBits(bits), exactly, in operations every vector unit has: the 53-bit integer is
-// split into its high 21 and low 32 bits, each made a double by the exponent trick (exact), and
-// the two summed (exact: the sum has 53 bits). A cast from a 64-bit integer has no SSE2 or AVX2
-// vector form, so a loop of them stays scalar.
-double uniformOfBits(std::uint64_t bits) {
-  const std::uint64_t v = bits >> 11;
-  const double low = std::bit_cast<double>(0x4330000000000000ULL | (v & 0xffffffffULL)) - 0x1p52;
-  const double high = std::bit_cast<double>(0x4530000000000000ULL | (v >> 32)) - 0x1p84;
-  return (high + low) * 0x1p-53;
-}
+// The identity, for draws stored as they are.
+struct AsDrawn {
+  double operator()(std::size_t, double u) const { return u; }
+};
 
-// out[k][i] = ParticleRandom::uniform(purposes[k]) of particle i, for every particle of the chunk.
-// The draws are 64-bit integer multiplies: scalar in the SSE2 build (emulated they are no faster
-// there), four lanes wide in the AVX2 path. A few purposes a loop share the key's load.
-template <std::size_t K>
+// out[k][i] = map(k, ParticleRandom::uniform(purposes[k]) of particle i), for every particle of
+// the chunk: what a draw becomes is worked out in the loop that draws it. The draws are 64-bit
+// integer multiplies: scalar in the SSE2 build (emulated they are no faster there), four lanes
+// wide in the AVX2 path. A few purposes a loop share the key's load.
+template <std::size_t K, class Map = AsDrawn>
 void drawUniforms(const Chunk& c, const std::array<RandomPurpose, K>& purposes,
-                  const std::array<double*, K>& out) {
+                  const std::array<double*, K>& out, Map map = {}) {
   std::array<std::uint32_t, K> p;
   for (std::size_t k = 0; k < K; ++k) p[k] = static_cast<std::uint32_t>(purposes[k]);
   for (std::size_t i = 0; i < c.n; ++i) {
     const std::uint64_t key = c.key[i];
-    for (std::size_t k = 0; k < K; ++k) out[k][i] = uniformOfBits(purposeBits(key, p[k]));
+    for (std::size_t k = 0; k < K; ++k) out[k][i] = map(k, uniformFromBits(purposeBits(key, p[k])));
   }
 }
 
-void drawUniform(const Chunk& c, RandomPurpose purpose, double* out) {
-  drawUniforms<1>(c, {purpose}, {out});
+template <class Map = AsDrawn>
+void drawUniform(const Chunk& c, RandomPurpose purpose, double* out, Map map = {}) {
+  drawUniforms<1>(c, {purpose}, {out}, [&](std::size_t, double u) { return map(0, u); });
 }
 
-// det::sincos() of 2π · turns for uniform `turns` in [0, 1): arguments below 2π, far inside the
-// range of the vectorised reduction (det::kernel::sincosSmall, |x| < 2^19), so none needs
-// det::sincosBlock()'s fallback. Inline, so that the AVX2 path vectorises it with its width.
-void sincosOfTurns(const double* turns, Chunk& c) {
+// A uniform number of turns in [0, 1) as an angle: below 2π, far inside the range of the
+// vectorised reduction (det::kernel::sincosSmall, |x| < 2^19), so none needs
+// det::sincosBlock()'s fallback.
+double angleOfTurns(double turns) {
   static_assert(kTwoPi < det::kernel::kCodyWaiteLimit);
-  for (std::size_t i = 0; i < c.n; ++i) c.w[i] = kTwoPi * turns[i];
-  det::kernel::sincosSmall(c.w, c.sine, c.cosine, c.n);
+  return kTwoPi * turns;
+}
+
+// c.sine and c.cosine of the angles. Inline, so that the AVX2 path vectorises it with its width.
+void sincosOf(const double* angles, Chunk& c) {
+  det::kernel::sincosSmall(angles, c.sine, c.cosine, c.n);
 }
 
 #ifdef TICKFX_AVX2_CLONES
@@ -100,22 +100,17 @@ void sqrtClamped(double* x, std::size_t n) {
 
 void boxOffsets(const SpawnRecipe& r, Chunk& c) {
   drawUniforms<3>(c, {RandomPurpose::PositionU, RandomPurpose::PositionV, RandomPurpose::PositionW},
-                  {c.offset[0], c.offset[1], c.offset[2]});
-  for (int axis = 0; axis < 3; ++axis) {
-    const double size = r.boxSize[axis];
-    for (std::size_t i = 0; i < c.n; ++i) c.offset[axis][i] = (c.offset[axis][i] - 0.5) * size;
-  }
+                  {c.offset[0], c.offset[1], c.offset[2]},
+                  [&](std::size_t axis, double u) { return (u - 0.5) * r.boxSize[axis]; });
 }
 
 template <bool kAvx2>
 void sphereOffsets(const SpawnRecipe& r, Chunk& c) {
-  drawUniforms<2>(c, {RandomPurpose::PositionU, RandomPurpose::PositionV}, {c.u, c.v});
-  sincosOfTurns(c.v, c);
-  // c.u becomes z, c.v the distance from the z axis on the unit sphere.
-  for (std::size_t i = 0; i < c.n; ++i) {
-    c.u[i] = 1.0 - 2.0 * c.u[i];
-    c.v[i] = 1.0 - c.u[i] * c.u[i];
-  }
+  // c.u becomes z, c.v the angle about the z axis, then the distance from it on the unit sphere.
+  drawUniforms<2>(c, {RandomPurpose::PositionU, RandomPurpose::PositionV}, {c.u, c.v},
+                  [](std::size_t k, double u) { return k == 0 ? 1.0 - 2.0 * u : angleOfTurns(u); });
+  sincosOf(c.v, c);
+  for (std::size_t i = 0; i < c.n; ++i) c.v[i] = 1.0 - c.u[i] * c.u[i];
   sqrtClamped<kAvx2>(c.v, c.n);
   // c.w becomes the radius: the sphere's, or the cube root's share of it inside.
   if (r.surface) {
@@ -135,9 +130,10 @@ void sphereOffsets(const SpawnRecipe& r, Chunk& c) {
 
 template <bool kAvx2>
 void discOffsets(const SpawnRecipe& r, Chunk& c) {
-  drawUniforms<2>(c, {RandomPurpose::PositionU, RandomPurpose::PositionV}, {c.u, c.v});
+  drawUniforms<2>(c, {RandomPurpose::PositionU, RandomPurpose::PositionV}, {c.u, c.v},
+                  [](std::size_t k, double u) { return k == 0 ? u : angleOfTurns(u); });
   sqrtClamped<kAvx2>(c.u, c.n);  // a uniform number is >= 0: the clamp changes nothing
-  sincosOfTurns(c.v, c);
+  sincosOf(c.v, c);
   for (std::size_t i = 0; i < c.n; ++i) {
     const double radius = r.radius * c.u[i];
     const double along1 = radius * c.cosine[i], along2 = radius * c.sine[i];
@@ -168,13 +164,13 @@ void shapeOffsets(const SpawnRecipe& r, Chunk& c) {
 // Uniform over the spherical cap of half-angle `spread` around the direction.
 template <bool kAvx2>
 void spreadDirections(const SpawnRecipe& r, Chunk& c) {
-  drawUniforms<2>(c, {RandomPurpose::DirectionU, RandomPurpose::DirectionV}, {c.u, c.v});
-  sincosOfTurns(c.v, c);
-  // c.u becomes cos θ, c.v sin θ.
-  for (std::size_t i = 0; i < c.n; ++i) {
-    c.u[i] = 1.0 - c.u[i] * (1.0 - r.cosSpread);
-    c.v[i] = 1.0 - c.u[i] * c.u[i];
-  }
+  // c.u becomes cos θ; c.v the angle about the direction, then sin θ.
+  const double capHeight = 1.0 - r.cosSpread;
+  drawUniforms<2>(
+      c, {RandomPurpose::DirectionU, RandomPurpose::DirectionV}, {c.u, c.v},
+      [&](std::size_t k, double u) { return k == 0 ? 1.0 - u * capHeight : angleOfTurns(u); });
+  sincosOf(c.v, c);
+  for (std::size_t i = 0; i < c.n; ++i) c.v[i] = 1.0 - c.u[i] * c.u[i];
   sqrtClamped<kAvx2>(c.v, c.n);
   for (std::size_t i = 0; i < c.n; ++i) {
     const double along1 = c.v[i] * c.cosine[i], along2 = c.v[i] * c.sine[i];
@@ -187,14 +183,13 @@ void spreadDirections(const SpawnRecipe& r, Chunk& c) {
 
 // value · (1 ± jitter), the sign and size drawn for `purpose`. Without jitter the factor is
 // exactly 1 (1 + 0 · (2u − 1) = 1 for any u), so nothing is drawn.
-void jittered(const Chunk& c, RandomPurpose purpose, double value, double jitter, double* out,
-              double* scratch) {
+void jittered(const Chunk& c, RandomPurpose purpose, double value, double jitter, double* out) {
   if (jitter == 0.0) {
     std::fill_n(out, c.n, value);
     return;
   }
-  drawUniform(c, purpose, scratch);
-  for (std::size_t i = 0; i < c.n; ++i) out[i] = value * (1.0 + jitter * (2.0 * scratch[i] - 1.0));
+  drawUniform(c, purpose, out,
+              [&](std::size_t, double u) { return value * (1.0 + jitter * (2.0 * u - 1.0)); });
 }
 
 // The emitter's position plus the offset, rounded to float once; for a point list, its point.
@@ -241,9 +236,9 @@ void spawnChunk(const SpawnRecipe& r, std::uint64_t first, std::uint64_t stride,
   const bool listVelocities = !r.pointVelocities.empty();
   if (!listVelocities) {
     if (r.spreadDegrees > 0.0) spreadDirections<kAvx2>(r, c);
-    jittered(c, RandomPurpose::Speed, r.speed, r.speedJitter, c.speed, c.u);
+    jittered(c, RandomPurpose::Speed, r.speed, r.speedJitter, c.speed);
   }
-  jittered(c, RandomPurpose::Lifetime, r.lifetime, r.lifetimeJitter, c.life, c.u);
+  jittered(c, RandomPurpose::Lifetime, r.lifetime, r.lifetimeJitter, c.life);
   const auto mass = static_cast<float>(r.mass);
   float* __restrict life = out.lifetime;
   float* __restrict masses = out.mass;

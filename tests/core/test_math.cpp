@@ -176,6 +176,34 @@ TEST(DetMath, SincosGivesTheBitsOfSinAndCos) {
   EXPECT_TRUE(std::isnan(s) && std::isnan(c));
 }
 
+// uniformFromBits() builds the double from bit fields (for the batch loops' vector units): it is
+// the 53-bit integer's value times 2^-53, bit for bit, on every bit pattern tried.
+TEST(Random, UniformFromBitsIsTheTop53BitsTimesTwoToTheMinus53) {
+  const auto cast = [](std::uint64_t bits) {
+    return static_cast<double>(bits >> 11) * 0x1.0p-53;  // exact: 53 bits, a power of two
+  };
+  std::vector<std::uint64_t> patterns = {0,
+                                         0x7ff,
+                                         0x800,
+                                         0xfff,
+                                         0x1000,
+                                         0x1800,
+                                         ~0ULL,
+                                         ~0ULL - 0x800,
+                                         1ULL << 63,
+                                         (1ULL << 63) | 0x800,
+                                         0x5555555555555555ULL,
+                                         0xaaaaaaaaaaaaaaaaULL};
+  for (int bit = 0; bit < 64; ++bit) patterns.push_back(1ULL << bit);
+  for (std::uint64_t serial = 0; serial < 100'000; ++serial)
+    patterns.push_back(randomBits(RandomKey{7, 1, serial, 2}));
+  for (const std::uint64_t bits : patterns) {
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(uniformFromBits(bits)),
+              std::bit_cast<std::uint64_t>(cast(bits)))
+        << std::hex << bits;
+  }
+}
+
 TEST(Random, UniformIsInTheHalfOpenUnitIntervalWithMeanOneHalf) {
   EXPECT_EQ(uniformFromBits(0), 0.0);
   EXPECT_LT(uniformFromBits(~std::uint64_t{0}), 1.0);
