@@ -39,6 +39,16 @@ double median(std::vector<double> v) {
 Case::Case(std::string caseName, std::function<void(std::int64_t)> runTicks)
     : name(std::move(caseName)), run(std::move(runTicks)) {}
 
+double pairedShare(const Case& with, const Case& without) {
+  const std::size_t rounds = std::min(with.secondsPerTick.size(), without.secondsPerTick.size());
+  std::vector<double> shares(rounds);
+  for (std::size_t r = 0; r < rounds; ++r) {
+    const double w = with.secondsPerTick[r];
+    shares[r] = (w - without.secondsPerTick[r]) / w;
+  }
+  return rounds > 0 ? median(shares) : 0.0;
+}
+
 double Case::fastest() const {
   return *std::min_element(secondsPerTick.begin(), secondsPerTick.end());
 }

@@ -88,6 +88,12 @@ inline double speedup(const Case& c, const Case& baseline) {
   return baseline.seconds() / c.seconds();
 }
 
+/// The share of `with`'s tick that `without` does not spend, (with − without) / with, paired
+/// round by round: timeCases() runs one batch of each case a round, so a load on the machine that
+/// changes between rounds moves both batches of a round alike and cancels in their ratio. The
+/// median over the rounds; the batches' seconds must be of the same timeCases() call.
+double pairedShare(const Case& with, const Case& without);
+
 /// One batch of `c`: `before`, the timed run, `after`. When `record`, its time, CPU seconds and
 /// count go to the case. Its seconds, or nothing when `after` says stop.
 std::optional<double> timeBatch(Case& c, bool record);
