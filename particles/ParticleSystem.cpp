@@ -256,7 +256,9 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
     if (!frameStart_) frameStart_ = std::make_unique<FrameStart>();
     frameStart_->reserve(pool_, integrator_->readsPreviousPosition());
   }
-  if (keepVelocities) previousVelocity_.resize(static_cast<Eigen::Index>(rows));
+  // Every row is copied in the frame's last tick: none kept (keeping them would move them all to
+  // the storage's front once the rows dropped there by deaths fill it).
+  if (keepVelocities) previousVelocity_.setRows(rows, 0);
   if (keepPrevious) pool_.keepPrevious();
 
   // Blocks never straddle a birth tick: block i starts at tick first + firstTick[i].
@@ -347,7 +349,7 @@ void ParticleSystem::runTick(bool shown) {
   }
   std::optional<profile::PhaseScope> phase(std::in_place, profile::Phase::Step);
   if (keepVelocities) {
-    previousVelocity_.resize(static_cast<Eigen::Index>(pool_.size()));
+    previousVelocity_.setRows(pool_.size(), 0);  // all copied below: none kept (see above)
     parallelForRows(pool_.size(), [&](std::size_t b, std::size_t e) {
       previousVelocity_.copyRows(pool_.velocity(), b, e);
     });
