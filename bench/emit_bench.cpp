@@ -545,9 +545,9 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
   figures.push_back({buf});
   std::snprintf(buf, sizeof buf,
                 "steady %s Emitter::emit alone: %.1f %% of the tick (%.4g ms, %s spawns/s; the "
-                "rest of the cost, %.4g ms, is the deaths)",
+                "rest of the paired cost, %.4g ms, is the deaths)",
                 pop.c_str(), 100.0 * emitAlone / with, 1e3 * emitAlone,
-                sci(perTick / emitAlone).c_str(), 1e3 * (with - without - emitAlone));
+                sci(perTick / emitAlone).c_str(), 1e3 * (share * with - emitAlone));
   figures.push_back({buf});
   const double withFused = cases[3].seconds();
   const double withoutFused = cases[4].seconds();

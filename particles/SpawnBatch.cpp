@@ -59,7 +59,7 @@ void drawUniforms(const Chunk& c, const std::array<RandomPurpose, K>& purposes,
 
 template <class Map = AsDrawn>
 void drawUniform(const Chunk& c, RandomPurpose purpose, double* out, Map map = {}) {
-  drawUniforms<1>(c, {purpose}, {out}, [&](std::size_t, double u) { return map(0, u); });
+  drawUniforms<1>(c, {purpose}, {out}, map);
 }
 
 // A uniform number of turns in [0, 1) as an angle: below 2π, far inside the range of the
