@@ -49,6 +49,14 @@ double pairedShare(const Case& with, const Case& without) {
   return rounds > 0 ? median(shares) : 0.0;
 }
 
+double pairedSpeedup(const Case& c, const Case& baseline) {
+  const std::size_t rounds = std::min(c.secondsPerTick.size(), baseline.secondsPerTick.size());
+  std::vector<double> ratios(rounds);
+  for (std::size_t r = 0; r < rounds; ++r)
+    ratios[r] = baseline.secondsPerTick[r] / c.secondsPerTick[r];
+  return rounds > 0 ? median(ratios) : 0.0;
+}
+
 double Case::fastest() const {
   return *std::min_element(secondsPerTick.begin(), secondsPerTick.end());
 }

@@ -94,6 +94,12 @@ inline double speedup(const Case& c, const Case& baseline) {
 /// median over the rounds; the batches' seconds must be of the same timeCases() call.
 double pairedShare(const Case& with, const Case& without);
 
+/// speedup() paired round by round as pairedShare() pairs them: the median over the rounds of
+/// `baseline`'s seconds over `c`'s. Each figure of two cases moves with the machine's load, and
+/// their ratio moved with it by up to half on a loaded guest; a round's two batches see the same
+/// load.
+double pairedSpeedup(const Case& c, const Case& baseline);
+
 /// One batch of `c`: `before`, the timed run, `after`. When `record`, its time, CPU seconds and
 /// count go to the case. Its seconds, or nothing when `after` says stop.
 std::optional<double> timeBatch(Case& c, bool record);

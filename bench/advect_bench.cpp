@@ -306,11 +306,13 @@ int main(int argc, char** argv) {
     const AdvectCase& pointAdvect = cases[i + 1];
     const AdvectCase& advectPoints = cases[i + 2];
     std::printf(
-        "advect order %d %s %s %s: %.2fx advectPoints (target >= 2x), %.2fx PointAdvect, %s "
-        "particle-steps/s (advectPoints %s, PointAdvect %s",
+        "advect order %d %s %s %s: %.2fx advectPoints paired round by round (target >= 2x; "
+        "%.2fx by the medians), %.2fx PointAdvect, %s particle-steps/s (advectPoints %s, "
+        "PointAdvect %s",
         c.order, bench::threadsLabel(c.threads).c_str(), c.name.substr(0, c.name.find(' ')).c_str(),
-        bench::sizeLabel(count).c_str(), bench::speedup(c, advectPoints),
-        bench::speedup(c, pointAdvect), bench::g3(static_cast<double>(count) / c.seconds()).c_str(),
+        bench::sizeLabel(count).c_str(), bench::pairedSpeedup(c, advectPoints),
+        bench::speedup(c, advectPoints), bench::speedup(c, pointAdvect),
+        bench::g3(static_cast<double>(count) / c.seconds()).c_str(),
         bench::g3(static_cast<double>(count) / advectPoints.seconds()).c_str(),
         bench::g3(static_cast<double>(count) / pointAdvect.seconds()).c_str());
     if (c.threads > 1) std::printf("; %.2f of %d cores busy", c.cores(), c.threads);

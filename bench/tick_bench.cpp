@@ -353,6 +353,10 @@ struct Row {
   double stepsPerSecond;
   double ratio;
   double cores;  // CPU over wall time while the case ran
+  // bench::pairedSpeedup() over the hand SoA loop on 1 thread, and over the case's own 1-thread
+  // form (0 for a case on 1 thread): the figures the targets are read from.
+  double pairedHand = 0.0;
+  double pairedOneThread = 0.0;
 };
 
 // Ticks a frame in the fused cases (issue 13's target: 4).
@@ -482,12 +486,27 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
 
   // The AoS loop is the baseline every ratio of the table is to.
   const bench::Case& aosCase = cases.front();
+  const auto named = [&](const std::string& name) -> const bench::Case* {
+    for (const bench::Case& c : cases) {
+      if (c.name == name) return &c;
+    }
+    return nullptr;
+  };
+  const bench::Case& handCase = *named("hand SoA loop, " + threadsLabel(1));
+  const std::string allLabel = threadsLabel(allThreads);
   for (const bench::Case& c : cases) {
     const double s = c.seconds();
     std::printf("  %-30s %10.4f ms/tick  (median of %zu batches of %lld ticks; %.4f to %.4f)\n",
                 c.name.c_str(), 1e3 * s, c.secondsPerTick.size(), static_cast<long long>(c.batch),
                 1e3 * c.fastest(), 1e3 * c.slowest());
-    rows.push_back({n, c.name, static_cast<double>(n) / s, bench::speedup(c, aosCase), c.cores()});
+    Row r{n, c.name, static_cast<double>(n) / s, bench::speedup(c, aosCase), c.cores()};
+    r.pairedHand = bench::pairedSpeedup(c, handCase);
+    const std::size_t at = c.name.rfind(allLabel);
+    if (allThreads > 1 && at != std::string::npos && at + allLabel.size() == c.name.size()) {
+      if (const bench::Case* single = named(c.name.substr(0, at) + threadsLabel(1)))
+        r.pairedOneThread = bench::pairedSpeedup(c, *single);
+    }
+    rows.push_back(r);
   }
   std::fflush(stdout);
 
@@ -597,7 +616,7 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
       for (const Row& r : rows) {
         if (r.n == n && r.name == name) return r;
       }
-      return Row{n, name, 0.0, 0.0, 0.0};
+      return Row{n, name, 0.0, 0.0, 0.0, 0.0, 0.0};
     };
     const std::string size = bench::sizeLabel(n);
     const char* z = size.c_str();
@@ -613,9 +632,9 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
         "tick integrate 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread; %.2fx AoS)\n", z,
         rate(integrate).c_str(), integrate.stepsPerSecond / h, integrate.stepsPerSecond / a);
     std::printf(
-        "tick step 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread, target >= 0.9x; "
-        "%.2fx AoS)\n",
-        z, rate(step).c_str(), step.stepsPerSecond / h, step.stepsPerSecond / a);
+        "tick step 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread paired round by "
+        "round, target >= 0.9x; %.2fx by the medians; %.2fx AoS)\n",
+        z, rate(step).c_str(), step.pairedHand, step.stepsPerSecond / h, step.stepsPerSecond / a);
     const Row soaAvx2 = row("hand SoA loop AVX2, 1 thread"),
               stepSse2 = row("tickfx step(), 1 t., SSE2");
     if (soaAvx2.stepsPerSecond > 0.0) {
@@ -632,10 +651,10 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
     }
     const Row fused = row(fusedLabel(1));
     std::printf(
-        "tick fused %lld ticks a frame 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread, "
-        "target >= 1.5x at 1e7; %.2fx tickfx step())\n",
-        static_cast<long long>(kFusedTicks), z, rate(fused).c_str(), fused.stepsPerSecond / h,
-        fused.stepsPerSecond / step.stepsPerSecond);
+        "tick fused %lld ticks a frame 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread "
+        "paired, target >= 1.5x at 1e7; %.2fx by the medians; %.2fx tickfx step())\n",
+        static_cast<long long>(kFusedTicks), z, rate(fused).c_str(), fused.pairedHand,
+        fused.stepsPerSecond / h, fused.stepsPerSecond / step.stepsPerSecond);
     if (allThreads == 1) continue;
     const Row fusedAll = row(fusedLabel(allThreads));
     std::printf(
@@ -654,10 +673,12 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
         z, rate(integrateAll).c_str(), integrateAll.stepsPerSecond / integrate.stepsPerSecond,
         integrateAll.stepsPerSecond / hAll, t);
     std::printf(
-        "tick step %s %s: %s particle-steps/s (%.2fx tickfx 1 thread, target >= 1.8x at 1e7; "
-        "%.2fx hand SoA %s; %.2f of %d cores busy)\n",
-        t, z, rate(stepAll).c_str(), stepAll.stepsPerSecond / step.stepsPerSecond,
-        stepAll.stepsPerSecond / hAll, t, stepAll.cores, allThreads);
+        "tick step %s %s: %s particle-steps/s (%.2fx tickfx 1 thread paired, target >= 1.8x at "
+        "1e7; %.2fx by the medians; %.2fx hand SoA %s, which gains %.2fx paired; %.2f of %d cores "
+        "busy)\n",
+        t, z, rate(stepAll).c_str(), stepAll.pairedOneThread,
+        stepAll.stepsPerSecond / step.stepsPerSecond, stepAll.stepsPerSecond / hAll, t,
+        soaAll.pairedOneThread, stepAll.cores, allThreads);
   }
 }
 
