@@ -39,22 +39,27 @@ double median(std::vector<double> v) {
 Case::Case(std::string caseName, std::function<void(std::int64_t)> runTicks)
     : name(std::move(caseName)), run(std::move(runTicks)) {}
 
+namespace {
+
+// The median over the rounds both cases have of f(a's seconds, b's seconds) in that round; 0
+// without one.
+template <class F>
+double medianOverRounds(const Case& a, const Case& b, const F& f) {
+  const std::size_t rounds = std::min(a.secondsPerTick.size(), b.secondsPerTick.size());
+  if (rounds == 0) return 0.0;
+  std::vector<double> values(rounds);
+  for (std::size_t r = 0; r < rounds; ++r) values[r] = f(a.secondsPerTick[r], b.secondsPerTick[r]);
+  return median(std::move(values));
+}
+
+}  // namespace
+
 double pairedShare(const Case& with, const Case& without) {
-  const std::size_t rounds = std::min(with.secondsPerTick.size(), without.secondsPerTick.size());
-  std::vector<double> shares(rounds);
-  for (std::size_t r = 0; r < rounds; ++r) {
-    const double w = with.secondsPerTick[r];
-    shares[r] = (w - without.secondsPerTick[r]) / w;
-  }
-  return rounds > 0 ? median(shares) : 0.0;
+  return medianOverRounds(with, without, [](double w, double wo) { return (w - wo) / w; });
 }
 
 double pairedSpeedup(const Case& c, const Case& baseline) {
-  const std::size_t rounds = std::min(c.secondsPerTick.size(), baseline.secondsPerTick.size());
-  std::vector<double> ratios(rounds);
-  for (std::size_t r = 0; r < rounds; ++r)
-    ratios[r] = baseline.secondsPerTick[r] / c.secondsPerTick[r];
-  return rounds > 0 ? median(ratios) : 0.0;
+  return medianOverRounds(c, baseline, [](double s, double base) { return base / s; });
 }
 
 double Case::fastest() const {
