@@ -50,6 +50,11 @@ Eigen::Vector3f CollisionPath::at(float alpha, const Eigen::Vector3f& end) const
 
 void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz,
                           bool history) {
+  if (!colliders_.empty() && !pool.keepsPrevious()) {
+    // A path starts at the previous position: without the column there is no path to test.
+    throw std::invalid_argument(
+        "colliders need the pool's previous positions: call ParticlePool::keepPrevious() first");
+  }
   beginTick(pool, tick, stepRateHz, history);
   if (!colliders_.empty()) {
     parallelForRows(pool.size(),
@@ -63,11 +68,6 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
   paths_.clear();
   contacts_ = 0;
   if (colliders_.empty()) return;
-  if (!pool.keepsPrevious()) {
-    // A path starts at the previous position: without the column there is no path to test.
-    throw std::invalid_argument(
-        "colliders need the pool's previous positions: call ParticlePool::keepPrevious() first");
-  }
   for (auto& c : colliders_) c->beginTick(tick, stepRateHz);
   TickState& t = tick_;
   t.dt = static_cast<float>(1.0 / static_cast<double>(stepRateHz));
@@ -75,6 +75,8 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
   // the step, in float.
   t.start = static_cast<float>(static_cast<double>(tick) / static_cast<double>(stepRateHz));
   t.history = history;
+  t.kills = false;
+  for (const auto& c : colliders_) t.kills |= c->settings().response == ColliderResponse::Kill;
   t.blocks = (pool.size() + kParallelBlockRows - 1) / kParallelBlockRows;
   blockPaths_.resize(std::max(blockPaths_.size(), t.blocks));
   for (std::size_t k = 0; k < t.blocks; ++k) blockPaths_[k].clear();
@@ -92,23 +94,28 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
   }
 }
 
-void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t end) {
+void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t end,
+                              const std::array<const float*, 3>& given) {
   if (colliders_.empty() || begin >= end) return;
   TICKFX_ASSERT(begin % kParallelBlockRows == 0 && end - begin <= kParallelBlockRows,
                 "collideRows() takes whole blocks of kParallelBlockRows rows");
+  TICKFX_ASSERT((given[0] != nullptr && !tick_.history) || pool.keepsPrevious(),
+                "paths start at the pool's previous positions, which it does not keep");
   const TickState& t = tick_;
   const float dt = t.dt;
   Vec3Column& pos = pool.position();
   Vec3Column& vel = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
-  std::uint8_t* dead = pool.dead().data();
+  // Only a kill flags a row: a mutable dead() would have the tick's end scan every row for none.
+  std::uint8_t* const dead = t.kills ? pool.dead().data() : nullptr;
   const std::uint64_t* ids = pool.id().data();
   std::vector<CollisionPath>& found = blockPaths_[begin / kParallelBlockRows];
   // Which rows may touch a collider: a screen over the block's columns first.
   thread_local std::vector<std::uint8_t> flags;
   flags.assign(end - begin, 0);
-  const float* const starts[3] = {prev.x.data() + begin, prev.y.data() + begin,
-                                  prev.z.data() + begin};
+  const float* const starts[3] = {given[0] != nullptr ? given[0] : prev.x.data() + begin,
+                                  given[0] != nullptr ? given[1] : prev.y.data() + begin,
+                                  given[0] != nullptr ? given[2] : prev.z.data() + begin};
   const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
   for (const auto& c : colliders_) c->screen(starts, ends, end - begin, flags.data());
   // Most rows are screened out: skipped eight at a time, through a pointer read once (the
@@ -127,7 +134,7 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
     if (flagged[k] == 0) continue;
     const std::size_t i = begin + k;
     const auto row = static_cast<Eigen::Index>(i);
-    Eigen::Vector3f a(prev.x[row], prev.y[row], prev.z[row]);
+    Eigen::Vector3f a(starts[0][k], starts[1][k], starts[2][k]);
     Eigen::Vector3f b(pos.x[row], pos.y[row], pos.z[row]);
     Eigen::Vector3f v(vel.x[row], vel.y[row], vel.z[row]);
     CollisionPath path;

@@ -81,8 +81,12 @@ class ColliderSet {
   /// step, while the block is in cache: beginTick() once, collideRows() for disjoint blocks
   /// [begin, end) of at most kParallelBlockRows rows, each begin a multiple of it, from any
   /// threads at once, then endTick(). No spawn or removal in between. The same bits as collide().
+  /// The paths start at `starts` where given (x, y, z: row r's at index r − begin; the step's
+  /// StepRows::starts, so that a tick no frame interpolates across leaves the pool's column
+  /// alone), else at the pool's previousPosition(), which must then be kept.
   void beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz, bool history);
-  void collideRows(ParticlePool& pool, std::size_t begin, std::size_t end);
+  void collideRows(ParticlePool& pool, std::size_t begin, std::size_t end,
+                   const std::array<const float*, 3>& starts = {});
   void endTick();
 
   /// From the next tick on, records every contact (ContactRecord) for collision events, and counts
@@ -107,6 +111,7 @@ class ColliderSet {
     float dt = 0.0f;     // s
     float start = 0.0f;  // s: the tick's start, for hittime
     bool history = false;
+    bool kills = false;  // some collider's response is Kill
     std::size_t blocks = 0;
     std::array<float*, kHitColumns.size()> hits{};  // the pool's hit columns, or null
     float* counts = nullptr;                        // the contact count column, or null

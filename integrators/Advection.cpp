@@ -1,6 +1,7 @@
 #include "integrators/Advection.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -122,11 +123,17 @@ void gatherRows(const Vec3Column& column, const std::uint32_t* rows, Vec3Rows ou
   }
 }
 
-void scatterRows(Vec3Rows values, const std::uint32_t* rows, Vec3Column& column) {
+// Row rows[j]'s value to[c][rows[j] − base] for each component c.
+void scatterRows(Vec3Rows values, const std::uint32_t* rows, const std::array<float*, 3>& to,
+                 std::size_t base) {
   for (int c = 0; c < 3; ++c) {
-    float* to = column[c].data();
-    for (Eigen::Index j = 0; j < values.x.size(); ++j) to[rows[j]] = values[c][j];
+    float* const out = to[static_cast<std::size_t>(c)];
+    for (Eigen::Index j = 0; j < values.x.size(); ++j) out[rows[j] - base] = values[c][j];
   }
+}
+
+void scatterRows(Vec3Rows values, const std::uint32_t* rows, Vec3Column& column) {
+  scatterRows(values, rows, {column.x.data(), column.y.data(), column.z.data()}, 0);
 }
 
 // Calls body(block) for consecutive blocks of LeafOrder::blockRows() of `rows`: one task each,
@@ -153,8 +160,11 @@ struct Advection::Step {
   AdvectionScheme scheme;
   float h;
   TickInstant t0, tHalf, t1;
-  // Write each row's starting position to pool.previousPosition() (previousRowsOf()'s test).
-  bool writesPrevious;
+  // Where each row's starting position goes (previousRowsOf()'s choice): the pool's
+  // previousPosition(), else the caller's starts (row r at r − startsBase), else nowhere.
+  bool writesColumn;
+  std::array<float*, 3> starts;
+  std::size_t startsBase;
 
   // The stages after the first, in order; returns how many.
   int laterStages(LaterStage (&out)[3]) const {
@@ -192,7 +202,11 @@ struct Advection::Step {
       predictValues(slot(GatheredTile::kX), slot(K1 + i), later[i].step, slot(X2 + i));
       sample(X2 + i, later[i].at, K2 + i);
     }
-    if (writesPrevious) scatterRows(slot(GatheredTile::kX), rows, pool.previousPosition());
+    if (writesColumn) {
+      scatterRows(slot(GatheredTile::kX), rows, pool.previousPosition());
+    } else if (starts[0] != nullptr) {
+      scatterRows(slot(GatheredTile::kX), rows, starts, startsBase);
+    }
     finishValues(scheme, h, slot(GatheredTile::kX), slot(GatheredTile::kV), slot);
     scatterRows(slot(GatheredTile::kX), rows, pool.position());
     scatterRows(slot(GatheredTile::kV), rows, pool.velocity());
@@ -201,10 +215,9 @@ struct Advection::Step {
 
 void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                      const StepRows& rows, const RowPass& afterEachTile) {
-  // The previous position is written only where previousRowsOf() gives the pool's column.
-  const bool writesPrevious = rows.keepPrevious || pool.previousIsState();
-  const Step s{pool,          forces,        scheme_,       time.dt(),
-               time.stage(0), time.stage(1), time.stage(2), writesPrevious};
+  const Step s{pool,          forces,         scheme_,       time.dt(),
+               time.stage(0), time.stage(1),  time.stage(2), writesPreviousColumn(pool, rows),
+               rows.starts,   rows.rows.begin};
   const bool fused = forces.isLocal();
   if (visits_ == Visits::LeafOrder && fused && forces.gathersVelocity()) {
     stepLeafOrder(s, rows, afterEachTile);
@@ -217,7 +230,7 @@ void Advection::stepLeafOrder(const Step& s, const StepRows& rows, const RowPass
   forEachBlock(rows, [&](RowRange block) {
     LeafScratch& scratch = leafScratch();
     if (!scratch.order.build(s.forces, s.pool.position(), block)) {
-      stepRowOrder(s, StepRows{block, rows.fresh, true, rows.keepPrevious}, true, afterEachTile);
+      stepRowOrder(s, rows.partOf(block), true, afterEachTile);
       return;
     }
     const std::size_t n = scratch.order.size();

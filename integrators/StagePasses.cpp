@@ -102,7 +102,13 @@ RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position,
 }
 
 Vec3Rows previousRowsOf(ParticlePool& pool, const StepRows& rows, RowRange r) {
-  if (writesPreviousRows(pool, rows)) return Vec3Rows::of(pool.previousPosition(), r);
+  if (writesPreviousColumn(pool, rows)) return Vec3Rows::of(pool.previousPosition(), r);
+  if (rows.starts[0] != nullptr) {
+    TICKFX_ASSERT(rows.rows.begin <= r.begin && r.end <= rows.rows.end,
+                  "a tile outside the step's rows");
+    const std::size_t at = r.begin - rows.rows.begin;
+    return {rows.starts[0] + at, rows.starts[1] + at, rows.starts[2] + at, r.count()};
+  }
   // One sink for all three components: written, never read. A tile's rows at most (a fused
   // tile, or a parallel block of split passes).
   thread_local std::vector<float> sink;

@@ -94,13 +94,20 @@ RowRange intersect(RowRange r, std::size_t begin, std::size_t end);
 
 /// Whether a step of `rows` writes its rows' starting positions to the pool's previousPosition():
 /// when the step keeps them (a frame interpolates across it) or the scheme reads them as state.
-inline bool writesPreviousRows(const ParticlePool& pool, const StepRows& rows) {
+inline bool writesPreviousColumn(const ParticlePool& pool, const StepRows& rows) {
   return rows.keepPrevious || pool.previousIsState();
 }
 
+/// Whether a step of `rows` writes its rows' starting positions where they are read: the pool's
+/// column (writesPreviousColumn()) or the caller's StepRows::starts.
+inline bool writesPreviousRows(const ParticlePool& pool, const StepRows& rows) {
+  return writesPreviousColumn(pool, rows) || rows.starts[0] != nullptr;
+}
+
 /// Where a step of `rows` writes the starting positions of tile rows `r`: the pool's
-/// previousPosition() rows when the step keeps them or the scheme reads them as state, else a sink
-/// on the calling thread that nothing reads (the same stores, into L1: the column is not touched).
+/// previousPosition() rows when writesPreviousColumn(), else the caller's StepRows::starts where
+/// set, else a sink on the calling thread that nothing reads (the same stores, into L1: the column
+/// is not touched).
 Vec3Rows previousRowsOf(ParticlePool& pool, const StepRows& rows, RowRange r);
 
 /// Rows `r` of a pool column, writable or read-only.

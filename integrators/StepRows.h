@@ -1,6 +1,7 @@
 // Which rows one integrator step advances.
 #pragma once
 
+#include <array>
 #include <cstddef>
 
 #include "particles/ParticlePool.h"
@@ -21,6 +22,20 @@ struct StepRows {
   /// this tick). Else the schemes that do not read it as state write it nowhere: a tick then
   /// neither reads nor writes the column (ParticlePool::previousIsState()).
   bool keepPrevious = true;
+  /// Without keepPrevious, where the step writes its rows' starting positions instead of nowhere:
+  /// three arrays (x, y, z), row r's value at index r − rows.begin (a block's collision pass reads
+  /// them right after its step: ColliderSet::collideRows()). Null: nowhere. A scheme that reads
+  /// the previous position as state writes the pool's column all the same.
+  std::array<float*, 3> starts{};
+
+  /// The rows of `part`, a part of these rows, on the calling thread, their starts moved with them.
+  StepRows partOf(RowRange part) const {
+    StepRows p{part, fresh, true, keepPrevious, starts};
+    if (starts[0] != nullptr) {
+      for (float*& s : p.starts) s += part.begin - rows.begin;
+    }
+    return p;
+  }
   /// Every row of `pool`, its unstepped rows fresh, in parallel.
   static StepRows wholePool(const ParticlePool& pool, bool keepPrevious = true) {
     return {RowRange{0, pool.size()}, pool.firstUnstepped(), false, keepPrevious};

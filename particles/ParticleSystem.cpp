@@ -1,14 +1,18 @@
+
+
 #include "particles/ParticleSystem.h"
 
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -358,8 +362,8 @@ void ParticleSystem::runTick(bool shown) {
   const StepTime time{tick_, settings_.stepRateHz};
   NonfiniteCheck* const check =
       settings_.nonfinite != NonfinitePolicy::Keep ? &nonfiniteCheck_ : nullptr;
-  if (colliders_ && forces_->isLocal()) {
-    stepAndCollideBlocks(time, check);
+  if (collidesBlocks()) {
+    stepAndCollideBlocks(time, check, keepPrevious);
   } else {
     integrator_->step(pool_, *forces_, time, check, keepPrevious);
     if (colliders_) {
@@ -377,18 +381,34 @@ void ParticleSystem::runTick(bool shown) {
   if (keepPrevious) previousTick_ = tick_;
 }
 
-void ParticleSystem::stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check) {
+bool ParticleSystem::collidesBlocks() const { return colliders_ && forces_->isLocal(); }
+
+void ParticleSystem::stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check,
+                                          bool keepPrevious) {
   // Each block is stepped and then collided on one thread, its rows still in that core's cache:
   // the collision pass is not a second trip through memory. Local forces give a block the bits
   // of a whole step (Integrator::stepRows), and collisions are per row.
   integrator_->prepare(pool_, *forces_);
   colliders_->beginTick(pool_, tick_, settings_.stepRateHz, integrator_->readsPreviousPosition());
+  // Paths start where the block's rows started. Unless the pool's column holds that (a frame
+  // interpolates across the tick, or the scheme reads it as state), the step writes the starts
+  // to a buffer of the thread's (3 × 32 KiB, in L2) that the block's collisions read next.
+  const bool buffered = !keepPrevious && !pool_.previousIsState();
   const std::size_t n = pool_.size(), stepped = pool_.firstUnstepped();
   parallelForTasks((n + kParallelBlockRows - 1) / kParallelBlockRows, [&](std::size_t i) {
     const std::size_t begin = i * kParallelBlockRows, end = std::min(n, begin + kParallelBlockRows);
-    const StepRows rows{RowRange{begin, end}, std::clamp(stepped, begin, end), true};
+    StepRows rows{RowRange{begin, end}, std::clamp(stepped, begin, end), true, keepPrevious};
+    std::array<const float*, 3> starts{};
+    if (buffered) {
+      thread_local std::vector<float> buffer;
+      buffer.resize(3 * kParallelBlockRows);
+      for (std::size_t c = 0; c < 3; ++c) {
+        rows.starts[c] = buffer.data() + c * kParallelBlockRows;
+        starts[c] = rows.starts[c];
+      }
+    }
     integrator_->stepRows(pool_, *forces_, time, rows, check);
-    colliders_->collideRows(pool_, begin, end);
+    colliders_->collideRows(pool_, begin, end, starts);
   });
   colliders_->endTick();
 }

@@ -248,10 +248,12 @@ class ParticleSystem {
   // Whether a tick keeps its starting positions: `shown` (its frame interpolates across it), a
   // host's wish, or colliders (their paths start there). Position Verlet's are state, kept anyway.
   bool keepsPrevious(bool shown) const {
-    return shown || keepPreviousAlways_ || colliders_ != nullptr;
+    // Colliders stepped block by block read each block's starts from a buffer of their own.
+    return shown || keepPreviousAlways_ || (colliders_ != nullptr && !collidesBlocks());
   }
+  bool collidesBlocks() const;
   // A tick's step and collisions block by block (colliders with local forces).
-  void stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check);
+  void stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check, bool keepPrevious);
   bool fusesTicks(std::int64_t ticks) const;
   bool runFusedTicks(std::int64_t ticks, bool shown);
   // After the ticks up to `tick` (the count it sets): ages, the kept velocities' rows matched to

@@ -288,6 +288,77 @@ TEST(LeafOrderedAdvection, WritesThePreviousPositionOnlyWhereRowOrderDoes) {
   }
 }
 
+TEST(LeafOrderedAdvection, WritesTheStartsWhereACallerAsks) {
+  // A block stepped with StepRows::starts (a block's collisions read them next) writes each row's
+  // starting position there, at row − the block's first row, in leaf order as in row order; and
+  // steps the rows as a whole-pool step that keeps the previous position in the pool's column.
+  ForceSet forces = curlNoiseField(false);
+  constexpr std::size_t kBlock = 8192, kRows = 20'000;  // blocks of 8192, 8192 and 3616 rows
+  for (const AdvectionScheme scheme : kSchemes) {
+    // Leaf order on coherent rows visits them in row order (LeafOrder::build() declines).
+    for (const auto& [visits, coherent] : {std::pair{Visits::RowOrder, false},
+                                           {Visits::LeafOrder, false},
+                                           {Visits::LeafOrder, true}}) {
+      const std::string what = std::string(advectionSchemeName(scheme)) +
+                               (visits == Visits::LeafOrder ? ", leaf order" : ", row order") +
+                               (coherent ? ", coherent" : ", scattered");
+      ParticlePool reference(kRows), blocks(kRows);
+      reference.keepPrevious();
+      for (ParticlePool* pool : {&reference, &blocks}) {
+        spawnAll(*pool, points(kRows, coherent), 0);
+        pool->markAllStepped();
+      }
+      const StepTime time{0, kRate};
+      Advection(scheme, Visits::RowOrder)
+          .step(reference, forces, time, StepRows::wholePool(reference, true));
+      Advection stepper(scheme, visits);
+      std::vector<float> starts(3 * kBlock, -1.0f);
+      for (std::size_t b = 0; b < kRows; b += kBlock) {
+        const std::size_t e = std::min(kRows, b + kBlock);
+        StepRows rows{RowRange{b, e}, e, true, false};
+        for (std::size_t c = 0; c < 3; ++c) rows.starts[c] = starts.data() + c * kBlock;
+        stepper.step(blocks, forces, time, rows);
+        for (int c = 0; c < 3; ++c) {
+          const float* written = starts.data() + static_cast<std::size_t>(c) * kBlock;
+          ASSERT_EQ(std::memcmp(written, reference.previousPosition()[c].data() + b,
+                                (e - b) * sizeof(float)),
+                    0)
+              << what << ": the starts of block " << b / kBlock << ", component " << c;
+        }
+      }
+      EXPECT_FALSE(blocks.keepsPrevious()) << what;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(std::memcmp(blocks.position()[c].data(), reference.position()[c].data(),
+                              kRows * sizeof(float)),
+                  0)
+            << what;
+        EXPECT_EQ(std::memcmp(blocks.velocity()[c].data(), reference.velocity()[c].data(),
+                              kRows * sizeof(float)),
+                  0)
+            << what;
+      }
+    }
+  }
+}
+
+TEST(StepRowsPart, MovesTheStartsWithItsRows) {
+  float x[200], y[200], z[200];
+  const StepRows rows{RowRange{100, 300}, 250, false, false, {x, y, z}};
+  const StepRows part = rows.partOf(RowRange{150, 200});
+  EXPECT_EQ(part.rows.begin, 150u);
+  EXPECT_EQ(part.rows.end, 200u);
+  EXPECT_EQ(part.fresh, 250u);
+  EXPECT_TRUE(part.serial);
+  EXPECT_FALSE(part.keepPrevious);
+  EXPECT_EQ(part.starts[0], x + 50);
+  EXPECT_EQ(part.starts[1], y + 50);
+  EXPECT_EQ(part.starts[2], z + 50);
+  // No starts asked: none given to the part.
+  const StepRows none{RowRange{100, 300}, 250, false, true};
+  EXPECT_EQ(none.partOf(RowRange{150, 200}).starts[0], nullptr);
+  EXPECT_TRUE(none.partOf(RowRange{150, 200}).keepPrevious);
+}
+
 TEST(LeafOrderedAdvection, SerialBlocksOfAFusedFrameMatchRowOrder) {
   // A fused frame hands each thread a block of rows to step serially: 10 000 rows here, an order
   // of 8192 rows and one of 1808.
