@@ -31,7 +31,8 @@ struct StepTime {
 /// A time-stepping scheme. An integrator advances rows (all of the pool, or a block: StepRows) by
 /// one tick, asking the forces for accelerations at the states and times its scheme needs, and
 /// stores the position it started from in pool.previousPosition() when the step keeps it (for
-/// interpolation: StepRows::keepPrevious) or the scheme reads it as state. Rows from
+/// interpolation: StepRows::keepPrevious) or the scheme reads it as state, else in the caller's
+/// StepRows::starts where given (a block's collisions). Rows from
 /// StepRows::fresh on were spawned this tick: schemes with history start them on their own.
 ///
 /// When the forces prescribe velocity (advection, ForceSet::prescribesVelocity), step() runs the
