@@ -1,5 +1,3 @@
-
-
 #include "particles/ParticleSystem.h"
 
 #include <tbb/task_arena.h>
