@@ -113,9 +113,9 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
   // Which rows may touch a collider: a screen over the block's columns first.
   thread_local std::vector<std::uint8_t> flags;
   flags.assign(end - begin, 0);
-  const float* const starts[3] = {given[0] != nullptr ? given[0] : prev.x.data() + begin,
-                                  given[0] != nullptr ? given[1] : prev.y.data() + begin,
-                                  given[0] != nullptr ? given[2] : prev.z.data() + begin};
+  const float* starts[3];
+  for (int c = 0; c < 3; ++c)
+    starts[c] = given[0] != nullptr ? given[static_cast<std::size_t>(c)] : prev[c].data() + begin;
   const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
   for (const auto& c : colliders_) c->screen(starts, ends, end - begin, flags.data());
   // Most rows are screened out: skipped eight at a time, through a pointer read once (the

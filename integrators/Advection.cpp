@@ -160,11 +160,8 @@ struct Advection::Step {
   AdvectionScheme scheme;
   float h;
   TickInstant t0, tHalf, t1;
-  // Where each row's starting position goes (previousRowsOf()'s choice): the pool's
-  // previousPosition(), else the caller's starts (row r at r − startsBase), else nowhere.
-  bool writesColumn;
-  std::array<float*, 3> starts;
-  std::size_t startsBase;
+  // Where each row's starting position goes (previousRowsOf()'s target).
+  StartsTarget starts;
 
   // The stages after the first, in order; returns how many.
   int laterStages(LaterStage (&out)[3]) const {
@@ -202,11 +199,7 @@ struct Advection::Step {
       predictValues(slot(GatheredTile::kX), slot(K1 + i), later[i].step, slot(X2 + i));
       sample(X2 + i, later[i].at, K2 + i);
     }
-    if (writesColumn) {
-      scatterRows(slot(GatheredTile::kX), rows, pool.previousPosition());
-    } else if (starts[0] != nullptr) {
-      scatterRows(slot(GatheredTile::kX), rows, starts, startsBase);
-    }
+    if (starts.to[0] != nullptr) scatterRows(slot(GatheredTile::kX), rows, starts.to, starts.base);
     finishValues(scheme, h, slot(GatheredTile::kX), slot(GatheredTile::kV), slot);
     scatterRows(slot(GatheredTile::kX), rows, pool.position());
     scatterRows(slot(GatheredTile::kV), rows, pool.velocity());
@@ -215,9 +208,8 @@ struct Advection::Step {
 
 void Advection::step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                      const StepRows& rows, const RowPass& afterEachTile) {
-  const Step s{pool,          forces,         scheme_,       time.dt(),
-               time.stage(0), time.stage(1),  time.stage(2), writesPreviousColumn(pool, rows),
-               rows.starts,   rows.rows.begin};
+  const Step s{pool,          forces,        scheme_,       time.dt(),
+               time.stage(0), time.stage(1), time.stage(2), startsTargetOf(pool, rows)};
   const bool fused = forces.isLocal();
   if (visits_ == Visits::LeafOrder && fused && forces.gathersVelocity()) {
     stepLeafOrder(s, rows, afterEachTile);

@@ -101,13 +101,22 @@ RowPass flowPass(const ParticlePool& pool, const ForceSet& forces, int position,
   };
 }
 
+StartsTarget startsTargetOf(ParticlePool& pool, const StepRows& rows) {
+  if (writesPreviousColumn(pool, rows)) {
+    Vec3Column& column = pool.previousPosition();
+    TICKFX_ASSERT(rows.rows.end <= static_cast<std::size_t>(column.x.size()),
+                  "a row range past the end of its column");
+    return {{column.x.data(), column.y.data(), column.z.data()}, 0};
+  }
+  return {rows.starts, rows.rows.begin};
+}
+
 Vec3Rows previousRowsOf(ParticlePool& pool, const StepRows& rows, RowRange r) {
-  if (writesPreviousColumn(pool, rows)) return Vec3Rows::of(pool.previousPosition(), r);
-  if (rows.starts[0] != nullptr) {
+  if (const StartsTarget t = startsTargetOf(pool, rows); t.to[0] != nullptr) {
     TICKFX_ASSERT(rows.rows.begin <= r.begin && r.end <= rows.rows.end,
                   "a tile outside the step's rows");
-    const std::size_t at = r.begin - rows.rows.begin;
-    return {rows.starts[0] + at, rows.starts[1] + at, rows.starts[2] + at, r.count()};
+    const std::size_t at = r.begin - t.base;
+    return {t.to[0] + at, t.to[1] + at, t.to[2] + at, r.count()};
   }
   // One sink for all three components: written, never read. A tile's rows at most (a fused
   // tile, or a parallel block of split passes).

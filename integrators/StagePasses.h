@@ -1,6 +1,7 @@
 // How an integrator's passes are scheduled over the rows, and where its stage values live.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <initializer_list>
 #include <vector>
@@ -104,10 +105,18 @@ inline bool writesPreviousRows(const ParticlePool& pool, const StepRows& rows) {
   return writesPreviousColumn(pool, rows) || rows.starts[0] != nullptr;
 }
 
-/// Where a step of `rows` writes the starting positions of tile rows `r`: the pool's
-/// previousPosition() rows when writesPreviousColumn(), else the caller's StepRows::starts where
-/// set, else a sink on the calling thread that nothing reads (the same stores, into L1: the column
-/// is not touched).
+/// Where a step of `rows` writes its rows' starting positions: row r's component c at
+/// to[c][r − base]. The pool's previousPosition() (base 0) when writesPreviousColumn(), else the
+/// caller's StepRows::starts (base rows.rows.begin) where set, else nowhere (to[0] null).
+struct StartsTarget {
+  std::array<float*, 3> to{};
+  std::size_t base = 0;
+};
+StartsTarget startsTargetOf(ParticlePool& pool, const StepRows& rows);
+
+/// Where a step of `rows` writes the starting positions of tile rows `r`: its startsTargetOf()
+/// rows, or where that is nowhere, a sink on the calling thread that nothing reads (the same
+/// stores, into L1: the column is not touched).
 Vec3Rows previousRowsOf(ParticlePool& pool, const StepRows& rows, RowRange r);
 
 /// Rows `r` of a pool column, writable or read-only.

@@ -3,7 +3,6 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <array>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -396,17 +395,13 @@ void ParticleSystem::stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* 
   parallelForTasks((n + kParallelBlockRows - 1) / kParallelBlockRows, [&](std::size_t i) {
     const std::size_t begin = i * kParallelBlockRows, end = std::min(n, begin + kParallelBlockRows);
     StepRows rows{RowRange{begin, end}, std::clamp(stepped, begin, end), true, keepPrevious};
-    std::array<const float*, 3> starts{};
     if (buffered) {
       thread_local std::vector<float> buffer;
       buffer.resize(3 * kParallelBlockRows);
-      for (std::size_t c = 0; c < 3; ++c) {
-        rows.starts[c] = buffer.data() + c * kParallelBlockRows;
-        starts[c] = rows.starts[c];
-      }
+      for (std::size_t c = 0; c < 3; ++c) rows.starts[c] = buffer.data() + c * kParallelBlockRows;
     }
     integrator_->stepRows(pool_, *forces_, time, rows, check);
-    colliders_->collideRows(pool_, begin, end, starts);
+    colliders_->collideRows(pool_, begin, end, {rows.starts[0], rows.starts[1], rows.starts[2]});
   });
   colliders_->endTick();
 }
