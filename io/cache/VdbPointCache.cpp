@@ -25,6 +25,7 @@
 #include <string_view>
 #include <system_error>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "fields/vdb/VdbGridFile.h"
@@ -76,15 +77,25 @@ std::string where(const std::string& path) { return vdbGridLabel(path, kGridName
 // away): x − floor(x) is exact, and so is x − n for the nearest integer n.
 // The choice of n or n + 1 is made on the bits, not by a branch (on random positions it is a
 // coin toss the processor would guess wrong half the time) nor by adding 0 (−0.0 + 0 is +0.0).
-std::pair<openvdb::Int32, float> nearestVoxel(float x) {
-  const float down = std::floor(x);
+// floor(x) for |x| < 2³¹, sign of zero included, without a call or a branch: x86-64's baseline
+// has no rounding instruction, so std::floor calls the C library. The truncation is exact (an |x|
+// past 2²³ is whole already), its sign is put back for −0.0 and (−1, 0), and 1 is taken off a
+// negative x's truncation when it is above x (subtracting +0 keeps the sign of −0.0).
+[[gnu::always_inline]] inline float floorOf(float x) {
+  const float truncated = std::copysign(static_cast<float>(static_cast<std::int32_t>(x)), x);
+  const std::uint32_t above = 0u - static_cast<std::uint32_t>(truncated > x);
+  return truncated - std::bit_cast<float>(std::bit_cast<std::uint32_t>(1.0f) & above);
+}
+
+[[gnu::always_inline]] inline std::pair<openvdb::Int32, float> nearestVoxel(float x) {
+  const float down = floorOf(x);
   const std::uint32_t up = 0u - static_cast<std::uint32_t>(x - down >= 0.5f);
   const float n = std::bit_cast<float>((std::bit_cast<std::uint32_t>(down + 1.0f) & up) |
                                        (std::bit_cast<std::uint32_t>(down) & ~up));
   return {static_cast<openvdb::Int32>(n), x - n};
 }
 
-std::pair<openvdb::Int32, float> place(float x) {
+[[gnu::always_inline]] inline std::pair<openvdb::Int32, float> place(float x) {
   if (std::isfinite(x) && std::abs(x) < static_cast<float>(kLargestIndex)) {
     const auto [n, offset] = nearestVoxel(x);
     const float back = static_cast<float>(n) + offset;
@@ -145,25 +156,34 @@ struct PointSlot {
 
 // A 16-bit fixed-point coordinate needs only its voxel and an offset within ±0.5, not the exact
 // bits: the codec quantises the offset anyway (and turns a NaN into undefined behaviour).
-std::pair<openvdb::Int32, float> placeQuantised(float x) {
+[[gnu::always_inline]] inline std::pair<openvdb::Int32, float> placeQuantised(float x) {
   if (std::isnan(x)) return {0, 0.0f};
   if (!(std::abs(x) < static_cast<float>(kLargestIndex))) return {0, x > 0 ? 0.5f : -0.5f};
   return nearestVoxel(x);
 }
 
-// The voxel of row r (and its offset in that voxel, when asked), placed as the positions' codec
-// places it.
-template <bool Quantised>
-openvdb::Coord voxelOf(const FrameData& frame, Eigen::Index r, openvdb::Vec3f* offset = nullptr) {
-  openvdb::Coord voxel;
-  for (int c = 0; c < 3; ++c) {
-    const float x = frame.position[c][r];
-    const auto [index, o] = Quantised ? placeQuantised(x) : place(x);
-    voxel[c] = index;
-    if (offset != nullptr) (*offset)[c] = o;
+// The frame's position columns, held apart from the frame: a loop that stores between two reads
+// would otherwise read the columns' addresses from the frame again after every store.
+struct Positions {
+  std::array<const float*, 3> axis;
+  explicit Positions(const FrameData& frame)
+      : axis{frame.position.x.data(), frame.position.y.data(), frame.position.z.data()} {}
+
+  // The voxel of row r (and its offset in that voxel, when asked), placed as the positions'
+  // codec places it. Inlined into the placement loops, where a call would cost more.
+  template <bool Quantised>
+  [[gnu::always_inline]] openvdb::Coord voxel(std::size_t r,
+                                              openvdb::Vec3f* offset = nullptr) const {
+    openvdb::Coord voxel;
+    for (int c = 0; c < 3; ++c) {
+      const float x = axis[static_cast<std::size_t>(c)][r];
+      const auto [index, o] = Quantised ? placeQuantised(x) : place(x);
+      voxel[c] = index;
+      if (offset != nullptr) (*offset)[c] = o;
+    }
+    return voxel;
   }
-  return voxel;
-}
+};
 
 constexpr auto kLeafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
 
@@ -171,16 +191,17 @@ constexpr auto kLeafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
 template <bool Quantised>
 std::vector<PointSlot> slotsInRowOrder(const FrameData& frame) {
   const std::size_t n = frame.size();
+  const Positions positions(frame);
   std::vector<PointSlot> slots(n);
-  par::parallel_for(
-      tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t i = range.begin(); i < range.end(); ++i) {
-          const openvdb::Coord voxel = voxelOf<Quantised>(frame, static_cast<Eigen::Index>(i));
-          slots[i] = PointSlot{voxel & kLeafMask,
-                               static_cast<openvdb::Index32>(Leaf::coordToOffset(voxel)), i};
-        }
-      });
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        const openvdb::Coord voxel = positions.voxel<Quantised>(i);
+                        slots[i] =
+                            PointSlot{voxel & kLeafMask,
+                                      static_cast<openvdb::Index32>(Leaf::coordToOffset(voxel)), i};
+                      }
+                    });
   return slots;
 }
 
@@ -256,26 +277,52 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
 }
 
 // The points grouped by leaf, as the leaves will hold them but for the order within a leaf: the
-// leaves in Coord order, a leaf's points in row order within each of its voxels (makeLeaf orders
-// them by voxel, keeping that order). Each point's values are copied here in that order, so that
-// a leaf reads its points from one stretch of memory instead of from all over the frame.
+// leaves in Coord order (ascending, as Coord's operator< orders them), a leaf's points in row
+// order within each of its voxels. Each point's values are copied here in that order (a stable
+// scatter by leaf writes few streams at once, where reading the rows in the grid's order would
+// miss the cache on every value), so that a leaf reads its points from one stretch of memory.
+// `local` orders each leaf's points by voxel, keeping their order within a voxel: the leaf's
+// array holds first its point local[start], then local[start + 1], ... (offsets in its stretch).
 struct GroupedPoints {
   std::vector<std::size_t> starts;  // each leaf's first point, and the end
   std::vector<openvdb::Coord> origins;
-  std::unique_ptr<std::uint16_t[]> voxel;    // a point's voxel in its leaf (0 to 511)
-  std::unique_ptr<openvdb::Vec3f[]> offset;  // its position's offset in the voxel
-  std::unique_ptr<std::uint64_t[]> id;
+  // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
+  LargeArray<std::uint16_t> voxel;  // a point's voxel in its leaf (0 to 511)
+  LargeArray<std::uint32_t> local;
+  LargeArray<openvdb::Vec3f> offset;  // its position's offset in the voxel
+  LargeArray<std::uint64_t> id;
   // velocity x, y, z, age, life, mass, then the frame's attributes (pointFloatColumns' order)
-  std::vector<std::unique_ptr<float[]>> columns;
+  std::vector<LargeArray<float>> columns;
 
-  explicit GroupedPoints(std::size_t n, std::size_t floatColumnCount)
-      : voxel(std::make_unique_for_overwrite<std::uint16_t[]>(n)),
-        offset(std::make_unique_for_overwrite<openvdb::Vec3f[]>(n)),
-        id(std::make_unique_for_overwrite<std::uint64_t[]>(n)) {
+  GroupedPoints(std::size_t n, std::size_t floatColumnCount)
+      : voxel(allocateLargeArray<std::uint16_t>(n)),
+        local(allocateLargeArray<std::uint32_t>(n)),
+        offset(allocateLargeArray<openvdb::Vec3f>(n)),
+        id(allocateLargeArray<std::uint64_t>(n)) {
     for (std::size_t j = 0; j < floatColumnCount; ++j)
-      columns.push_back(std::make_unique_for_overwrite<float[]>(n));
+      columns.push_back(allocateLargeArray<float>(n));
   }
 };
+
+// Each leaf's `local` order: its points by voxel, their order kept within a voxel (a counting sort
+// of the leaf's voxels).
+void orderByVoxel(GroupedPoints& points) {
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.origins.size()),
+                    [&](const tbb::blocked_range<std::size_t>& leaves) {
+                      for (std::size_t l = leaves.begin(); l < leaves.end(); ++l) {
+                        const std::size_t begin = points.starts[l];
+                        const std::size_t count = points.starts[l + 1] - begin;
+                        const std::uint16_t* voxel = points.voxel.get() + begin;
+                        std::array<std::uint32_t, Leaf::SIZE> next{};
+                        for (std::size_t k = 0; k < count; ++k) ++next[voxel[k]];
+                        std::uint32_t sum = 0;
+                        for (std::uint32_t& n : next) sum += std::exchange(n, sum);
+                        std::uint32_t* local = points.local.get() + begin;
+                        for (std::size_t k = 0; k < count; ++k)
+                          local[next[voxel[k]]++] = static_cast<std::uint32_t>(k);
+                      }
+                    });
+}
 
 constexpr std::size_t kStandardFloatColumns = 6;  // velocity x, y, z, age, life, mass
 
@@ -294,12 +341,13 @@ GroupedPoints sortedPoints(const FrameData& frame) {
   if (!sortByKeys(slots)) par::parallel_sort(slots.begin(), slots.end());
   const std::vector<const float*> source = pointFloatColumns(frame);
   GroupedPoints points(slots.size(), source.size());
+  const Positions positions(frame);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t k = range.begin(); k < range.end(); ++k) {
                         const std::size_t r = slots[k].row;
                         points.voxel[k] = static_cast<std::uint16_t>(slots[k].voxel);
-                        voxelOf<Quantised>(frame, static_cast<Eigen::Index>(r), &points.offset[k]);
+                        positions.voxel<Quantised>(r, &points.offset[k]);
                         points.id[k] = frame.id[r];
                         for (std::size_t j = 0; j < source.size(); ++j)
                           points.columns[j][k] = source[j][r];
@@ -312,7 +360,15 @@ GroupedPoints sortedPoints(const FrameData& frame) {
     }
   }
   points.starts.push_back(slots.size());
+  orderByVoxel(points);  // (the identity: the slots are sorted by voxel)
   return points;
+}
+
+// to[at[i]] = from[i] for rows [begin, end).
+template <typename T>
+void scatter(const T* __restrict from, const std::uint32_t* __restrict at, std::size_t begin,
+             std::size_t end, T* __restrict to) {
+  for (std::size_t i = begin; i < end; ++i) to[at[i]] = from[i];
 }
 
 // Rows are bucketed in chunks of at least this many, at most kMaxChunks chunks.
@@ -405,15 +461,15 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     return std::pair{chunk * n / chunks, (chunk + 1) * n / chunks};
   };
   // Each row's leaf, and each chunk's count of rows a leaf.
-  std::vector<std::uint32_t> rowAt(n);
+  const Positions positions(frame);
+  const LargeArray<std::uint32_t> rowAt = allocateLargeArray<std::uint32_t>(n);
   std::vector<std::uint32_t> table(leaves * chunks, 0);
   std::vector<char> outsideBox(chunks, 0);
   par::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
     std::uint32_t* count = table.data() + chunk * leaves;
     const auto [begin, end] = chunkRange(chunk);
     for (std::size_t i = begin; i < end; ++i) {
-      const openvdb::Coord leaf =
-          voxelOf<Quantised>(frame, static_cast<Eigen::Index>(i)) & kLeafMask;
+      const openvdb::Coord leaf = positions.voxel<Quantised>(i) & kLeafMask;
       // (Never, as the box is made; but a wrong box must not write past the table.)
       if (openvdb::Coord::lessThan(leaf, box.first) || openvdb::Coord::lessThan(box.second, leaf)) {
         outsideBox[chunk] = 1;
@@ -448,119 +504,60 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   }
   points.starts.push_back(n);
   // Each row's place (read in row order, written to one stretch a leaf), then its values, one
-  // column at a time.
-  par::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
-    std::uint32_t* next = table.data() + chunk * leaves;
-    const auto [begin, end] = chunkRange(chunk);
-    for (std::size_t i = begin; i < end; ++i) {
-      const std::uint32_t at = next[rowAt[i]]++;
-      rowAt[i] = at;
-      points.voxel[at] = static_cast<std::uint16_t>(Leaf::coordToOffset(
-          voxelOf<Quantised>(frame, static_cast<Eigen::Index>(i), &points.offset[at])));
-    }
-    for (std::size_t i = begin; i < end; ++i) points.id[rowAt[i]] = frame.id[i];
-    for (std::size_t j = 0; j < source.size(); ++j) {
-      float* to = points.columns[j].get();
-      const float* from = source[j];
-      for (std::size_t i = begin; i < end; ++i) to[rowAt[i]] = from[i];
-    }
-  });
+  // column at a time over a run of chunks: a column's writes go to one line a leaf at a time,
+  // which stay in cache from one chunk to the next (all the columns of a chunk at once would
+  // evict each other's lines before they fill).
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+                    [&](const tbb::blocked_range<std::size_t>& run) {
+                      const std::size_t runBegin = chunkRange(run.begin()).first;
+                      const std::size_t runEnd = chunkRange(run.end() - 1).second;
+                      for (std::size_t chunk = run.begin(); chunk < run.end(); ++chunk) {
+                        std::uint32_t* next = table.data() + chunk * leaves;
+                        const auto [begin, end] = chunkRange(chunk);
+                        for (std::size_t i = begin; i < end; ++i) rowAt[i] = next[rowAt[i]]++;
+                      }
+                      const std::uint32_t* const at = rowAt.get();
+                      std::uint16_t* const __restrict voxel = points.voxel.get();
+                      openvdb::Vec3f* const __restrict offset = points.offset.get();
+                      for (std::size_t i = runBegin; i < runEnd; ++i) {
+                        openvdb::Vec3f o;
+                        const openvdb::Coord v = positions.voxel<Quantised>(i, &o);
+                        voxel[at[i]] = static_cast<std::uint16_t>(Leaf::coordToOffset(v));
+                        offset[at[i]] = o;
+                      }
+                      scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
+                      for (std::size_t j = 0; j < source.size(); ++j)
+                        scatter(source[j], at, runBegin, runEnd, points.columns[j].get());
+                    });
+  orderByVoxel(points);
   return points;
 }
 
-// The array at `pos` of `leaf` as its own type, expanded to one value a point (each is then
-// set: no fill). Typed access calls the codec inline, where a handle calls through a pointer.
-template <typename Array>
-Array& expandedArray(Leaf& leaf, std::size_t pos) {
-  auto& array = static_cast<Array&>(leaf.attributeArray(pos));
-  array.expand(/*fill=*/false);
-  return array;
-}
+// What an attribute of the grid holds, in the descriptor's order: P, v, id, age, life, mass, then
+// the frame's attribute groups as Houdini's typed attributes (hitnum an int32, hitpos a vec3s).
+// `column`: the first of GroupedPoints::columns it reads (a vector reads three).
+struct GridAttribute {
+  enum class Kind { Position, Vector, Id, Float, Int };
+  Kind kind = Kind::Float;
+  std::size_t column = 0;
+};
 
-// Leaf l of `points`, every attribute filled. The leaf orders its points by voxel, keeping their
-// order within a voxel.
-template <typename PositionArray>
-std::unique_ptr<Leaf> makeLeaf(const GroupedPoints& points, std::size_t l,
-                               const std::vector<AttributeGroup>& groups,
-                               const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
-  const std::size_t begin = points.starts[l];
-  const auto count = static_cast<openvdb::Index>(points.starts[l + 1] - begin);
-  auto leaf = std::make_unique<Leaf>(points.origins[l]);
-  std::array<openvdb::Index32, Leaf::SIZE> counts{};
-  for (openvdb::Index k = 0; k < count; ++k) ++counts[points.voxel[begin + k]];
-  // Each voxel's value is the end of its points in the leaf's arrays.
-  std::vector<openvdb::PointDataIndex32> offsets(Leaf::SIZE);
-  openvdb::Index32 sum = 0;
-  for (std::size_t v = 0; v < Leaf::SIZE; ++v) {
-    const openvdb::Index32 c = counts[v];
-    counts[v] = sum;  // now where the voxel's points begin
-    offsets[v] = sum += c;
-  }
-  // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
-  leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, count),
-                            /*allowMismatchingDescriptors=*/true);
-  leaf->setOffsets(offsets);
-
-  // Where each of the leaf's points comes from (positions set on the way), then one pass an
-  // attribute.
-  std::vector<std::size_t> from(count);
-  auto& p = expandedArray<PositionArray>(*leaf, 0);
-  for (openvdb::Index k = 0; k < count; ++k) {
-    const openvdb::Index32 at = counts[points.voxel[begin + k]]++;
-    from[at] = begin + k;
-    p.setUnsafe(at, points.offset[begin + k]);
-  }
-  const auto vectors = [&](std::size_t pos, std::size_t column) {
-    auto& a = expandedArray<VectorArray>(*leaf, pos);
-    const float* x = points.columns[column].get();
-    const float* y = points.columns[column + 1].get();
-    const float* z = points.columns[column + 2].get();
-    for (openvdb::Index k = 0; k < count; ++k) {
-      const std::size_t i = from[k];
-      a.setUnsafe(k, openvdb::Vec3f(x[i], y[i], z[i]));
-    }
-  };
-  vectors(1, 0);
-  auto& id = expandedArray<IdArray>(*leaf, 2);
-  for (openvdb::Index k = 0; k < count; ++k)
-    id.setUnsafe(k, static_cast<std::int64_t>(points.id[from[k]]));
-  const auto floats = [&](std::size_t pos, std::size_t column) {
-    auto& a = expandedArray<FloatArray>(*leaf, pos);
-    const float* c = points.columns[column].get();
-    for (openvdb::Index k = 0; k < count; ++k) a.setUnsafe(k, c[from[k]]);
-  };
-  floats(3, 3);
-  floats(4, 4);
-  floats(5, 5);
-  // The frame's columns as Houdini's typed attributes (hitnum an int32, hitpos a vec3s, ...).
-  std::size_t pos = standardAttributes().size();
+std::vector<GridAttribute> gridAttributes(const std::vector<AttributeGroup>& groups) {
+  using Kind = GridAttribute::Kind;
+  std::vector<GridAttribute> attributes = {{Kind::Position, 0}, {Kind::Vector, 0},
+                                           {Kind::Id, 0},       {Kind::Float, 3},
+                                           {Kind::Float, 4},    {Kind::Float, 5}};
   for (const AttributeGroup& g : groups) {
-    const std::size_t column = kStandardFloatColumns + g.column;
-    if (g.kind == AttributeKind::Float) {
-      floats(pos++, column);
-    } else if (g.kind == AttributeKind::Int) {
-      auto& a = expandedArray<IntArray>(*leaf, pos++);
-      const float* c = points.columns[column].get();
-      for (openvdb::Index k = 0; k < count; ++k)
-        a.setUnsafe(k, static_cast<std::int32_t>(c[from[k]]));
-    } else {
-      vectors(pos++, column);
-    }
+    const Kind kind = g.kind == AttributeKind::Vec3  ? Kind::Vector
+                      : g.kind == AttributeKind::Int ? Kind::Int
+                                                     : Kind::Float;
+    attributes.push_back({kind, kStandardFloatColumns + g.column});
   }
-  return leaf;
+  return attributes;
 }
 
-// Which way the points are grouped: only tests ask for the general way.
-enum class Grouping { Any, Sorted };
-
 template <typename PositionArray>
-vdbp::PointDataTree::Ptr makeTree(const FrameData& frame, Grouping grouping) {
-  constexpr bool kQuantised = !std::is_same_v<typename PositionArray::Codec, vdbp::NullCodec>;
-  std::optional<GroupedPoints> bucketed;
-  if (grouping == Grouping::Any) bucketed = bucketedPoints<kQuantised>(frame);
-  const GroupedPoints points = bucketed ? std::move(*bucketed) : sortedPoints<kQuantised>(frame);
-
-  const std::vector<AttributeGroup> groups = attributeGroups(frame.attributeNames);
+vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<AttributeGroup>& groups) {
   auto descriptor = vdbp::AttributeSet::Descriptor::create(PositionArray::attributeType());
   descriptor = descriptor->duplicateAppend("v", VectorArray::attributeType());
   descriptor = descriptor->duplicateAppend("id", IdArray::attributeType());
@@ -572,28 +569,192 @@ vdbp::PointDataTree::Ptr makeTree(const FrameData& frame, Grouping grouping) {
                 : g.kind == AttributeKind::Vec3 ? VectorArray::attributeType()
                                                 : FloatArray::attributeType());
   }
+  return descriptor;
+}
 
-  // Leaves are independent: filled in parallel (as OpenVDB's point conversion does), then
-  // handed to the tree in order.
+// Leaf l's voxel values: each the end of its voxel's points in the leaf's arrays.
+std::vector<openvdb::PointDataIndex32> voxelEnds(const GroupedPoints& points, std::size_t l) {
+  std::array<openvdb::Index32, Leaf::SIZE> counts{};
+  for (std::size_t k = points.starts[l]; k < points.starts[l + 1]; ++k) ++counts[points.voxel[k]];
+  std::vector<openvdb::PointDataIndex32> ends(Leaf::SIZE);
+  openvdb::Index32 sum = 0;
+  for (std::size_t v = 0; v < Leaf::SIZE; ++v) ends[v] = sum += counts[v];
+  return ends;
+}
+
+// Leaf l with its voxel values and an attribute set of its point count, each array uniform (the
+// placeholders encodePointsFile takes, or to be expanded and filled).
+std::unique_ptr<Leaf> makeEmptyLeaf(const GroupedPoints& points, std::size_t l,
+                                    const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
+  const auto count = static_cast<openvdb::Index>(points.starts[l + 1] - points.starts[l]);
+  auto leaf = std::make_unique<Leaf>(points.origins[l]);
+  // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
+  leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, count),
+                            /*allowMismatchingDescriptors=*/true);
+  leaf->setOffsets(voxelEnds(points, l));
+  return leaf;
+}
+
+// Calls set(k, value) for each point k of leaf l in its array's order, with the value attribute
+// `a` holds for it.
+template <typename Set>
+void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& a, const Set& set) {
+  using Kind = GridAttribute::Kind;
+  const std::size_t begin = points.starts[l];
+  const std::size_t count = points.starts[l + 1] - begin;
+  const std::uint32_t* local = points.local.get() + begin;
+  const auto column = [&](std::size_t j) { return points.columns[a.column + j].get() + begin; };
+  switch (a.kind) {
+    case Kind::Position: {
+      const openvdb::Vec3f* offset = points.offset.get() + begin;
+      for (std::size_t k = 0; k < count; ++k) set(k, offset[local[k]]);
+      return;
+    }
+    case Kind::Vector: {
+      const float *x = column(0), *y = column(1), *z = column(2);
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::uint32_t i = local[k];
+        set(k, openvdb::Vec3f(x[i], y[i], z[i]));
+      }
+      return;
+    }
+    case Kind::Id: {
+      const std::uint64_t* id = points.id.get() + begin;
+      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int64_t>(id[local[k]]));
+      return;
+    }
+    case Kind::Int: {
+      const float* x = column(0);
+      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[local[k]]));
+      return;
+    }
+    case Kind::Float: {
+      const float* x = column(0);
+      for (std::size_t k = 0; k < count; ++k) set(k, x[local[k]]);
+      return;
+    }
+  }
+}
+
+// Calls f(std::type_identity<Array>()) with the array type of attributes of `kind`.
+template <typename PositionArray, typename F>
+void withArrayType(GridAttribute::Kind kind, const F& f) {
+  using Kind = GridAttribute::Kind;
+  switch (kind) {
+    case Kind::Position:
+      return f(std::type_identity<PositionArray>());
+    case Kind::Vector:
+      return f(std::type_identity<VectorArray>());
+    case Kind::Id:
+      return f(std::type_identity<IdArray>());
+    case Kind::Int:
+      return f(std::type_identity<IntArray>());
+    case Kind::Float:
+      return f(std::type_identity<FloatArray>());
+  }
+}
+
+// The array at `pos` of `leaf` as its own type, expanded to one value a point (each is then
+// set: no fill). Typed access calls the codec inline, where a handle calls through a pointer.
+template <typename Array>
+Array& expandedArray(Leaf& leaf, std::size_t pos) {
+  auto& array = static_cast<Array&>(leaf.attributeArray(pos));
+  array.expand(/*fill=*/false);
+  return array;
+}
+
+// Leaf l of `points`, every attribute filled through its array: what OpenVDB's own writer
+// takes, the reference that the bytes FrameValues stores are held to.
+template <typename PositionArray>
+std::unique_ptr<Leaf> makeLeaf(const std::vector<GridAttribute>& attributes,
+                               const GroupedPoints& points, std::size_t l,
+                               const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
+  std::unique_ptr<Leaf> leaf = makeEmptyLeaf(points, l, descriptor);
+  for (std::size_t pos = 0; pos < attributes.size(); ++pos) {
+    const auto fill = [&]<typename Array>(Array& array) {
+      eachValue(points, l, attributes[pos], [&](std::size_t k, const auto& value) {
+        if constexpr (std::is_convertible_v<decltype(value), typename Array::ValueType>)
+          array.setUnsafe(static_cast<openvdb::Index>(k), value);
+        else
+          throw std::logic_error("VDB points: an attribute's values are not of its array's type");
+      });
+    };
+    withArrayType<PositionArray>(
+        attributes[pos].kind,
+        [&]<typename Array>(std::type_identity<Array>) { fill(expandedArray<Array>(*leaf, pos)); });
+  }
+  return leaf;
+}
+
+// The grid's values, from the grouped points straight into the file's bytes: each encoded by its
+// array's codec and stored as the array would store it.
+template <typename PositionArray>
+class GroupedValues final : public PointValues {
+ public:
+  GroupedValues(const GroupedPoints& points, std::vector<GridAttribute> attributes)
+      : points_(points), attributes_(std::move(attributes)) {}
+
+  void store(std::size_t attribute, const openvdb::Coord& origin, std::size_t count,
+             char* to) const override {
+    const auto& origins = points_.origins;
+    const auto leaf = std::lower_bound(origins.begin(), origins.end(), origin);
+    const auto l = static_cast<std::size_t>(leaf - origins.begin());
+    if (leaf == origins.end() || *leaf != origin ||
+        points_.starts[l + 1] - points_.starts[l] != count || attribute >= attributes_.size()) {
+      throw std::logic_error("VDB points: values asked for a leaf the frame does not have");
+    }
+    const GridAttribute& a = attributes_[attribute];
+    withArrayType<PositionArray>(
+        a.kind, [&]<typename Array>(std::type_identity<Array>) { storeAs<Array>(l, a, to); });
+  }
+
+ private:
+  template <typename Array>
+  void storeAs(std::size_t l, const GridAttribute& a, char* to) const {
+    using Storage = typename Array::StorageType;
+    eachValue(points_, l, a, [&](std::size_t k, const auto& value) {
+      if constexpr (std::is_convertible_v<decltype(value), typename Array::ValueType>) {
+        Storage stored;
+        Array::Codec::encode(typename Array::ValueType(value), stored);
+        std::memcpy(to + k * sizeof(Storage), &stored, sizeof(Storage));
+      } else {
+        throw std::logic_error("VDB points: an attribute's values are not of its array's type");
+      }
+    });
+  }
+
+  const GroupedPoints& points_;
+  std::vector<GridAttribute> attributes_;
+};
+
+// Which way the points are grouped: only tests ask for the general way.
+enum class Grouping { Any, Sorted };
+
+template <typename PositionArray>
+GroupedPoints groupedPoints(const FrameData& frame, Grouping grouping) {
+  constexpr bool kQuantised = !std::is_same_v<typename PositionArray::Codec, vdbp::NullCodec>;
+  std::optional<GroupedPoints> bucketed;
+  if (grouping == Grouping::Any) bucketed = bucketedPoints<kQuantised>(frame);
+  return bucketed ? std::move(*bucketed) : sortedPoints<kQuantised>(frame);
+}
+
+// The tree of `points`, each leaf made by makeLeaf(l). Leaves are independent: made in parallel
+// (as OpenVDB's point conversion does), then handed to the tree in order.
+template <typename MakeLeaf>
+vdbp::PointDataTree::Ptr makeTree(const GroupedPoints& points, const MakeLeaf& makeLeaf) {
   std::vector<std::unique_ptr<Leaf>> leaves(points.origins.size());
   par::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t l = range.begin(); l < range.end(); ++l)
-                        leaves[l] = makeLeaf<PositionArray>(points, l, groups, descriptor);
+                        leaves[l] = makeLeaf(l);
                     });
   auto tree = std::make_shared<vdbp::PointDataTree>();
   for (std::unique_ptr<Leaf>& leaf : leaves) tree->addLeaf(leaf.release());
   return tree;
 }
 
-openvdb::points::PointDataGrid::Ptr makeGrid(const FrameData& frame, const VdbCacheMetadata& meta,
-                                             const VdbCacheOptions& options,
-                                             Grouping grouping = Grouping::Any) {
-  checkColumns(frame);
-  const std::size_t n = frame.size();
-  const vdbp::PointDataTree::Ptr tree = options.positions == VdbCacheOptions::Positions::Fixed16
-                                            ? makeTree<QuantisedPositionArray>(frame, grouping)
-                                            : makeTree<PositionArray>(frame, grouping);
+vdbp::PointDataGrid::Ptr makeGrid(const vdbp::PointDataTree::Ptr& tree, const FrameData& frame,
+                                  const VdbCacheMetadata& meta) {
   auto grid = vdbp::PointDataGrid::create(tree);
   grid->setName(kGridName);
   grid->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
@@ -604,8 +765,57 @@ openvdb::points::PointDataGrid::Ptr makeGrid(const FrameData& frame, const VdbCa
   grid->insertMeta(kMetaFrame, openvdb::Int64Metadata(frame.frame));
   grid->insertMeta(kMetaTime, openvdb::DoubleMetadata(frame.timeSeconds));
   grid->insertMeta(kMetaVersion, openvdb::StringMetadata(meta.tickfxVersion));
-  grid->insertMeta(kMetaPointCount, openvdb::Int64Metadata(static_cast<std::int64_t>(n)));
+  grid->insertMeta(kMetaPointCount,
+                   openvdb::Int64Metadata(static_cast<std::int64_t>(frame.size())));
   return grid;
+}
+
+std::uint32_t compressionFlags(const VdbCacheOptions& options);
+
+// The file's bytes, but for the UUID: the grid's leaves hold placeholders, and the values go from
+// the grouped points straight into the bytes (encodePointsFile's PointValues).
+template <typename PositionArray>
+FileBytes encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
+                      const VdbCacheOptions& options, Grouping grouping) {
+  const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
+  const std::vector<AttributeGroup> groups = attributeGroups(frame.attributeNames);
+  const auto descriptor = gridDescriptor<PositionArray>(groups);
+  const vdbp::PointDataGrid::Ptr grid = makeGrid(
+      makeTree(points, [&](std::size_t l) { return makeEmptyLeaf(points, l, descriptor); }), frame,
+      meta);
+  const GroupedValues<PositionArray> values(points, gridAttributes(groups));
+  return encodePointsFile(*grid, compressionFlags(options), &values);
+}
+
+// The grid with every array filled, as OpenVDB's own writer takes it.
+template <typename PositionArray>
+vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetadata& meta,
+                                    Grouping grouping) {
+  const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
+  const std::vector<AttributeGroup> groups = attributeGroups(frame.attributeNames);
+  const auto descriptor = gridDescriptor<PositionArray>(groups);
+  const std::vector<GridAttribute> attributes = gridAttributes(groups);
+  return makeGrid(makeTree(points,
+                           [&](std::size_t l) {
+                             return makeLeaf<PositionArray>(attributes, points, l, descriptor);
+                           }),
+                  frame, meta);
+}
+
+FileBytes encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
+                      const VdbCacheOptions& options, Grouping grouping = Grouping::Any) {
+  checkColumns(frame);
+  return options.positions == VdbCacheOptions::Positions::Fixed16
+             ? encodeFrame<QuantisedPositionArray>(frame, meta, options, grouping)
+             : encodeFrame<PositionArray>(frame, meta, options, grouping);
+}
+
+vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetadata& meta,
+                                    const VdbCacheOptions& options, Grouping grouping) {
+  checkColumns(frame);
+  return options.positions == VdbCacheOptions::Positions::Fixed16
+             ? filledGrid<QuantisedPositionArray>(frame, meta, grouping)
+             : filledGrid<PositionArray>(frame, meta, grouping);
 }
 
 // ---- reading ---------------------------------------------------------------------------------
@@ -695,8 +905,7 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
                         const std::filesystem::path& path, const VdbCacheOptions& options,
                         Durability durability) {
   openvdb::initialize();
-  const vdbp::PointDataGrid::Ptr grid = makeGrid(frame, meta, options);
-  FileBytes bytes = encodePointsFile(*grid, compressionFlags(options));
+  FileBytes bytes = encodeFrame(frame, meta, options);
   stampUuid(std::span<char>(bytes.data(), bytes.size()), meta, frame.frame);
   writeFileAtomically(
       path,
@@ -712,13 +921,13 @@ std::string vdbPointCacheBytes(const FrameData& frame, const VdbCacheMetadata& m
                                const VdbCacheOptions& options, VdbEncoder encoder,
                                VdbGrouping grouping) {
   openvdb::initialize();
-  const vdbp::PointDataGrid::Ptr grid = makeGrid(
-      frame, meta, options, grouping == VdbGrouping::Sorted ? Grouping::Sorted : Grouping::Any);
+  const Grouping by = grouping == VdbGrouping::Sorted ? Grouping::Sorted : Grouping::Any;
   std::string bytes;
   if (encoder == VdbEncoder::Parallel) {
-    const FileBytes encoded = encodePointsFile(*grid, compressionFlags(options));
+    const FileBytes encoded = encodeFrame(frame, meta, options, by);
     bytes.assign(encoded.data(), encoded.size());
   } else {
+    const vdbp::PointDataGrid::Ptr grid = filledGrid(frame, meta, options, by);
     bytes =
         encodePointsFileSerially(grid, compressionFlags(options), expectedFileBytes(frame, *grid));
   }

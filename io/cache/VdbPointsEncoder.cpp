@@ -17,6 +17,7 @@
 #include <cstring>
 #include <ios>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <ostream>
 #include <sstream>
@@ -30,20 +31,92 @@
 
 namespace tickfx::io {
 
-void FileBytes::Free::operator()(char* p) const { std::free(p); }
+namespace {
+
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+
+// Large blocks, kept when freed for the next frame's buffers of about the same size: a frame's
+// cache needs the same buffers as the last one, and faulting fresh pages in (and handing them
+// back) cost more than the copying in a virtual machine. Blocks are taken by best fit within a
+// quarter over the size asked, and made an eighth larger than asked so that a growing frame
+// still fits; at most kKeptBytes of free blocks are kept, the least recently freed handed back
+// first. The memory is the process's until it exits (reachable from here, not leaked).
+class LargeBlocks {
+ public:
+  static LargeBlocks& instance() {
+    static LargeBlocks* const blocks = new LargeBlocks;  // never destroyed: used until exit
+    return *blocks;
+  }
+
+  void* take(std::size_t size) {
+    {
+      const std::lock_guard lock(mutex_);
+      Block* best = nullptr;
+      for (Block& b : blocks_) {
+        if (!b.free || b.capacity < size || b.capacity - size > size / 4 + kHugePage) continue;
+        if (best == nullptr || b.capacity < best->capacity) best = &b;
+      }
+      if (best != nullptr) {
+        best->free = false;
+        freeBytes_ -= best->capacity;
+        return best->p;
+      }
+    }
+    const std::size_t capacity = (size + size / 8 + kHugePage - 1) / kHugePage * kHugePage;
+    void* p = std::aligned_alloc(kHugePage, capacity);
+    if (p == nullptr) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    ::madvise(p, capacity, MADV_HUGEPAGE);  // a hint: its failure changes nothing
+#endif
+    const std::lock_guard lock(mutex_);
+    blocks_.push_back(Block{p, capacity, false, 0});
+    return p;
+  }
+
+  // False when `p` is not a large block (the caller frees it).
+  bool give(void* p) {
+    const std::lock_guard lock(mutex_);
+    const auto block =
+        std::find_if(blocks_.begin(), blocks_.end(), [&](const Block& b) { return b.p == p; });
+    if (block == blocks_.end()) return false;
+    block->free = true;
+    block->freedAt = ++clock_;
+    freeBytes_ += block->capacity;
+    while (freeBytes_ > kKeptBytes) {
+      auto oldest = blocks_.end();
+      for (auto b = blocks_.begin(); b != blocks_.end(); ++b) {
+        if (b->free && (oldest == blocks_.end() || b->freedAt < oldest->freedAt)) oldest = b;
+      }
+      freeBytes_ -= oldest->capacity;
+      std::free(oldest->p);
+      blocks_.erase(oldest);
+    }
+    return true;
+  }
+
+ private:
+  static constexpr std::size_t kKeptBytes = std::size_t{2} << 30;
+  struct Block {
+    void* p = nullptr;
+    std::size_t capacity = 0;
+    bool free = false;
+    std::uint64_t freedAt = 0;
+  };
+  std::mutex mutex_;
+  std::vector<Block> blocks_;
+  std::size_t freeBytes_ = 0;
+  std::uint64_t clock_ = 0;
+};
+
+}  // namespace
+
+void FileBytes::Free::operator()(void* p) const {
+  if (p != nullptr && !LargeBlocks::instance().give(p)) std::free(p);
+}
 
 FileBytes::Storage FileBytes::allocate(std::size_t size) {
-  constexpr std::size_t kHugePage = std::size_t{2} << 20;
-  void* p = nullptr;
-  if (size >= kHugePage) {
-    const std::size_t rounded = (size + kHugePage - 1) / kHugePage * kHugePage;
-    p = std::aligned_alloc(kHugePage, rounded);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    if (p != nullptr) ::madvise(p, rounded, MADV_HUGEPAGE);  // a hint: its failure changes nothing
-#endif
-  } else {
-    p = std::malloc(std::max<std::size_t>(size, 1));
-  }
+  if (size >= kHugePage) return Storage(static_cast<char*>(LargeBlocks::instance().take(size)));
+  void* p = std::malloc(std::max<std::size_t>(size, 1));
   if (p == nullptr) throw std::bad_alloc();
   return Storage(static_cast<char*>(p));
 }
@@ -124,10 +197,12 @@ class MemorySink final : public std::streambuf {
   std::size_t pos_ = 0;
 };
 
-// A stretch of bytes of the file, in memory owned elsewhere.
+// A stretch of bytes of the file, in memory owned elsewhere; or, where `data` is null, leaf
+// `leaf`'s array of the attribute at hand, its values to be stored by the caller's PointValues.
 struct Piece {
   const char* data = nullptr;
   std::size_t size = 0;
+  std::size_t leaf = 0;
 };
 
 // ---- the leaves' buffers ----------------------------------------------------------------------
@@ -157,6 +232,26 @@ struct Piece {
 
 constexpr std::size_t kRangePoints = 16384;  // a leaf range ends once it holds this many points
 constexpr std::size_t kRangeLeaves = 64;     // or this many leaves
+
+// The leaves in the tree's order, and where their arrays are placeholders (encodePointsFile's
+// `values`) what stands in for the arrays: each leaf's point count, each attribute's bytes a
+// value, and each attribute's metadata record as OpenVDB writes it for leaf 0's array expanded.
+struct Leaves {
+  std::vector<const Leaf*> leaf;
+  const PointValues* values = nullptr;
+  std::vector<std::size_t> count;
+  std::vector<std::size_t> storage;
+  std::vector<std::string> metadata;
+
+  std::size_t size() const { return leaf.size(); }
+  std::size_t points(std::size_t l) const { return count[l]; }
+  // Leaf l's values of attribute a, stored at `to` by the caller's PointValues.
+  void store(std::size_t l, std::size_t a, char* to) const {
+    values->store(a, leaf[l]->origin(), count[l], to);
+  }
+  // The bytes of leaf l's array of attribute a, without blosc's or the flag's.
+  std::size_t arrayBytes(std::size_t l, std::size_t a) const { return points(l) * storage[a]; }
+};
 
 // The first leaf of each range, and the end: a pure function of the grid, not of the threads.
 std::vector<std::size_t> leafRanges(const std::vector<const Leaf*>& leaves) {
@@ -192,6 +287,56 @@ class LeafStream {
   std::ostream out_;
 };
 
+// ---- placeholder arrays -----------------------------------------------------------------------
+//
+// TypedAttributeArray::writeMetadata() (points/AttributeArray.h, OpenVDB 10) writes, for an array
+// in memory and not transient: its byte count (uint64: 2 + 4 + the array's bytes, for flags and
+// size; a paged array's bytes are never compressed here), flags (uint8), serialization flags
+// (uint8), size (uint32), and the stride (uint32) only where it is not 1. Only the byte count and
+// the size depend on the point count: a placeholder's record is leaf 0's expanded array's with
+// those two set to the leaf's.
+constexpr std::size_t kMetadataBytesAt = 0, kMetadataSizeAt = 10, kMetadataLength = 14;
+
+std::uint64_t metadataByteCount(std::size_t points, std::size_t storage) {
+  return sizeof(openvdb::Int16) + sizeof(openvdb::Index) + points * storage;
+}
+
+// Attribute a's record for leaf 0, written by OpenVDB for a copy of leaf 0's array expanded.
+std::string metadataTemplate(const Leaves& all, std::size_t a,
+                             const openvdb::io::StreamMetadata& metadata) {
+  const vdbp::AttributeArray& placeholder = *all.leaf.front()->attributeSet().getConst(a);
+  const vdbp::AttributeArray::Ptr expanded = placeholder.copy();
+  expanded->expand(/*fill=*/true);
+  std::stringbuf text;
+  {
+    LeafStream stream(&text, metadata);
+    expanded->writeMetadata(stream.out(), /*outputTransient=*/false, /*paged=*/true);
+  }
+  std::string record = text.str();
+  std::uint64_t bytes = 0;
+  openvdb::Index size = 0;
+  if (record.size() == kMetadataLength) {
+    std::memcpy(&bytes, record.data() + kMetadataBytesAt, sizeof bytes);
+    std::memcpy(&size, record.data() + kMetadataSizeAt, sizeof size);
+  }
+  if (record.size() != kMetadataLength || size != all.points(0) ||
+      bytes != metadataByteCount(all.points(0), all.storage[a])) {
+    throw std::logic_error("VDB points: an attribute's metadata is not laid out as foreseen");
+  }
+  return record;
+}
+
+// Leaf l's record of attribute a, as writeMetadata() writes it for the array expanded.
+void writeArrayMetadata(const Leaves& all, std::size_t l, std::size_t a, std::ostream& out) {
+  char record[kMetadataLength];
+  std::memcpy(record, all.metadata[a].data(), kMetadataLength);
+  const std::uint64_t bytes = metadataByteCount(all.points(l), all.storage[a]);
+  const auto size = static_cast<openvdb::Index>(all.points(l));
+  std::memcpy(record + kMetadataBytesAt, &bytes, sizeof bytes);
+  std::memcpy(record + kMetadataSizeAt, &size, sizeof size);
+  out.write(record, kMetadataLength);
+}
+
 // A leaf range's parts of passes 0, 1 and a+2, one after another in `sink`: the offsets' sizes
 // end at ends[0], the arrays' metadata at ends[1], the voxel buffers at ends[2].
 struct RangeBytes {
@@ -201,8 +346,9 @@ struct RangeBytes {
 
 // Writes the parts of leaves [begin, end) into `range`, each by the call that
 // PointDataLeafNode::writeBuffers() makes in its pass.
-void encodeLeafRange(const std::vector<const Leaf*>& leaves, std::size_t begin, std::size_t end,
+void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
                      const openvdb::io::StreamMetadata& metadata, bool toHalf, RangeBytes& range) {
+  const std::vector<const Leaf*>& leaves = all.leaf;
   range.sink = std::make_unique<MemorySink>((end - begin) * (2 * 1024 + 128) + 4096);
   LeafStream stream(range.sink.get(), metadata);
   std::ostream& out = stream.out();
@@ -216,7 +362,11 @@ void encodeLeafRange(const std::vector<const Leaf*>& leaves, std::size_t begin, 
       out.write(reinterpret_cast<const char*>(&shared), sizeof shared);
       set.writeDescriptor(out, /*outputTransient=*/false);
     }
-    set.writeMetadata(out, /*outputTransient=*/false, /*paged=*/true);
+    if (all.values == nullptr) {
+      set.writeMetadata(out, /*outputTransient=*/false, /*paged=*/true);
+    } else {
+      for (std::size_t a = 0; a < all.metadata.size(); ++a) writeArrayMetadata(all, l, a, out);
+    }
   }
   range.ends[1] = range.sink->size();
   for (std::size_t l = begin; l < end; ++l)
@@ -228,7 +378,10 @@ void encodeLeafRange(const std::vector<const Leaf*>& leaves, std::size_t begin, 
 // What AttributeArray::writeBuffers() writes for `array` without blosc (points/AttributeArray.h):
 // nothing for a transient array, the one value of a uniform one, else a flag byte (0: not
 // compressed) and the values.
-std::size_t unpagedBytes(const vdbp::AttributeArray& array) {
+// A placeholder stands for an array expanded, never transient.
+std::size_t unpagedBytes(const Leaves& all, std::size_t l, std::size_t a) {
+  if (all.values != nullptr) return 1 + all.arrayBytes(l, a);
+  const vdbp::AttributeArray& array = *all.leaf[l]->attributeSet().getConst(a);
   if (array.isTransient()) return 0;
   if (array.isUniform()) return array.storageTypeSize();
   return 1 + std::size_t{array.dataSize()} * array.storageTypeSize();
@@ -244,9 +397,21 @@ class SpanSink final : public std::streambuf {
 // Writes attribute `a` of leaves [begin, end) without blosc, each array by its writeBuffers()
 // (PointDataLeafNode::writeBuffers() in pass a+3+k: writePagedBuffers() falls back to it), into
 // the `size` bytes at `to`, which unpagedBytes() said they take.
-void writeArrays(const std::vector<const Leaf*>& leaves, std::size_t begin, std::size_t end,
-                 std::size_t a, const openvdb::io::StreamMetadata& metadata, char* to,
-                 std::size_t size) {
+// With placeholders, each array's flag and values are written here, the values by the caller.
+void writeArrays(const Leaves& all, std::size_t begin, std::size_t end, std::size_t a,
+                 const openvdb::io::StreamMetadata& metadata, char* to, std::size_t size) {
+  if (all.values != nullptr) {
+    char* const stop = to + size;
+    for (std::size_t l = begin; l < end; ++l) {
+      *to++ = 0;  // not compressed
+      all.store(l, a, to);
+      to += all.arrayBytes(l, a);
+    }
+    if (to != stop)
+      throw std::logic_error("VDB points: an attribute array took other than the bytes foreseen");
+    return;
+  }
+  const std::vector<const Leaf*>& leaves = all.leaf;
   SpanSink sink(to, size);
   LeafStream stream(&sink, metadata);
   for (std::size_t l = begin; l < end; ++l)
@@ -258,6 +423,7 @@ void writeArrays(const std::vector<const Leaf*>& leaves, std::size_t begin, std:
 // One page of a paged attribute: the arrays' bytes it gathers, in order, and its two records,
 // the size (in the sizes' pass) and the bytes (in the values' pass).
 struct Page {
+  std::size_t attribute = 0;
   std::vector<Piece> arrays;
   std::size_t bytes = 0;
   std::unique_ptr<MemorySink> values;
@@ -268,20 +434,27 @@ struct Page {
 // Attribute `a`'s pages, as PagedOutputStream::write() cuts them: an array that would take the
 // page past compression::PageSize closes it first; an array larger than a page is a page alone.
 // Transient arrays are not written (writePagedBuffers()).
-void cutPages(const std::vector<const Leaf*>& leaves, std::size_t a, std::vector<Page>& pages) {
+void cutPages(const Leaves& all, std::size_t a, std::vector<Page>& pages) {
   const auto pageSize = static_cast<std::size_t>(openvdb::compression::PageSize);
   Page page;
+  page.attribute = a;
   auto close = [&] {
     if (page.bytes > 0) pages.push_back(std::move(page));
     page = Page();
+    page.attribute = a;
   };
-  for (const Leaf* leaf : leaves) {
-    const vdbp::AttributeArray& array = *leaf->attributeSet().getConst(a);
-    if (array.isTransient()) continue;
-    const std::size_t bytes =
-        std::size_t{array.isUniform() ? 1 : array.dataSize()} * array.storageTypeSize();
+  for (std::size_t l = 0; l < all.size(); ++l) {
+    Piece piece{nullptr, 0, l};
+    if (all.values != nullptr) {
+      piece.size = all.arrayBytes(l, a);
+    } else {
+      const vdbp::AttributeArray& array = *all.leaf[l]->attributeSet().getConst(a);
+      if (array.isTransient()) continue;
+      piece.data = array.constDataAsByteArray();
+      piece.size = std::size_t{array.isUniform() ? 1 : array.dataSize()} * array.storageTypeSize();
+    }
+    const std::size_t bytes = piece.size;
     if (bytes == 0) continue;
-    const Piece piece{array.constDataAsByteArray(), bytes};
     if (bytes > pageSize) {
       close();
       page.arrays.push_back(piece);
@@ -300,13 +473,26 @@ void cutPages(const std::vector<const Leaf*>& leaves, std::size_t a, std::vector
 // its size record from the result: (compressed, uncompressed) as two ints when blosc made it
 // smaller, else −uncompressed (PagedOutputStream::compressAndWrite() in size-only mode, which
 // compresses the same bytes the same way only to count them).
-void encodePage(Page& page) {
+// Placeholders' values are stored one after another first, then written at once: the page cuts
+// and compresses them as it would the same bytes written array by array.
+void encodePage(const Leaves& all, Page& page) {
+  const std::size_t a = page.attribute;
   page.values = std::make_unique<MemorySink>(page.bytes);
   std::ostream out(page.values.get());
   openvdb::compression::PagedOutputStream stream(out);
   stream.setSizeOnly(false);
-  for (const Piece& array : page.arrays)
-    stream.write(array.data, static_cast<std::streamsize>(array.size));
+  if (all.values != nullptr) {
+    const std::unique_ptr<char[]> bytes = std::make_unique_for_overwrite<char[]>(page.bytes);
+    std::size_t at = 0;
+    for (const Piece& array : page.arrays) {
+      all.store(array.leaf, a, bytes.get() + at);
+      at += array.size;
+    }
+    stream.write(bytes.get(), static_cast<std::streamsize>(page.bytes));
+  }
+  for (const Piece& array : page.arrays) {
+    if (array.data != nullptr) stream.write(array.data, static_cast<std::streamsize>(array.size));
+  }
   stream.flush();
   if (!out) throw std::runtime_error("cannot encode the VDB points' pages");
   const std::size_t written = page.values->size();
@@ -348,18 +534,49 @@ struct Part {
   std::size_t attribute = 0, begin = 0, end = 0;
 };
 
+// The placeholders' sizes and metadata records (encodePointsFile's `values`).
+void describePlaceholders(Leaves& all, const openvdb::io::StreamMetadata& metadata) {
+  for (const Leaf* leaf : all.leaf) all.count.push_back(leaf->pointCount());
+  const vdbp::AttributeSet& set = all.leaf.front()->attributeSet();
+  for (std::size_t a = 0; a < set.size(); ++a) {
+    const vdbp::AttributeArray& array = *set.getConst(a);
+    if (array.stride() != 1 || !array.hasConstantStride())
+      throw std::logic_error("VDB points: a placeholder array with a stride");
+    all.storage.push_back(array.storageTypeSize());
+  }
+  for (std::size_t l = 0; l < all.size(); ++l) {
+    const vdbp::AttributeSet& leafSet = all.leaf[l]->attributeSet();
+    for (std::size_t a = 0; a < leafSet.size(); ++a) {
+      const vdbp::AttributeArray& array = *leafSet.getConst(a);
+      if (!array.isUniform() || array.isTransient() || array.size() != all.points(l))
+        throw std::logic_error("VDB points: an array is not a placeholder of its leaf's points");
+    }
+  }
+  for (std::size_t a = 0; a < set.size(); ++a)
+    all.metadata.push_back(metadataTemplate(all, a, metadata));
+}
+
 // Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel, and
 // returns true; or writes nothing and returns false when the tree is not splittable() (or has no
-// leaf: two bytes that OpenVDB writes as fast) or `os` does not write into a MemorySink.
-bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::ostream& os) {
+// leaf: two bytes that OpenVDB writes as fast) or `os` does not write into a MemorySink. With
+// `values`, the tree's arrays are placeholders (encodePointsFile): a tree with leaves that this
+// cannot write throws.
+bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const PointValues* values,
+                            std::ostream& os) {
   auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
-  if (sink == nullptr) return false;
-  std::vector<const Leaf*> leaves;
+  Leaves all;
+  all.values = values;
+  std::vector<const Leaf*>& leaves = all.leaf;
   leaves.reserve(tree.leafCount());
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
-  if (leaves.empty() || !splittable(leaves)) return false;
+  if (leaves.empty()) return false;
+  if (sink == nullptr || !splittable(leaves)) {
+    if (values == nullptr) return false;
+    throw std::logic_error("VDB points: placeholder arrays that cannot be encoded in parallel");
+  }
   const openvdb::io::StreamMetadata::Ptr metadata = openvdb::io::getStreamMetadataPtr(os);
   if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
+  if (values != nullptr) describePlaceholders(all, *metadata);
 
   const std::size_t attributes = leaves.front()->attributeSet().size();
   const bool paged = (openvdb::io::getDataCompression(os) & openvdb::io::COMPRESS_BLOSC) != 0;
@@ -367,7 +584,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
   const std::size_t ranges = starts.size() - 1;
   std::vector<RangeBytes> rangeBytes(ranges);
   std::vector<std::vector<Page>> pages(paged ? attributes : 0);
-  for (std::size_t a = 0; a < pages.size(); ++a) cutPages(leaves, a, pages[a]);
+  for (std::size_t a = 0; a < pages.size(); ++a) cutPages(all, a, pages[a]);
   std::vector<Page*> allPages;
   for (std::vector<Page>& attributePages : pages)
     for (Page& page : attributePages) allPages.push_back(&page);
@@ -377,10 +594,10 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
                     [&](const tbb::blocked_range<std::size_t>& tasks) {
                       for (std::size_t t = tasks.begin(); t < tasks.end(); ++t) {
                         if (t < ranges) {
-                          encodeLeafRange(leaves, starts[t], starts[t + 1], *metadata, toHalf,
+                          encodeLeafRange(all, starts[t], starts[t + 1], *metadata, toHalf,
                                           rangeBytes[t]);
                         } else {
-                          encodePage(*allPages[t - ranges]);
+                          encodePage(all, *allPages[t - ranges]);
                         }
                       }
                     });
@@ -406,8 +623,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
     for (std::size_t a = 0; a < attributes; ++a) {
       for (std::size_t r = 0; r < ranges; ++r) {
         Part part{nullptr, 0, a, starts[r], starts[r + 1]};
-        for (std::size_t l = part.begin; l < part.end; ++l)
-          part.size += unpagedBytes(*leaves[l]->attributeSet().getConst(a));
+        for (std::size_t l = part.begin; l < part.end; ++l) part.size += unpagedBytes(all, l, a);
         parts.push_back(part);
       }
     }
@@ -427,7 +643,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
                         if (part.data != nullptr) {
                           std::memcpy(to + offsets[p], part.data, part.size);
                         } else {
-                          writeArrays(leaves, part.begin, part.end, part.attribute, *metadata,
+                          writeArrays(all, part.begin, part.end, part.attribute, *metadata,
                                       to + offsets[p], part.size);
                         }
                       }
@@ -439,14 +655,46 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, std::o
 // its leaves' buffers written by writeBuffersInParallel(). Archive::write() calls the virtual
 // GridBase::writeBuffers() between the topology and the grid's end offset, which it then patches
 // into the grid's descriptor itself.
+// With placeholder arrays (`values`), memUsage() is what the grid would use with its arrays
+// expanded, and so is that of the shallow copy Archive::write() makes to record it in the file
+// (file_mem_bytes).
 class ParallelBuffersGrid final : public vdbp::PointDataGrid {
  public:
-  explicit ParallelBuffersGrid(vdbp::PointDataGrid& grid)
-      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()) {}
+  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues* values)
+      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()), values_(values) {
+    if (values_ == nullptr) return;
+    for (auto leaf = constTree().cbeginLeaf(); leaf; ++leaf) {
+      const vdbp::AttributeSet& set = leaf->attributeSet();
+      for (std::size_t a = 0; a < set.size(); ++a) {
+        const vdbp::AttributeArray& array = *set.getConst(a);
+        if (array.isUniform() && array.size() > 0)
+          expandedExtra_ += (std::size_t{array.size()} - 1) * array.storageTypeSize();
+      }
+    }
+  }
   void writeBuffers(std::ostream& os) const override {
-    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), os))
+    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), values_, os))
       vdbp::PointDataGrid::writeBuffers(os);
   }
+  openvdb::Index64 memUsage() const override {
+    return vdbp::PointDataGrid::memUsage() + expandedExtra_;
+  }
+  // A shallow copy, with what stands for the placeholders.
+  ParallelBuffersGrid(ParallelBuffersGrid& grid, openvdb::ShallowCopy)
+      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()),
+        values_(grid.values_),
+        expandedExtra_(grid.expandedExtra_) {}
+  openvdb::GridBase::Ptr copyGrid() override {
+    return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
+  }
+  openvdb::GridBase::ConstPtr copyGrid() const override {
+    return std::make_shared<ParallelBuffersGrid>(const_cast<ParallelBuffersGrid&>(*this),
+                                                 openvdb::ShallowCopy());
+  }
+
+ private:
+  const PointValues* values_ = nullptr;
+  openvdb::Index64 expandedExtra_ = 0;
 };
 
 // Archive::write(), protected in OpenVDB, with File::write()'s seekable stream.
@@ -462,8 +710,8 @@ class PointsArchive final : public openvdb::io::Archive {
 }  // namespace
 
 FileBytes encodePointsFile(vdbp::PointDataGrid& grid, std::uint32_t compression,
-                           std::size_t expectedBytes) {
-  const openvdb::GridCPtrVec grids{std::make_shared<const ParallelBuffersGrid>(grid)};
+                           const PointValues* values, std::size_t expectedBytes) {
+  const openvdb::GridCPtrVec grids{std::make_shared<const ParallelBuffersGrid>(grid, values)};
   MemorySink sink(expectedBytes);
   std::ostream os(&sink);
   PointsArchive(compression).writeSeekable(os, grids);

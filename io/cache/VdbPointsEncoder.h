@@ -8,18 +8,21 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 namespace tickfx::io {
 
 /// Bytes made in memory, in storage left uninitialised until they are written: the threads that
 /// fill its parts fault its pages in, where a std::string would be zeroed first, on one thread.
-/// Large storage asks Linux for transparent huge pages (madvise), so that filling it takes a
-/// page fault every 2 MiB rather than every 4 KiB: in a virtual machine these faults cost more
-/// than the copying itself.
+/// Large storage (2 MiB or more) asks Linux for transparent huge pages (madvise), so that filling
+/// it takes a page fault every 2 MiB rather than every 4 KiB, and is kept when freed, for the
+/// next frame's buffers of about its size (up to 2 GiB of it, the least recently freed given
+/// back first): in a virtual machine faulting pages in and handing them back cost more than the
+/// copying itself.
 class FileBytes {
  public:
   struct Free {
-    void operator()(char* p) const;
+    void operator()(void* p) const;
   };
   using Storage = std::unique_ptr<char[], Free>;
 
@@ -37,6 +40,31 @@ class FileBytes {
   std::size_t size_ = 0;
 };
 
+/// The values of a grid's attribute arrays, given by the caller instead of held by the arrays: a
+/// grid of a million points need not copy them into its leaves to be written.
+class PointValues {
+ public:
+  virtual ~PointValues() = default;
+  /// Writes attribute `attribute`'s values of the `count` points of the leaf at `origin` into
+  /// `to`, as the leaf's array would store them (its codec's StorageType each, no stride), in the
+  /// order of the leaf's array. Called from several threads at once, for different leaves or
+  /// attributes.
+  virtual void store(std::size_t attribute, const openvdb::Coord& origin, std::size_t count,
+                     char* to) const = 0;
+};
+
+/// Uninitialised storage for `n` values of T (a type a plain copy creates, as numbers and
+/// openvdb::Vec3f are), allocated as FileBytes::allocate() allocates: its pages are faulted in by
+/// the threads that first write them, 2 MiB at a time where it is large.
+template <typename T>
+using LargeArray = std::unique_ptr<T[], FileBytes::Free>;
+
+template <typename T>
+LargeArray<T> allocateLargeArray(std::size_t n) {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+  return LargeArray<T>(reinterpret_cast<T*>(FileBytes::allocate(n * sizeof(T)).release()));
+}
+
 /// What openvdb::io::File::write() writes for `grid` alone (its name unique, no file metadata)
 /// with `compression` (openvdb::io::COMPRESS_* flags), made in memory: the bytes of
 /// io::Archive::write(os, {grid}, seekable = true), every one of them but the header's UUID, which
@@ -50,7 +78,13 @@ class FileBytes {
 /// depend on the thread count. A grid this cannot split (leaves whose attributes differ, arrays
 /// not in memory) or without a leaf is written by OpenVDB alone, to the same bytes.
 /// `expectedBytes`: the room reserved for the header, metadata and topology.
+/// With `values`, every leaf's arrays are placeholders: uniform, of the leaf's point count, stride
+/// 1, in memory. The file is then the one the grid would give with each array expanded to hold
+/// the values `values` stores (its metadata, the file's memory statistics and the arrays'
+/// bytes), and the values go from `values` straight into the file's bytes. Such a grid is never
+/// handed to OpenVDB's own writer: a grid the encoder cannot split throws std::logic_error.
 FileBytes encodePointsFile(openvdb::points::PointDataGrid& grid, std::uint32_t compression,
+                           const PointValues* values = nullptr,
                            std::size_t expectedBytes = 1 << 20);
 
 /// The same bytes made by io::Archive::write() alone, on one thread, into a std::ostringstream:

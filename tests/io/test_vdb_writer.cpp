@@ -214,6 +214,32 @@ TEST_F(ioVdbWriter, AMillionPointsGiveOpenVdbsBytes) {
     expectSameBytesAsOpenVdb(frame, options);
 }
 
+// Buffers of one frame kept for the next (FileBytes): a frame written after a larger one with
+// other values and attributes, into the blocks that frame left, gives its own bytes, not any of
+// the larger frame's; and so does the larger frame written again after it.
+TEST_F(ioVdbWriter, KeptBuffersGiveEachFramesOwnBytes) {
+  const FrameData large = frameOf(600000, 40.0f, {"heat", "hitnum"});
+  FrameData small = frameOf(540000, 40.0f, {"heat", "hitnum"});
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(small.size()); ++i) {
+    small.velocity[0][i] = -small.velocity[0][i];
+    small.attributes[0][i] += 1.0f;
+  }
+  const std::string largeBytes =
+      detail::vdbPointCacheBytes(large, metadata(), kDefault, VdbEncoder::Serial);
+  const std::string smallBytes =
+      detail::vdbPointCacheBytes(small, metadata(), kDefault, VdbEncoder::Serial);
+  for (int round = 0; round < 2; ++round) {
+    SCOPED_TRACE("round " + std::to_string(round));
+    EXPECT_TRUE(detail::vdbPointCacheBytes(large, metadata(), kDefault, VdbEncoder::Parallel) ==
+                largeBytes);
+    const std::string again =
+        detail::vdbPointCacheBytes(small, metadata(), kDefault, VdbEncoder::Parallel);
+    EXPECT_EQ(again.size(), smallBytes.size());
+    EXPECT_TRUE(again == smallBytes)
+        << "the encoders differ first at byte " << firstDifference(again, smallBytes);
+  }
+}
+
 // 2·10⁵ of 2.2·10⁵ points in one 8 m leaf, the others over an 80 m box: that leaf's P, v and id
 // arrays are larger than a page (pages of their own, closing the page before them), its float
 // arrays fill most of one, in both position encodings.
