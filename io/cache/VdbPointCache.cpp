@@ -187,6 +187,54 @@ struct Positions {
 
 constexpr auto kLeafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
 
+// Rows placed kPlacedRows at a time by placeRows(): each axis's voxel indices and offsets.
+constexpr std::size_t kPlacedRows = 512;
+struct PlacedRows {
+  std::array<std::array<std::int32_t, kPlacedRows>, 3> index;
+  std::array<std::array<float, kPlacedRows>, 3> offset;
+
+  openvdb::Coord voxel(std::size_t k) const { return {index[0][k], index[1][k], index[2][k]}; }
+};
+
+// Places rows [begin, begin + count) (count <= kPlacedRows) as Positions::voxel() places them,
+// the same bits, in loops without branches or calls that the compiler vectorises: the
+// coordinates outside the bound (or NaN) are placed as if they were 0, then their results
+// replaced (the same rule as place(), placeQuantised() and nearestVoxel() above).
+template <bool Quantised>
+void placeRows(const Positions& positions, std::size_t begin, std::size_t count,
+               PlacedRows& placed) {
+  constexpr float kBound = static_cast<float>(kLargestIndex);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const float* __restrict x = positions.axis[c] + begin;
+    std::int32_t* __restrict index = placed.index[c].data();
+    float* __restrict offset = placed.offset[c].data();
+    for (std::size_t k = 0; k < count; ++k) {
+      // Selections by masks, not ternaries: the compiler turns a ternary into a branch, which
+      // random positions mispredict half the time, and does not vectorise it.
+      const auto mask = [](bool b) { return 0u - static_cast<std::uint32_t>(b); };
+      const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+      const auto real = [](std::uint32_t u) { return std::bit_cast<float>(u); };
+      const float v = x[k];
+      const std::uint32_t inside = mask(std::abs(v) < kBound);  // false for NaN
+      const float safe = real(bits(v) & inside);
+      const float down = floorOf(safe);
+      const std::uint32_t up = mask(safe - down >= 0.5f);
+      const float n = real((bits(down + 1.0f) & up) | (bits(down) & ~up));  // −0.0 stays −0.0
+      const auto i = static_cast<std::int32_t>(n);
+      const float o = safe - n;
+      std::uint32_t keep = inside;  // the rows placed by nearestVoxel()
+      std::uint32_t otherwise = bits(v);
+      if constexpr (Quantised) {
+        otherwise = ((bits(v) & 0x80000000u) | bits(0.5f)) & ~mask(v != v);  // ±0.5, NaN 0
+      } else {
+        keep &= mask(bits(static_cast<float>(i) + o) == bits(v));
+      }
+      index[k] = static_cast<std::int32_t>(static_cast<std::uint32_t>(i) & keep);
+      offset[k] = real((bits(o) & keep) | (otherwise & ~keep));
+    }
+  }
+}
+
 // Each point's leaf and voxel offset within its leaf (0 to 511), in row order (sorted below).
 template <bool Quantised>
 std::vector<PointSlot> slotsInRowOrder(const FrameData& frame) {
@@ -468,16 +516,22 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   par::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
     std::uint32_t* count = table.data() + chunk * leaves;
     const auto [begin, end] = chunkRange(chunk);
-    for (std::size_t i = begin; i < end; ++i) {
-      const openvdb::Coord leaf = positions.voxel<Quantised>(i) & kLeafMask;
-      // (Never, as the box is made; but a wrong box must not write past the table.)
-      if (openvdb::Coord::lessThan(leaf, box.first) || openvdb::Coord::lessThan(box.second, leaf)) {
-        outsideBox[chunk] = 1;
-        return;
+    PlacedRows placed;
+    for (std::size_t first = begin; first < end; first += kPlacedRows) {
+      const std::size_t rows = std::min(kPlacedRows, end - first);
+      placeRows<Quantised>(positions, first, rows, placed);
+      for (std::size_t k = 0; k < rows; ++k) {
+        const openvdb::Coord leaf = placed.voxel(k) & kLeafMask;
+        // (Never, as the box is made; but a wrong box must not write past the table.)
+        if (openvdb::Coord::lessThan(leaf, box.first) ||
+            openvdb::Coord::lessThan(box.second, leaf)) {
+          outsideBox[chunk] = 1;
+          return;
+        }
+        const std::uint32_t l = leafIndex(leaf);
+        rowAt[first + k] = l;
+        ++count[l];
       }
-      const std::uint32_t l = leafIndex(leaf);
-      rowAt[i] = l;
-      ++count[l];
     }
   });
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
@@ -519,11 +573,17 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                       const std::uint32_t* const at = rowAt.get();
                       std::uint16_t* const __restrict voxel = points.voxel.get();
                       openvdb::Vec3f* const __restrict offset = points.offset.get();
-                      for (std::size_t i = runBegin; i < runEnd; ++i) {
-                        openvdb::Vec3f o;
-                        const openvdb::Coord v = positions.voxel<Quantised>(i, &o);
-                        voxel[at[i]] = static_cast<std::uint16_t>(Leaf::coordToOffset(v));
-                        offset[at[i]] = o;
+                      PlacedRows placed;
+                      for (std::size_t first = runBegin; first < runEnd; first += kPlacedRows) {
+                        const std::size_t rows = std::min(kPlacedRows, runEnd - first);
+                        placeRows<Quantised>(positions, first, rows, placed);
+                        for (std::size_t k = 0; k < rows; ++k) {
+                          const std::uint32_t to = at[first + k];
+                          voxel[to] =
+                              static_cast<std::uint16_t>(Leaf::coordToOffset(placed.voxel(k)));
+                          offset[to] = openvdb::Vec3f(placed.offset[0][k], placed.offset[1][k],
+                                                      placed.offset[2][k]);
+                        }
                       }
                       scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
                       for (std::size_t j = 0; j < source.size(); ++j)
@@ -664,7 +724,7 @@ Array& expandedArray(Leaf& leaf, std::size_t pos) {
 }
 
 // Leaf l of `points`, every attribute filled through its array: what OpenVDB's own writer
-// takes, the reference that the bytes FrameValues stores are held to.
+// takes, the reference that the bytes GroupedValues stores are held to.
 template <typename PositionArray>
 std::unique_ptr<Leaf> makeLeaf(const std::vector<GridAttribute>& attributes,
                                const GroupedPoints& points, std::size_t l,
