@@ -598,36 +598,55 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
 // `column`: the first of GroupedPoints::columns it reads (a vector reads three).
 struct GridAttribute {
   enum class Kind { Position, Vector, Id, Float, Int };
+  std::string name;
   Kind kind = Kind::Float;
   std::size_t column = 0;
 };
 
-std::vector<GridAttribute> gridAttributes(const std::vector<AttributeGroup>& groups) {
+// The grid's attributes of a frame with these attribute columns.
+std::vector<GridAttribute> gridAttributes(const std::vector<std::string>& attributeNames) {
   using Kind = GridAttribute::Kind;
-  std::vector<GridAttribute> attributes = {{Kind::Position, 0}, {Kind::Vector, 0},
-                                           {Kind::Id, 0},       {Kind::Float, 3},
-                                           {Kind::Float, 4},    {Kind::Float, 5}};
-  for (const AttributeGroup& g : groups) {
+  const std::vector<std::string>& standard = standardAttributes();  // P, v, id, age, life, mass
+  std::vector<GridAttribute> attributes = {
+      {standard[0], Kind::Position, 0}, {standard[1], Kind::Vector, 0},
+      {standard[2], Kind::Id, 0},       {standard[3], Kind::Float, 3},
+      {standard[4], Kind::Float, 4},    {standard[5], Kind::Float, 5}};
+  for (const AttributeGroup& g : attributeGroups(attributeNames)) {
     const Kind kind = g.kind == AttributeKind::Vec3  ? Kind::Vector
                       : g.kind == AttributeKind::Int ? Kind::Int
                                                      : Kind::Float;
-    attributes.push_back({kind, kStandardFloatColumns + g.column});
+    attributes.push_back({g.name, kind, kStandardFloatColumns + g.column});
   }
   return attributes;
 }
 
+// Calls f(std::type_identity<Array>()) with the array type of attributes of `kind`.
+template <typename PositionArray, typename F>
+void withArrayType(GridAttribute::Kind kind, const F& f) {
+  using Kind = GridAttribute::Kind;
+  switch (kind) {
+    case Kind::Position:
+      return f(std::type_identity<PositionArray>());
+    case Kind::Vector:
+      return f(std::type_identity<VectorArray>());
+    case Kind::Id:
+      return f(std::type_identity<IdArray>());
+    case Kind::Int:
+      return f(std::type_identity<IntArray>());
+    case Kind::Float:
+      return f(std::type_identity<FloatArray>());
+  }
+}
+
+// The grid's descriptor: each attribute's name and its array's type, P first.
 template <typename PositionArray>
-vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<AttributeGroup>& groups) {
+vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<GridAttribute>& attributes) {
   auto descriptor = vdbp::AttributeSet::Descriptor::create(PositionArray::attributeType());
-  descriptor = descriptor->duplicateAppend("v", VectorArray::attributeType());
-  descriptor = descriptor->duplicateAppend("id", IdArray::attributeType());
-  for (const char* name : {"age", "life", "mass"})
-    descriptor = descriptor->duplicateAppend(name, FloatArray::attributeType());
-  for (const AttributeGroup& g : groups) {
-    descriptor = descriptor->duplicateAppend(
-        g.name, g.kind == AttributeKind::Int    ? IntArray::attributeType()
-                : g.kind == AttributeKind::Vec3 ? VectorArray::attributeType()
-                                                : FloatArray::attributeType());
+  for (std::size_t a = 1; a < attributes.size(); ++a) {
+    withArrayType<PositionArray>(
+        attributes[a].kind, [&]<typename Array>(std::type_identity<Array>) {
+          descriptor = descriptor->duplicateAppend(attributes[a].name, Array::attributeType());
+        });
   }
   return descriptor;
 }
@@ -693,24 +712,6 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
       for (std::size_t k = 0; k < count; ++k) set(k, x[local[k]]);
       return;
     }
-  }
-}
-
-// Calls f(std::type_identity<Array>()) with the array type of attributes of `kind`.
-template <typename PositionArray, typename F>
-void withArrayType(GridAttribute::Kind kind, const F& f) {
-  using Kind = GridAttribute::Kind;
-  switch (kind) {
-    case Kind::Position:
-      return f(std::type_identity<PositionArray>());
-    case Kind::Vector:
-      return f(std::type_identity<VectorArray>());
-    case Kind::Id:
-      return f(std::type_identity<IdArray>());
-    case Kind::Int:
-      return f(std::type_identity<IntArray>());
-    case Kind::Float:
-      return f(std::type_identity<FloatArray>());
   }
 }
 
@@ -838,12 +839,12 @@ template <typename PositionArray>
 FileBytes encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
                       const VdbCacheOptions& options, Grouping grouping) {
   const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
-  const std::vector<AttributeGroup> groups = attributeGroups(frame.attributeNames);
-  const auto descriptor = gridDescriptor<PositionArray>(groups);
+  std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
+  const auto descriptor = gridDescriptor<PositionArray>(attributes);
   const vdbp::PointDataGrid::Ptr grid = makeGrid(
       makeTree(points, [&](std::size_t l) { return makeEmptyLeaf(points, l, descriptor); }), frame,
       meta);
-  const GroupedValues<PositionArray> values(points, gridAttributes(groups));
+  const GroupedValues<PositionArray> values(points, std::move(attributes));
   return encodePointsFile(*grid, compressionFlags(options), &values);
 }
 
@@ -852,9 +853,8 @@ template <typename PositionArray>
 vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetadata& meta,
                                     Grouping grouping) {
   const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
-  const std::vector<AttributeGroup> groups = attributeGroups(frame.attributeNames);
-  const auto descriptor = gridDescriptor<PositionArray>(groups);
-  const std::vector<GridAttribute> attributes = gridAttributes(groups);
+  const std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
+  const auto descriptor = gridDescriptor<PositionArray>(attributes);
   return makeGrid(makeTree(points,
                            [&](std::size_t l) {
                              return makeLeaf<PositionArray>(attributes, points, l, descriptor);
