@@ -334,6 +334,26 @@ TEST(ParticlePool, TheDeadAtTheFrontCostNoMove) {
   EXPECT_EQ(pool.storageRows() + 300, pool.allocatedRows());
 }
 
+// Storage of 2 MiB or more starts on a 2 MiB boundary (where Linux can back it with huge pages:
+// first touching a large pool was 25 times faster so), less on a cache line; a column that grows
+// into a large storage keeps its values.
+TEST(ParticlePool, LargeStorageStartsOnAHugePage) {
+  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+  FloatColumn small(1000);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % 64, 0u);
+  for (Eigen::Index i = 0; i < small.size(); ++i) small[i] = static_cast<float>(i) * 0.5f;
+  small.setRows(3'000'000, 1000);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % kHugePage, 0u);
+  ASSERT_EQ(small.size(), 3'000'000);
+  for (Eigen::Index i = 0; i < 1000; ++i) ASSERT_EQ(small[i], static_cast<float>(i) * 0.5f);
+  ParticlePool pool(1'000'000);
+  pool.reserve(1'000'000);
+  for (int i = 0; i < 10; ++i) pool.spawn(tagged(static_cast<float>(i)), 0);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pool.position().y.data()) % kHugePage, 0u);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pool.id().data()) % kHugePage, 0u);
+  EXPECT_EQ(pool.position().y[9], 18.0f);
+}
+
 // A steady emitter's life: each round spawns a batch at the back and kills the oldest batch (and
 // a scattered few), for many times the storage. The rows are always the survivors in id order
 // with their own values, and the storage stops growing: the freed front is reused.
