@@ -11,6 +11,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -423,6 +424,43 @@ void scatter(const T* __restrict from, const std::uint32_t* __restrict at, std::
 constexpr std::size_t kBucketChunk = 65536;
 constexpr std::size_t kMaxChunks = 64;
 
+// Extends [low, high] over the coordinates x[begin, end) below 2³⁰ in magnitude, and returns
+// whether some other coordinate (beyond, infinite or NaN: placed at 0) is among them. Four lanes
+// of bounds at once, folded at the end (min and max give the same bounds in any order; a zero's
+// sign may differ, and both zeros lie in the same voxel).
+bool extendBounds(const float* x, std::size_t begin, std::size_t end, float& low, float& high) {
+  using Lanes = float __attribute__((vector_size(16)));
+  using Bits = std::int32_t __attribute__((vector_size(16)));
+  constexpr auto kLimit = static_cast<float>(kLargestIndex);
+  const Lanes limit = {kLimit, kLimit, kLimit, kLimit};
+  Lanes lows = {low, low, low, low}, highs = {high, high, high, high};
+  Bits outside = {};
+  std::size_t i = begin;
+  for (; i + 4 <= end; i += 4) {
+    Lanes v;
+    std::memcpy(&v, x + i, sizeof v);
+    const Bits bits = std::bit_cast<Bits>(v);
+    const Bits inside = std::bit_cast<Lanes>(bits & 0x7fffffff) < limit;  // all ones; not NaN
+    const Bits lower = inside & (v < lows), higher = inside & (v > highs);
+    lows = std::bit_cast<Lanes>((bits & lower) | (std::bit_cast<Bits>(lows) & ~lower));
+    highs = std::bit_cast<Lanes>((bits & higher) | (std::bit_cast<Bits>(highs) & ~higher));
+    outside |= ~inside;
+  }
+  bool beyond = false;
+  for (int k = 0; k < 4; ++k) {
+    low = std::min(low, lows[k]);
+    high = std::max(high, highs[k]);
+    beyond |= outside[k] != 0;
+  }
+  for (; i < end; ++i) {
+    const bool inside = std::abs(x[i]) < kLimit;  // not NaN
+    low = std::min(low, inside ? x[i] : low);
+    high = std::max(high, inside ? x[i] : high);
+    beyond |= !inside;
+  }
+  return beyond;
+}
+
 // The fast way, when the leaves' bounding box holds few enough leaves to count them in a table
 // (any effect of sane size): a stable counting sort of the rows by the leaf's index in the box
 // (x, then y, then z: Coord's order), so rows ascend within each leaf. The chunks are fixed by
@@ -443,19 +481,9 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   const Range range = par::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, kPlacementGrain), init,
       [&](const tbb::blocked_range<std::size_t>& rows, Range r) {
-        for (int c = 0; c < 3; ++c) {
-          const float* x = frame.position[c].data();
-          float low = r.low[c], high = r.high[c];
-          bool outside = false;
-          for (std::size_t i = rows.begin(); i < rows.end(); ++i) {
-            const bool inside = std::abs(x[i]) < static_cast<float>(kLargestIndex);  // not NaN
-            low = std::min(low, inside ? x[i] : low);
-            high = std::max(high, inside ? x[i] : high);
-            outside |= !inside;
-          }
-          r.low[c] = low;
-          r.high[c] = high;
-          r.placedAtZero |= outside;
+        for (std::size_t c = 0; c < 3; ++c) {
+          r.placedAtZero |= extendBounds(frame.position[static_cast<int>(c)].data(), rows.begin(),
+                                         rows.end(), r.low[c], r.high[c]);
         }
         return r;
       },
@@ -651,14 +679,25 @@ vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<GridAttribu
   return descriptor;
 }
 
-// Leaf l's voxel values: each the end of its voxel's points in the leaf's arrays.
-std::vector<openvdb::PointDataIndex32> voxelEnds(const GroupedPoints& points, std::size_t l) {
+// Sets leaf l's voxel values, each the end of its voxel's points in the leaf's arrays, and its
+// value mask, on where a voxel holds points: what setOffsets(ends, /*updateValueMask=*/true)
+// sets, without its two calls a voxel.
+void setVoxelEnds(const GroupedPoints& points, std::size_t l, Leaf& leaf) {
   std::array<openvdb::Index32, Leaf::SIZE> counts{};
   for (std::size_t k = points.starts[l]; k < points.starts[l + 1]; ++k) ++counts[points.voxel[k]];
-  std::vector<openvdb::PointDataIndex32> ends(Leaf::SIZE);
+  openvdb::PointDataIndex32* const ends = leaf.buffer().data();
+  Leaf::NodeMaskType mask;  // all off
   openvdb::Index32 sum = 0;
-  for (std::size_t v = 0; v < Leaf::SIZE; ++v) ends[v] = sum += counts[v];
-  return ends;
+  for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
+    std::uint64_t word = 0;
+    for (openvdb::Index b = 0; b < 64; ++b) {
+      const openvdb::Index32 count = counts[64 * w + b];
+      word |= std::uint64_t{count > 0} << b;
+      ends[64 * w + b] = sum += count;
+    }
+    mask.template getWord<std::uint64_t>(w) = word;
+  }
+  leaf.setValueMask(mask);
 }
 
 // Leaf l with its voxel values and an attribute set of its point count, each array uniform (the
@@ -670,7 +709,7 @@ std::unique_ptr<Leaf> makeEmptyLeaf(const GroupedPoints& points, std::size_t l,
   // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
   leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, count),
                             /*allowMismatchingDescriptors=*/true);
-  leaf->setOffsets(voxelEnds(points, l));
+  setVoxelEnds(points, l, *leaf);
   return leaf;
 }
 
