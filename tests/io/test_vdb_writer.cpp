@@ -2,6 +2,7 @@
 // serial writer: the same bytes for every option and size, on any number of threads, and files
 // that read back (through tickfx and through OpenVDB alone) to the points written.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -242,15 +244,48 @@ TEST_F(ioVdbWriter, KeptBuffersGiveEachFramesOwnBytes) {
 
 // 2·10⁵ of 2.2·10⁵ points in one 8 m leaf, the others over an 80 m box: that leaf's P, v and id
 // arrays are larger than a page (pages of their own, closing the page before them), its float
-// arrays fill most of one, in both position encodings.
+// arrays fill most of one, in both position encodings; without blosc, they are stored into place
+// as one stretch of 2.4 MB (P) or 0.8 MB (each float).
 TEST_F(ioVdbWriter, ArraysLargerThanAPageGiveOpenVdbsBytes) {
   FrameData frame = frameOf(220000, 40.0f);
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(frame.size()); ++i) {
     if (i % 11 == 0) continue;
     for (int c = 0; c < 3; ++c) frame.position[c][i] = 4.0f + frame.position[c][i] * (3.4f / 40.0f);
   }
-  for (const VdbCacheOptions& options : {kBlosc, kFixed16Blosc})
+  for (const VdbCacheOptions& options : {kDefault, kFixed16, kBlosc, kFixed16Blosc})
     expectSameBytesAsOpenVdb(frame, options);
+}
+
+// The disk fills up 256 KiB into a frame of 10 MB (RLIMIT_FSIZE, which binds root too), encoded
+// on one thread and on three: the error names the file and the system's reason, the frame
+// written before is still whole under its name, and no temporary is left.
+TEST_F(ioVdbWriter, AFullDiskLeavesTheFormerFileWhole) {
+  const fs::path file = dir_ / "frame.vdb";
+  const FrameData before = frameOf(1000, 5.0f), after = frameOf(200000, 40.0f);
+  writeVdbPointCache(before, metadata(), file, kDefault);
+  const std::string old = fileBytes(file);
+  const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism, 3);
+  for (const int threads : {1, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    rlimit saved{};
+    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+    rlimit small = saved;
+    small.rlim_cur = 256 << 10;
+    const auto savedHandler = std::signal(SIGXFSZ, SIG_IGN);  // a short write, not a kill
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+    std::string message;
+    try {
+      tbb::task_arena(threads).execute(
+          [&] { writeVdbPointCache(after, metadata(), file, kDefault); });
+    } catch (const std::runtime_error& e) {
+      message = e.what();
+    }
+    ::setrlimit(RLIMIT_FSIZE, &saved);
+    std::signal(SIGXFSZ, savedHandler);
+    EXPECT_EQ(message, file.string() + ": error: cannot write (File too large)");
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+    EXPECT_TRUE(fileBytes(file) == old);
+  }
 }
 
 // The counting sort by leaf that writeVdbPointCache groups points with, against the sort of
