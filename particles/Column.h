@@ -3,11 +3,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 #include <algorithm>
 #include <cstddef>
 #include <cstdlib>
@@ -20,6 +15,12 @@
 #include "particles/Assert.h"
 
 namespace tickfx {
+
+/// Uninitialised storage of `bytes` (a multiple of 64), aligned to a cache line, for std::free;
+/// throws std::bad_alloc when there is none. Storage of 2 MiB or more starts on a 2 MiB boundary
+/// and asks the system for huge pages where it has them (Linux: transparent huge pages by
+/// madvise), so that its first writers fault a page in every 2 MiB rather than every 4 KiB.
+void* allocateColumnStorage(std::size_t bytes);
 
 /// An aligned buffer of trivially copyable T whose rows start at an offset into it: rows() rows
 /// are visible from data() on, and dropFront(k) makes row k the first by moving the offset, not
@@ -90,24 +91,10 @@ class OffsetBuffer {
   }
 
  private:
-  // Storage of 2 MiB or more is aligned to 2 MiB and asks Linux for transparent huge pages (a
-  // hint: its failure changes nothing), so that its first writers fault a page in every 2 MiB
-  // rather than every 4 KiB. In a virtual machine each fault costs microseconds: a fresh 240 MB
-  // took 0.7–0.95 s to touch with 4 KiB pages and 27 ms with huge pages (docs/performance.md).
-  // Its size is not rounded up to 2 MiB: the last part of a page stays in 4 KiB pages, so no
-  // column holds memory it never uses.
-  static constexpr std::size_t kHugePage = std::size_t{2} << 20;
-
   static T* allocate(std::size_t rows) {
     const std::size_t bytes =
         std::max((rows * sizeof(T) + kAlignment - 1) / kAlignment * kAlignment, kAlignment);
-    const std::size_t alignment = bytes >= kHugePage ? kHugePage : kAlignment;
-    void* p = nullptr;
-    if (::posix_memalign(&p, alignment, bytes) != 0) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    if (alignment == kHugePage) ::madvise(p, bytes / kHugePage * kHugePage, MADV_HUGEPAGE);
-#endif
-    return static_cast<T*>(p);
+    return static_cast<T*>(allocateColumnStorage(bytes));
   }
   void copyFrom(const OffsetBuffer& other) {
     OffsetBuffer fresh;
