@@ -8,10 +8,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
@@ -28,6 +24,7 @@
 #include <vector>
 
 #include "io/util/ProfiledTbb.h"
+#include "particles/Column.h"
 
 namespace tickfx::io {
 
@@ -63,11 +60,7 @@ class LargeBlocks {
       }
     }
     const std::size_t capacity = (size + size / 8 + kHugePage - 1) / kHugePage * kHugePage;
-    void* p = std::aligned_alloc(kHugePage, capacity);
-    if (p == nullptr) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    ::madvise(p, capacity, MADV_HUGEPAGE);  // a hint: its failure changes nothing
-#endif
+    void* p = allocateColumnStorage(capacity);  // on huge pages, as the pool's columns
     const std::lock_guard lock(mutex_);
     blocks_.push_back(Block{p, capacity, false, 0});
     return p;
