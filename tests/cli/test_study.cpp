@@ -188,9 +188,9 @@ TEST(IntegratorStudyConstantAcceleration, EulerErrorIsHalfOfADtWorthOfVelocity) 
   }
 }
 
-// The README's figure: |a|·dt·T/2 = 9.81 · 0.05 · 10 / 2 = 2.4525 m, with decimal constants. The
-// float constants (9.81f, float(0.05)) move the closed form by 3.7e-5 m; the round-off bound of
-// 200 ticks is 5.3e-3 m.
+// docs/integrators.md's figure: |a|·dt·T/2 = 9.81 · 0.05 · 10 / 2 = 2.4525 m, with decimal
+// constants. The float constants (9.81f, float(0.05)) move the closed form by 3.7e-5 m; the
+// round-off bound of 200 ticks is 5.3e-3 m.
 TEST(IntegratorStudyConstantAcceleration, ExplicitEulerAt20HzIsOff2_4525mAfter10s) {
   const auto& r = fall("explicit_euler", 20, 10.0);
   EXPECT_DOUBLE_EQ(r.exact, -490.5);
@@ -456,7 +456,7 @@ TEST(IntegratorStudyWind, SixteenHertzAt20HzIsCarriedBackwards) {
   const auto& r = gust("velocity_verlet", 20, 16.0);
   EXPECT_NEAR(r.exact, 150.0 * 2.0 / (2.0 * kPi * 16.0), 1e-12);
   const double expected = trapezoidFactor(2.0 * kPi * 16.0 * floatDt(20)) * r.exact;
-  EXPECT_NEAR(expected, -10.3229, 5e-5);  // the README's figure, to its digits
+  EXPECT_NEAR(expected, -10.3229, 5e-5);  // the integrator study's figure, to its digits
   EXPECT_NEAR(r.position, expected, windBound("velocity_verlet", 20, 16.0));
   // The 4 Hz wind's samples are those of the 16 Hz one negated (sin(2π·4k/20) = −sin(2π·16k/20)),
   // so its run is the same run mirrored, up to both runs' round-off.

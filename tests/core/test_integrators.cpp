@@ -196,10 +196,10 @@ TEST(ConstantAcceleration, LateSpawnStartsCleanlyInEveryScheme) {
   }
 }
 
-// Regression (issue 10, item 16), the README's order table: position Verlet's velocity is the last
-// step's difference of positions, half a step behind, so a force that reads velocity makes it first
-// order: under linear drag (k = 2/s, from 10 m/s, 1 s) its position error halves when the step
-// halves, where velocity Verlet's quarters. The figures are the schemes' closed forms
+// Regression (issue 10, item 16), docs/integrators.md's order table: position Verlet's velocity is
+// the last step's difference of positions, half a step behind, so a force that reads velocity makes
+// it first order: under linear drag (k = 2/s, from 10 m/s, 1 s) its position error halves when the
+// step halves, where velocity Verlet's quarters. The figures are the schemes' closed forms
 // (test_forces_oblique): position Verlet −0.04975 m at 60 Hz and −0.02481 m at 120 Hz.
 TEST(LinearDragOrder, PositionVerletIsFirstOrderWhenForcesReadVelocity) {
   constexpr double kDrag = 2.0, kSpeed = 10.0, kSeconds = 1.0;

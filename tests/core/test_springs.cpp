@@ -1024,11 +1024,11 @@ TEST(Pinning, APinnedParticleGetsNoAccelerationFromAnyForce) {
 // step v·dt is below half an ulp does not move at all, so the chain can stop a few ulps away from
 // the exact float balance, with velocities up to ulp/(2·dt) = 7e-6 m/s that move nothing.
 // Tolerance 1e-6 m (8 ulps at the bottom, 1e-4 of the smallest stretch); velocities below
-// ulp/dt = 1.4e-5 m/s. Position Verlet is quantised harder (README): a particle stays put while
-// its |a|·dt² is below half an ulp, i.e. |a| < 8.6e-4 m/s², and such residual forces m·|a| on
-// every particle, all one way, displace the bottom by 45·m·|a|/k = 3.9e-5 m: its tolerance, 4e-5 m.
-// Measured worst errors: 1.8e-7 m (explicit and semi-implicit Euler), 1.0e-7 (RK4), 7.1e-8
-// (midpoint, velocity Verlet), 1.4e-5 (position Verlet).
+// ulp/dt = 1.4e-5 m/s. Position Verlet is quantised harder (docs/integrators.md): a particle stays
+// put while its |a|·dt² is below half an ulp, i.e. |a| < 8.6e-4 m/s², and such residual forces
+// m·|a| on every particle, all one way, displace the bottom by 45·m·|a|/k = 3.9e-5 m: its
+// tolerance, 4e-5 m. Measured worst errors: 1.8e-7 m (explicit and semi-implicit Euler), 1.0e-7
+// (RK4), 7.1e-8 (midpoint, velocity Verlet), 1.4e-5 (position Verlet).
 
 TEST_P(EveryScheme, ADampedHangingChainSettlesToTheAnalyticStaticShape) {
   constexpr int kN = 10;
