@@ -5,11 +5,9 @@
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +19,7 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
+#include "FileSizeLimit.h"
 #include "LittleEndianBytes.h"
 #include "fields/Gravity.h"
 #include "fields/SpringNetwork.h"
@@ -752,20 +751,16 @@ TEST_F(ioCheckpoint, AFailedWriteLeavesTheOldCheckpointIntact) {
   a->stepTicks(30);
   ASSERT_GT(a->pool().size() * 84, 8192u) << "the new file must outgrow the limit";
 
-  rlimit saved{};
-  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
-  rlimit small = saved;
-  small.rlim_cur = 4096;
-  const auto savedHandler = std::signal(SIGXFSZ, SIG_IGN);  // a short write, not a kill
-  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
   std::string message;
-  try {
-    writeCheckpoint(path, *a, CheckpointInfo{kEffect, 60, 0});
-  } catch (const std::runtime_error& e) {
-    message = e.what();
+  {
+    const test::FileSizeLimit limit(4096);
+    ASSERT_TRUE(limit.set());
+    try {
+      writeCheckpoint(path, *a, CheckpointInfo{kEffect, 60, 0});
+    } catch (const std::runtime_error& e) {
+      message = e.what();
+    }
   }
-  ::setrlimit(RLIMIT_FSIZE, &saved);
-  std::signal(SIGXFSZ, savedHandler);
 
   EXPECT_EQ(message, path.string() + ": error: cannot write (File too large)");
   EXPECT_EQ(entries(), std::set<std::string>{"run.ckpt"});

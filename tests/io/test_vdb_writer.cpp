@@ -2,7 +2,6 @@
 // serial writer: the same bytes for every option and size, on any number of threads, and files
 // that read back (through tickfx and through OpenVDB alone) to the points written.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
@@ -10,7 +9,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "FileSizeLimit.h"
 #include "PointCacheTestSupport.h"
 #include "VdbTestData.h"
 #include "io/cache/FrameData.h"
@@ -267,21 +266,17 @@ TEST_F(ioVdbWriter, AFullDiskLeavesTheFormerFileWhole) {
   const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism, 3);
   for (const int threads : {1, 3}) {
     SCOPED_TRACE(std::to_string(threads) + " threads");
-    rlimit saved{};
-    ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
-    rlimit small = saved;
-    small.rlim_cur = 256 << 10;
-    const auto savedHandler = std::signal(SIGXFSZ, SIG_IGN);  // a short write, not a kill
-    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
     std::string message;
-    try {
-      tbb::task_arena(threads).execute(
-          [&] { writeVdbPointCache(after, metadata(), file, kDefault); });
-    } catch (const std::runtime_error& e) {
-      message = e.what();
+    {
+      const test::FileSizeLimit limit(256 << 10);
+      ASSERT_TRUE(limit.set());
+      try {
+        tbb::task_arena(threads).execute(
+            [&] { writeVdbPointCache(after, metadata(), file, kDefault); });
+      } catch (const std::runtime_error& e) {
+        message = e.what();
+      }
     }
-    ::setrlimit(RLIMIT_FSIZE, &saved);
-    std::signal(SIGXFSZ, savedHandler);
     EXPECT_EQ(message, file.string() + ": error: cannot write (File too large)");
     EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
     EXPECT_TRUE(fileBytes(file) == old);
