@@ -16,12 +16,11 @@ namespace {
 // up to 2 MiB: the last part of a page stays in 4 KiB pages, so no column holds memory it never
 // writes.
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
-constexpr std::size_t kCacheLine = 64;
 
 }  // namespace
 
 void* allocateColumnStorage(std::size_t bytes) {
-  const std::size_t alignment = bytes >= kHugePage ? kHugePage : kCacheLine;
+  const std::size_t alignment = bytes >= kHugePage ? kHugePage : OffsetBuffer<char>::kAlignment;
   void* p = nullptr;
   if (::posix_memalign(&p, alignment, bytes) != 0) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
