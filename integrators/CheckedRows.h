@@ -48,24 +48,36 @@ struct LaneBits<Lanes8> {
 template <class Lane>
 inline constexpr Eigen::Index kLanes = static_cast<Eigen::Index>(sizeof(Lane) / sizeof(float));
 
-/// Lane by lane, `value` with every subnormal replaced by a zero of its sign; normal values,
-/// zeros, infinities and NaNs unchanged. The integrators store state through this, so that no
-/// state stays subnormal: a long decay (a drag) reaches exact zeros instead of running for
-/// thousands of ticks on subnormals, which x86 and many ARM cores compute tens of times slower.
-/// It is a rule on IEEE results in integer bits, the same on every platform, and leaves the
-/// host's floating-point environment alone: hardware flush-to-zero (MXCSR FTZ, FPCR.FZ) is not
-/// used because x86 detects tininess after rounding and AArch64 before, so the two flush
-/// different results (docs/determinism.md, subnormals).
+/// The smallest magnitude a stored value keeps, 2⁻⁶⁴ (as bits: exponent 63, mantissa 0). Below
+/// it, flushTiny() stores a zero of the value's sign. Not FLT_MIN: a state value just above
+/// FLT_MIN still makes subnormal intermediate products (v · dt, k · v · dt) for tens of ticks of a
+/// decay, and on x86 those stall as much as subnormal state. With 2⁻⁶⁴, a stored value times up to
+/// three factors of 2⁻²⁰ or more (a step of 1/60 s is 2⁻⁶ to 2⁻⁵, dt² 2⁻¹²) is still normal. In SI
+/// units 2⁻⁶⁴ (5.4e-20 m, m/s) is no distance or speed an effect shows.
+inline constexpr std::uint32_t kSmallestStoredBits = 0x1f800000U;
+inline constexpr float kSmallestStored = 0x1p-64f;
+static_assert(std::bit_cast<std::uint32_t>(kSmallestStored) == kSmallestStoredBits);
+
+/// Lane by lane, `value` with every magnitude below kSmallestStored (subnormals included) replaced
+/// by a zero of its sign; anything else (larger values, zeros, infinities, NaNs) unchanged. The
+/// integrators store state through this, so that no state is subnormal or near it: a long decay
+/// (a drag) reaches exact zeros instead of running for thousands of ticks on subnormals, which x86
+/// and many ARM cores compute tens of times slower, and no tick computes a subnormal from the state
+/// on the way. It is a rule on IEEE results in integer bits, the same on every platform, and leaves
+/// the host's floating-point environment alone: hardware flush-to-zero (MXCSR FTZ, FPCR.FZ) is not
+/// used because x86 detects tininess after rounding and AArch64 before, so the two flush different
+/// results (docs/determinism.md, subnormals).
 template <class Lane>
 Lane flushTiny(Lane value) {
   if constexpr (std::is_same_v<Lane, float>) {
     const auto bits = std::bit_cast<std::uint32_t>(value);
-    const bool tiny = (bits & 0x7fffffffU) < 0x00800000U;
+    const bool tiny = (bits & 0x7fffffffU) < kSmallestStoredBits;
     return std::bit_cast<float>(tiny ? bits & 0x80000000U : bits);
   } else {
     using Bits = typename LaneBits<Lane>::type;
     const auto bits = std::bit_cast<Bits>(value);
-    const Bits keep = (bits & 0x7fffffff) >= 0x00800000;  // all ones where normal, inf or NaN
+    // all ones where kept: at least kSmallestStored, infinite or NaN
+    const Bits keep = (bits & 0x7fffffff) >= static_cast<std::int32_t>(kSmallestStoredBits);
     return std::bit_cast<Lane>(bits & (keep | std::int32_t{-0x7fffffff - 1}));
   }
 }
@@ -98,8 +110,8 @@ struct RowsAt {
       std::memcpy(column + i, &value, sizeof value);
     }
   }
-  /// Writes `value` flushed (flushTiny()): every value an integrator computes is stored normal or
-  /// zero.
+  /// Writes `value` flushed (flushTiny()): every value an integrator computes is stored zero or
+  /// at least kSmallestStored in magnitude.
   void store(float* column, Lane value) const {
     const Lane flushed = flushTiny(value);
     if constexpr (std::is_same_v<Lane, float>) {
