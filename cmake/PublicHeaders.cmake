@@ -58,6 +58,7 @@ set(TICKFX_EFFECTS_PUBLIC_HEADERS
   include/tickfx/tickfx.h
   io/util/AtomicFile.h
   io/util/Fingerprint.h
+  io/util/UninitialisedVector.h
   io/cache/BackgroundWriter.h
   io/cache/CacheFormat.h
   io/cache/CsvCache.h

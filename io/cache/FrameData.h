@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "io/util/UninitialisedVector.h"
 #include "particles/ParticlePool.h"
 
 namespace tickfx {
@@ -18,7 +19,8 @@ namespace tickfx::io {
 struct FrameData {
   std::int64_t frame = 0;    // frame number, from 1
   double timeSeconds = 0.0;  // the frame's time (for metadata only)
-  std::vector<std::uint64_t> id;
+  /// resize() leaves new ids uninitialised, for the caller to write (no serial zero-fill).
+  UninitialisedVector<std::uint64_t> id;
   Vec3Column position;  // metres
   Vec3Column velocity;  // metres per second
   FloatColumn age;      // seconds
@@ -28,8 +30,8 @@ struct FrameData {
   std::vector<FloatColumn> attributes;
 
   std::size_t size() const { return id.size(); }
-  /// Sizes every column for `rows` particles, with one attribute column per name (values left
-  /// for the reader to fill).
+  /// Sizes every column for `rows` particles, with one attribute column per name (values, ids
+  /// included, left uninitialised for the reader to fill).
   void resize(std::size_t rows, std::vector<std::string> names);
 };
 

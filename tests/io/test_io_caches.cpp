@@ -1,8 +1,11 @@
 // Frame caches and frame schedules: what is written reads back bit for bit, and bad files fail
 // loudly with their name and place.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +21,7 @@
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/PlyCache.h"
+#include "io/util/UninitialisedVector.h"
 #include "particles/ParticleSystem.h"
 
 namespace fs = std::filesystem;
@@ -193,6 +197,38 @@ TEST_F(Caches, AFailedWriteLeavesTheOldFileAndNoTemporary) {
   for (const auto& entry : fs::directory_iterator(dir_)) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
   }
+}
+
+// The bytes of this process's pages in memory (Linux: /proc/self/statm).
+std::size_t residentBytes() {
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+}
+
+// A frame's ids are an UninitialisedVector: resize() writes nothing (no serial zero-fill before
+// the parallel copy that writes every id), so 64 MiB of new ids make no page resident where a
+// std::vector's would make all of them; large ones start on a 2 MiB page like the pool's columns;
+// the rest is a std::vector's.
+TEST(UninitialisedVector, ResizeWritesNothingAndLargeStorageStartsOnAHugePage) {
+  if (!fs::exists("/proc/self/statm")) GTEST_SKIP() << "no /proc/self/statm";
+  constexpr std::size_t kIds = std::size_t{8} << 20;  // 64 MiB
+  UninitialisedVector<std::uint64_t> ids;
+  const std::size_t before = residentBytes();
+  ids.resize(kIds);
+  const std::size_t after = residentBytes();
+  EXPECT_LT(after > before ? after - before : 0, kIds * sizeof(std::uint64_t) / 2);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(ids.data()) % (std::uintptr_t{2} << 20), 0u);
+  std::iota(ids.begin(), ids.end(), std::uint64_t{7});
+  EXPECT_EQ(ids[kIds - 1], kIds + 6);
+  ids.push_back(5);  // a std::vector's growth, values kept
+  EXPECT_EQ(ids.back(), 5u);
+  EXPECT_EQ(ids[kIds - 1], kIds + 6);
+  ids.assign(3, 9);
+  EXPECT_EQ(ids, (UninitialisedVector<std::uint64_t>{9, 9, 9}));
+  UninitialisedVector<std::uint64_t> small{1, 2};
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % 64, 0u);
 }
 
 TEST(FrameTimes, SchedulesEndExactlyWhereAsked) {

@@ -156,7 +156,7 @@ def Points "p" (kind = "component")
 )";
   const FrameData f = readUsdaFrame(file, 7);
   ASSERT_EQ(f.size(), 2u);
-  EXPECT_EQ(f.id, (std::vector<std::uint64_t>{10, 11}));
+  EXPECT_EQ(f.id, (UninitialisedVector<std::uint64_t>{10, 11}));
   EXPECT_EQ(f.position.x[0], 1.5f);
   EXPECT_EQ(f.position.z[0], 3e-3f);
   EXPECT_EQ(f.age[1], 0.5f);

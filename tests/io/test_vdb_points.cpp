@@ -75,7 +75,7 @@ FrameData oddFrame() {
   f.frame = 42;
   f.timeSeconds = 1.75;
   const auto n = static_cast<Eigen::Index>(positions.size());
-  f.id = ids;
+  f.id.assign(ids.begin(), ids.end());
   f.position.resize(n);
   f.velocity.resize(n);
   f.age.resize(n);
@@ -361,7 +361,7 @@ TEST_F(ioVdbPoints, AForeignPointsFileReadsWithDefaultsForWhatItLacks) {
   EXPECT_EQ(back.attributeNames,
             (std::vector<std::string>{"density", "flags", "Cd_r", "Cd_g", "Cd_b"}));
   // Rows in file order, numbered from 0; positions within the codec's resolution.
-  EXPECT_EQ(back.id, (std::vector<std::uint64_t>{0, 1, 2}));
+  EXPECT_EQ(back.id, (UninitialisedVector<std::uint64_t>{0, 1, 2}));
   std::vector<bool> matched(3, false);
   for (Eigen::Index r = 0; r < 3; ++r) {
     EXPECT_EQ(back.velocity.x[r], 0.0f);
