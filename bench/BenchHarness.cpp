@@ -1,5 +1,6 @@
 #include "BenchHarness.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -93,7 +94,7 @@ std::optional<double> timeBatch(Case& c, bool record) {
 
 bool prepareCase(Case& c, double target) {
   const std::int64_t unit = c.ticksPerFrame;
-  c.batch = unit;
+  c.batch = (std::max(c.minimumBatch, unit) + unit - 1) / unit * unit;
   if (!c.calibrated) return !c.warmUp || timeBatch(c, /*record=*/false).has_value();
   for (;;) {
     const std::optional<double> s = timeBatch(c, /*record=*/false);

@@ -62,6 +62,10 @@ struct Case {
   std::function<double()> counter;
   /// Batches are whole multiples of this many ticks (a frame of several ticks).
   std::int64_t ticksPerFrame = 1;
+  /// Batches are at least this many ticks (rounded up to whole frames): cases compared with each
+  /// other take batches of one length, so that each batch's first, cold tick weighs alike (a
+  /// case calibrated on one slow tick would otherwise time every tick cold).
+  std::int64_t minimumBatch = 1;
   /// Whether the batch grows to min-time/reps seconds (its untimed runs are the warm-up). If not,
   /// every batch is one frame (a burst into a fresh pool cannot repeat within a batch), with one
   /// untimed batch first when `warmUp`.

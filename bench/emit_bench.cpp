@@ -455,6 +455,11 @@ bool runSteady(std::size_t population, const bench::Timing& timing, std::vector<
   cases.back().ticksPerFrame = kFusedTicks;
   cases.emplace_back("frames of 4 ticks without emission", framesOf(*stillFused));
   cases.back().ticksPerFrame = kFusedTicks;
+  // Batches of one second of ticks for every case: the cases take turns, so each batch's first
+  // tick finds the others' rows in the cache, and the shares compare batches of one length; a
+  // second also holds the emitter's periodic move of the live rows to the freed front, as a run
+  // does.
+  for (bench::Case& c : cases) c.minimumBatch = kStepRateHz;
   // Shares are differences of two tick times, each moved by the machine's load: more rounds
   // than the other parts take, paired round by round (bench::pairedShare).
   bench::Timing steadyTiming = timing;
