@@ -4,6 +4,7 @@
 // when large), for the same reason.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdlib>
 #include <memory>
@@ -29,8 +30,10 @@ class DefaultInitAllocator {
 
   T* allocate(std::size_t n) {
     if (n > std::size_t(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
-    const std::size_t bytes = (n * sizeof(T) + 63) / 64 * 64;
-    return static_cast<T*>(allocateColumnStorage(bytes == 0 ? 64 : bytes));
+    // Whole lines, at least one, as a column's own storage (OffsetBuffer) asks.
+    constexpr std::size_t kLine = OffsetBuffer<char>::kAlignment;
+    const std::size_t bytes = std::max((n * sizeof(T) + kLine - 1) / kLine * kLine, kLine);
+    return static_cast<T*>(allocateColumnStorage(bytes));
   }
   void deallocate(T* p, std::size_t) noexcept { std::free(p); }
 
