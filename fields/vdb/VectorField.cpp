@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -50,50 +51,126 @@ Eigen::Vector3f toFloat(const openvdb::Vec3d& v) {
   return {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
 }
 
-/// openvdb::tools::BoxSampler with the same result bit for bit, faster where it matters. BoxSampler
-/// reads the eight corners of the cell with eight accessor probes, which for a cell across leaf
-/// nodes (one in three for scattered points) alternate between leaves and miss the accessor's
-/// leaf cache at each. This looks each leaf of the cell up once, reads the corners from the leaf
-/// buffers (a corner where no leaf is allocated from the accessor: a tile or the background, as
-/// BoxSampler reads it), then interpolates with BoxSampler's own function.
-struct LeafBoxSampler {
-  template <class Accessor, class ValueT>
-  static void sample(Accessor& acc, const openvdb::Vec3R& index, ValueT& result) {
-    const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(index);
-    ValueT data[2][2][2];
-    corners(acc, openvdb::Coord(base), data);
-    result = openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
+/// openvdb::tools::BoxSampler's result bit for bit, for samples that come in leaf order
+/// (integrators/LeafOrder.h): consecutive samples, and an advection step's stages, mostly read
+/// the same leaves. BoxSampler reads the eight corners of a cell with eight accessor probes (a
+/// cell across leaves, one in three for scattered points, alternates between them and misses the
+/// accessor's leaf cache at each); this keeps the 2 × 2 × 2 leaves from the last sample's leaf
+/// on, each looked up once, on first use, until a sample falls in another leaf. A corner is then
+/// one load from a leaf's buffer, or from the one value of a tile or the background where no leaf
+/// is allocated (a leaf-sized region without a leaf lies in one tile of the tree, or in none: its
+/// value and active state are the same throughout, as the accessor would read them). The corners
+/// are then interpolated by BoxSampler's own function. One per thread and frame, as an accessor.
+template <class GridT>
+class LeafNeighbourhood {
+ public:
+  using Accessor = typename GridT::ConstUnsafeAccessor;
+  using Leaf = typename GridT::TreeType::LeafNodeType;
+  using ValueT = typename GridT::ValueType;
+
+  /// acc.isValueOn(Coord::round(index)): whether the voxel nearest to `index` is active.
+  bool activeNearest(Accessor& acc, const openvdb::Vec3d& index) {
+    const openvdb::Coord nearest = openvdb::Coord::round(index);
+    anchor(openvdb::Coord(openvdb::tools::local_util::floorVec3(index)));
+    const int n = neighbour(acc, nearest);
+    if (n < 0) return acc.isValueOn(nearest);
+    const Leaf* leaf = leaf_[n];
+    return leaf != nullptr ? leaf->valueMask().isOn(Leaf::coordToOffset(nearest)) : active_[n];
   }
 
-  // The values at ijk + (a, b, c), a, b, c in {0, 1}, into data[a][b][c].
-  template <class Accessor, class ValueT>
-  static void corners(Accessor& acc, const openvdb::Coord& ijk, ValueT (&data)[2][2][2]) {
-    using Leaf = typename Accessor::TreeType::LeafNodeType;
-    constexpr openvdb::Int32 kLast = static_cast<openvdb::Int32>(Leaf::DIM) - 1;
-    // Whether a step of +1 along each axis leaves ijk's leaf.
-    const int cross[3] = {(ijk.x() & kLast) == kLast, (ijk.y() & kLast) == kLast,
-                          (ijk.z() & kLast) == kLast};
-    // The cell's leaves by which axes they lie across, each looked up once (the buffer once:
-    // LeafBuffer::data() checks for out-of-core data on every call).
-    const typename Leaf::ValueType* buffers[2][2][2] = {};
-    bool known[2][2][2] = {};
+  /// Asks the processor for the cache lines of the cell at `index` where it lies in the leaf
+  /// the neighbourhood is anchored at (a later sample's, as samples come in leaf order): a
+  /// sample's cost is the memory latency of its corners.
+  void prefetch(const openvdb::Vec3d& index) const {
+    const openvdb::Coord base(openvdb::tools::local_util::floorVec3(index));
+    if ((base & ~static_cast<openvdb::Int32>(Leaf::DIM - 1)) != origin_ || (fetched_ & 1u) == 0 ||
+        leaf_[0] == nullptr) {
+      return;
+    }
+    const ValueT* corner = values_[0] + Leaf::coordToOffset(base);
+    constexpr std::size_t kRow = Leaf::DIM, kPlane = Leaf::DIM * Leaf::DIM;
+    __builtin_prefetch(corner);
+    __builtin_prefetch(corner + kRow);
+    __builtin_prefetch(corner + kPlane);
+    __builtin_prefetch(corner + kPlane + kRow);
+  }
+
+  /// BoxSampler::sample(acc, index, result)'s result.
+  ValueT sample(Accessor& acc, const openvdb::Vec3d& index) {
+    const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(index);
+    const openvdb::Coord ijk(base);
+    anchor(ijk);
+    ValueT data[2][2][2];
     for (int a = 0; a < 2; ++a) {
       for (int b = 0; b < 2; ++b) {
-        for (int c = 0; c < 2; ++c) {
-          const openvdb::Coord q = ijk.offsetBy(a, b, c);
-          const int la = a & cross[0], lb = b & cross[1], lc = c & cross[2];
-          if (!known[la][lb][lc]) {
-            const Leaf* leaf = acc.probeConstLeaf(q);
-            buffers[la][lb][lc] = leaf != nullptr ? leaf->buffer().data() : nullptr;
-            known[la][lb][lc] = true;
-          }
-          const auto* values = buffers[la][lb][lc];
-          data[a][b][c] = values != nullptr ? values[Leaf::coordToOffset(q)] : acc.getValue(q);
-        }
+        for (int c = 0; c < 2; ++c) data[a][b][c] = value(acc, ijk.offsetBy(a, b, c));
       }
     }
+    return openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
   }
+
+ private:
+  static constexpr int kLog2Dim = static_cast<int>(Leaf::LOG2DIM);
+
+  // Makes the neighbourhood that of the leaf holding `voxel`, nothing looked up yet, unless it is.
+  void anchor(const openvdb::Coord& voxel) {
+    const openvdb::Coord origin = voxel & ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
+    if (origin == origin_) return;
+    origin_ = origin;
+    fetched_ = 0;
+  }
+
+  // Which of the eight leaves holds `voxel` (x, y, z one bit each, x highest), looked up now if
+  // it was not yet; −1 beyond them (no sample's corners are: only an index too large for an int
+  // brings one there, and then the accessor answers).
+  int neighbour(Accessor& acc, const openvdb::Coord& voxel) {
+    int n = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::int64_t d = std::int64_t{voxel[axis]} - origin_[axis];
+      if (d < 0 || d >= 2 * std::int64_t{Leaf::DIM}) return -1;
+      n = (n << 1) | static_cast<int>(d >> kLog2Dim);
+    }
+    if ((fetched_ & (1u << n)) == 0) fetch(acc, n);
+    return n;
+  }
+
+  void fetch(Accessor& acc, int n) {
+    const auto step = [n](int bit) {
+      return ((n >> bit) & 1) * static_cast<openvdb::Int32>(Leaf::DIM);
+    };
+    const openvdb::Coord q = origin_.offsetBy(step(2), step(1), step(0));
+    const Leaf* leaf = acc.probeConstLeaf(q);
+    leaf_[n] = leaf;
+    if (leaf != nullptr) {
+      values_[n] = leaf->buffer().data();  // (once: data() checks for out-of-core data)
+      mask_[n] = Leaf::SIZE - 1;
+    } else {
+      constant_[n] = acc.getValue(q);
+      active_[n] = acc.isValueOn(q);
+      values_[n] = &constant_[n];
+      mask_[n] = 0;
+    }
+    fetched_ |= 1u << n;
+  }
+
+  ValueT value(Accessor& acc, const openvdb::Coord& voxel) {
+    const int n = neighbour(acc, voxel);
+    if (n < 0) return acc.getValue(voxel);
+    return values_[n][Leaf::coordToOffset(voxel) & mask_[n]];
+  }
+
+  // No leaf's origin (origins are multiples of Leaf::DIM): the first sample anchors.
+  openvdb::Coord origin_{1, 1, 1};
+  unsigned fetched_ = 0;
+  const Leaf* leaf_[8] = {};
+  const ValueT* values_[8] = {};
+  openvdb::Index mask_[8] = {};
+  ValueT constant_[8] = {};
+  bool active_[8] = {};
 };
+
+/// The sampler tag of LeafNeighbourhood: BoxSampler's results.
+struct LeafBoxSampler {};
 
 }  // namespace
 
@@ -123,6 +200,9 @@ struct VectorField::Impl {
 
 namespace {
 
+// Rows ahead whose corners add() asks for.
+constexpr Eigen::Index kPrefetchRows = 8;
+
 template <class GridT>
 struct ImplT final : VectorField::Impl {
   using ValueT = typename GridT::ValueType;
@@ -143,6 +223,7 @@ struct ImplT final : VectorField::Impl {
           scaleTranslate(
               xform->template constMap<openvdb::math::UniformScaleTranslateMap>().get()) {}
     Accessor acc;
+    LeafNeighbourhood<GridT> cells;  // LeafBoxSampler's
     const openvdb::math::Transform* xform;
     const openvdb::math::UniformScaleMap* scale;
     const openvdb::math::UniformScaleTranslateMap* scaleTranslate;
@@ -157,12 +238,17 @@ struct ImplT final : VectorField::Impl {
   template <class Sampler>
   static Eigen::Vector3f at(Frame& f, const openvdb::Vec3d& world, bool zeroOutside) {
     const openvdb::Vec3d index = f.toIndex(world);
-    if (zeroOutside && !f.acc.isValueOn(openvdb::Coord::round(index))) {
-      return Eigen::Vector3f::Zero();
+    if constexpr (std::is_same_v<Sampler, LeafBoxSampler>) {
+      if (zeroOutside && !f.cells.activeNearest(f.acc, index)) return Eigen::Vector3f::Zero();
+      return toFloat(f.cells.sample(f.acc, index));
+    } else {
+      if (zeroOutside && !f.acc.isValueOn(openvdb::Coord::round(index))) {
+        return Eigen::Vector3f::Zero();
+      }
+      ValueT u;
+      Sampler::sample(f.acc, index, u);
+      return toFloat(u);
     }
-    ValueT u;
-    Sampler::sample(f.acc, index, u);
-    return toFloat(u);
   }
 
   // The two frames' samplers for one call, and the sample at a world position, blended in time.
@@ -174,6 +260,9 @@ struct ImplT final : VectorField::Impl {
           second(*impl.grids[frames.second]),
           blend(frames.second != frames.first && frames.weight != 0.0f),
           zero(s.outside != VectorField::Outside::Background) {}
+    // Asks for the cache lines of the cell at `world` in the first frame, where it lies in the
+    // neighbourhood's first leaf (LeafBoxSampler only).
+    void prefetch(const openvdb::Vec3d& world) const { first.cells.prefetch(first.toIndex(world)); }
     Eigen::Vector3f operator()(const openvdb::Vec3d& world) {
       const Eigen::Vector3f u = at<Sampler>(first, world, zero);
       if (!blend) return u;
@@ -193,7 +282,14 @@ struct ImplT final : VectorField::Impl {
     const bool drag = s.mode == VectorField::Mode::Drag;
     const ConstVec3Rows p = in.position.rows(rows);
     const ConstVec3Rows v = in.velocity.rows(rows);
-    for (Eigen::Index j = 0; j < rows.count(); ++j) {
+    const Eigen::Index n = rows.count();
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if constexpr (std::is_same_v<Sampler, LeafBoxSampler>) {
+        if (j + kPrefetchRows < n) {
+          const Eigen::Index k = j + kPrefetchRows;
+          field.prefetch(openvdb::Vec3d(p.x[k], p.y[k], p.z[k]));
+        }
+      }
       // float → double is exact; the sample is rounded to float once.
       const Eigen::Vector3f u = field(openvdb::Vec3d(p.x[j], p.y[j], p.z[j]));
       if (drag) {

@@ -186,6 +186,73 @@ TEST_F(VdbField, OutsidePolicies) {
   EXPECT_EQ(dead[2], 0);
 }
 
+TEST_F(VdbField, TrilinearSamplesAreOpenVdbsAcrossLeavesTilesAndTheBackground) {
+  // The box sampler keeps the leaves around the last sample's leaf (fields/vdb/VectorField.cpp):
+  // every kind of corner it reads is here, each against OpenVDB's BoxSampler, bit for bit.
+  vdbt::GridFileSpec grid;
+  grid.voxelSize = 0.5;
+  grid.background = {0.25, -0.5, 1.0};
+  // Voxels over three leaves along x (−16 to 7) and two along y and z, with holes: inactive
+  // voxels of allocated leaves, which read the background.
+  for (int i = -13; i < 8; ++i) {
+    for (int j = -2; j < 10; ++j) {
+      for (int k = -1; k < 9; ++k) {
+        if ((i + 2 * j + 3 * k) % 7 == 0) continue;
+        grid.activeVoxels.push_back({{i, j, k}, {0.5 * i, 0.25 * j - 1.0, 0.125 * k * k}});
+      }
+    }
+  }
+  grid.tiles = {{1, {8, 0, 0}, {3.0, 2.0, 1.0}, true},      // a leaf's region as one active value
+                {1, {-24, 0, 0}, {-3.0, 0.5, 2.0}, false},  // and one inactive
+                {2, {128, 0, 0}, {7.0, 7.0, 7.0}, true}};   // 128³ voxels further on
+  vdbt::writeGridFile(path("f.vdb"), grid);
+  // Rows in no order a leaf visit would give: x sweeps over every leaf, tile and the gaps, back
+  // and forth, with y and z on and beside leaf boundaries.
+  vdbt::Positions world;
+  for (const float y : {-1.1f, 0.0f, 3.75f, 3.9f, 4.0f, 7.6f}) {
+    for (const float z : {-0.3f, 1.2f, 3.95f, 4.3f}) {
+      for (int n = 0; n < 120; ++n) {
+        const float x = (n % 2 == 0 ? -14.0f + 0.13f * n : 70.0f - 0.29f * n) * 0.5f;
+        world.push_back({x, y, z});
+      }
+    }
+  }
+  world.push_back({-30.0f, 0.5f, 0.5f});  // the background alone
+  const std::size_t n = world.size();
+  for (const VectorField::Outside outside :
+       {VectorField::Outside::Background, VectorField::Outside::Zero}) {
+    const bool zero = outside == VectorField::Outside::Zero;
+    SCOPED_TRACE(zero ? "outside = zero" : "outside = background");
+    const vdbt::Positions expected = vdbt::boxSamples(path("f.vdb"), "vel", world, zero);
+    VectorField::Settings s = settingsFor(path("f.vdb"));
+    s.mode = VectorField::Mode::Advect;
+    s.outside = outside;
+    const VectorField field(s);
+    ParticlePool pool(n);
+    for (const auto& w : world) pool.spawn({Eigen::Vector3f(w[0], w[1], w[2])}, 0);
+    const ForceInput in{pool, Vec3View::of(pool.position()), Vec3View::of(pool.velocity()),
+                        TickInstant{}};
+    Vec3Column sampled;
+    sampled.resize(static_cast<Eigen::Index>(n));
+    for (int c = 0; c < 3; ++c) sampled[c].setZero();
+    Vec3Rows out = Vec3Rows::of(sampled, RowRange{0, n});
+    field.accumulateVelocity(in, RowRange{0, n}, out);
+    std::size_t nonzero = 0, differ = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto e = static_cast<Eigen::Index>(i);
+      const Eigen::Vector3f one =
+          field.sample(Eigen::Vector3f(world[i][0], world[i][1], world[i][2]));
+      for (int c = 0; c < 3; ++c) {
+        const float want = expected[i][static_cast<std::size_t>(c)];
+        nonzero += want != 0.0f ? 1 : 0;
+        differ += (sampled[c][e] != want || one[c] != want) ? 1 : 0;
+      }
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_GT(nonzero, n / 2);  // the samples are not all zero (nor the comparison empty)
+  }
+}
+
 TEST_F(VdbField, SequencesInterpolateLinearlyInTime) {
   BakeSettings b;
   b.voxelSize = 0.5;

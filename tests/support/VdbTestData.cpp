@@ -8,6 +8,7 @@
 #include <openvdb/points/PointCount.h>
 #include <openvdb/points/PointDataGrid.h>
 #include <openvdb/points/PointGroup.h>
+#include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/PointAdvect.h>
 #include <openvdb/tools/PointIndexGrid.h>
 
@@ -282,6 +283,27 @@ std::unique_ptr<VectorField> oneVoxelFrames(const VectorField::Settings& setting
     grids.grids.push_back(grid);
   }
   return std::make_unique<VectorField>(settings, grids);
+}
+
+Positions boxSamples(const std::filesystem::path& path, const std::string& grid,
+                     const Positions& world, bool zeroOutside) {
+  openvdb::initialize();
+  openvdb::io::File in(path.string());
+  in.open();
+  const openvdb::Vec3SGrid::Ptr g = openvdb::gridPtrCast<openvdb::Vec3SGrid>(in.readGrid(grid));
+  in.close();
+  if (!g) throw std::runtime_error(path.string() + ": grid '" + grid + "' is not a vec3s grid");
+  auto acc = g->getConstAccessor();
+  Positions out;
+  out.reserve(world.size());
+  for (const auto& w : world) {
+    const openvdb::Vec3d index = g->transform().worldToIndex(openvdb::Vec3d(w[0], w[1], w[2]));
+    openvdb::Vec3f u(0.0f);
+    if (!zeroOutside || acc.isValueOn(openvdb::Coord::round(index)))
+      openvdb::tools::BoxSampler::sample(acc, index, u);
+    out.push_back({u[0], u[1], u[2]});
+  }
+  return out;
 }
 
 Positions advectWithPointAdvect(const AnalyticField& field, const BakeSettings& bake,

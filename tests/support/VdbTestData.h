@@ -170,6 +170,14 @@ GridProbe probeGridReadByTickfx(const std::filesystem::path& path, const std::st
 std::unique_ptr<VectorField> oneVoxelFrames(const VectorField::Settings& settings, double voxelSize,
                                             const std::vector<Coord>& activeVoxel);
 
+/// The sampling oracle: what openvdb::tools::BoxSampler gives for the Vec3SGrid `grid` of `path`
+/// (read by openvdb::io::File) at each world position, its index from the grid's transform
+/// (worldToIndex), through one accessor for all of them; with `zeroOutside`, zero where the voxel
+/// nearest to the index (Coord::round) is inactive. VectorField's trilinear sampling, done by
+/// OpenVDB alone.
+Positions boxSamples(const std::filesystem::path& path, const std::string& grid,
+                     const Positions& world, bool zeroOutside);
+
 /// The comparison oracle for advection: openvdb::tools::PointAdvect<Vec3fGrid,
 /// std::vector<Vec3f>, false> (no constraint) advects `points` through bakeGrid(field, bake)
 /// (fields/vdb/VectorFieldGrids.h, tickfx's bake, the grid bakeVectorField samples): one
