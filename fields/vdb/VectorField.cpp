@@ -68,16 +68,6 @@ class LeafNeighbourhood {
   using Leaf = typename GridT::TreeType::LeafNodeType;
   using ValueT = typename GridT::ValueType;
 
-  /// acc.isValueOn(Coord::round(index)): whether the voxel nearest to `index` is active.
-  bool activeNearest(Accessor& acc, const openvdb::Vec3d& index) {
-    const openvdb::Coord nearest = openvdb::Coord::round(index);
-    anchor(openvdb::Coord(openvdb::tools::local_util::floorVec3(index)));
-    const int n = neighbour(acc, nearest);
-    if (n < 0) return acc.isValueOn(nearest);
-    const Leaf* leaf = leaf_[n];
-    return leaf != nullptr ? leaf->valueMask().isOn(Leaf::coordToOffset(nearest)) : active_[n];
-  }
-
   /// Asks the processor for the cache lines of the cell at `index` where it lies in the leaf
   /// the neighbourhood is anchored at (a later sample's, as samples come in leaf order): a
   /// sample's cost is the memory latency of its corners.
@@ -95,18 +85,39 @@ class LeafNeighbourhood {
     __builtin_prefetch(corner + kPlane + kRow);
   }
 
-  /// BoxSampler::sample(acc, index, result)'s result.
-  ValueT sample(Accessor& acc, const openvdb::Vec3d& index) {
+  /// BoxSampler::sample(acc, index, result)'s result into `result`, and true; or, with
+  /// `zeroOutside` where the voxel nearest to `index` is inactive (!acc.isValueOn(
+  /// Coord::round(index))), false and nothing sampled.
+  bool sample(Accessor& acc, const openvdb::Vec3d& index, bool zeroOutside, ValueT& result) {
     const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(index);
     const openvdb::Coord ijk(base);
     anchor(ijk);
+    if (zeroOutside && !active(acc, openvdb::Coord::round(index))) return false;
     ValueT data[2][2][2];
-    for (int a = 0; a < 2; ++a) {
-      for (int b = 0; b < 2; ++b) {
-        for (int c = 0; c < 2; ++c) data[a][b][c] = value(acc, ijk.offsetBy(a, b, c));
+    const openvdb::Coord local = ijk - origin_;
+    constexpr openvdb::Int32 kLast = static_cast<openvdb::Int32>(Leaf::DIM) - 1;
+    if (local.x() < kLast && local.y() < kLast && local.z() < kLast && neighbour(acc, ijk) == 0 &&
+        leaf_[0] != nullptr) {
+      // The cell inside the anchored leaf (7³ of its 8³ cells): its corners at fixed offsets.
+      const ValueT* v = values_[0] + Leaf::coordToOffset(ijk);
+      constexpr std::size_t kRow = Leaf::DIM, kPlane = Leaf::DIM * Leaf::DIM;
+      data[0][0][0] = v[0];
+      data[0][0][1] = v[1];
+      data[0][1][0] = v[kRow];
+      data[0][1][1] = v[kRow + 1];
+      data[1][0][0] = v[kPlane];
+      data[1][0][1] = v[kPlane + 1];
+      data[1][1][0] = v[kPlane + kRow];
+      data[1][1][1] = v[kPlane + kRow + 1];
+    } else {
+      for (int a = 0; a < 2; ++a) {
+        for (int b = 0; b < 2; ++b) {
+          for (int c = 0; c < 2; ++c) data[a][b][c] = value(acc, ijk.offsetBy(a, b, c));
+        }
       }
     }
-    return openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
+    result = openvdb::tools::BoxSampler::trilinearInterpolation(data, index - base);
+    return true;
   }
 
  private:
@@ -151,6 +162,14 @@ class LeafNeighbourhood {
       mask_[n] = 0;
     }
     fetched_ |= 1u << n;
+  }
+
+  // acc.isValueOn(voxel), for a voxel of the neighbourhood.
+  bool active(Accessor& acc, const openvdb::Coord& voxel) {
+    const int n = neighbour(acc, voxel);
+    if (n < 0) return acc.isValueOn(voxel);
+    const Leaf* leaf = leaf_[n];
+    return leaf != nullptr ? leaf->valueMask().isOn(Leaf::coordToOffset(voxel)) : active_[n];
   }
 
   ValueT value(Accessor& acc, const openvdb::Coord& voxel) {
@@ -239,8 +258,9 @@ struct ImplT final : VectorField::Impl {
   static Eigen::Vector3f at(Frame& f, const openvdb::Vec3d& world, bool zeroOutside) {
     const openvdb::Vec3d index = f.toIndex(world);
     if constexpr (std::is_same_v<Sampler, LeafBoxSampler>) {
-      if (zeroOutside && !f.cells.activeNearest(f.acc, index)) return Eigen::Vector3f::Zero();
-      return toFloat(f.cells.sample(f.acc, index));
+      ValueT u;
+      if (!f.cells.sample(f.acc, index, zeroOutside, u)) return Eigen::Vector3f::Zero();
+      return toFloat(u);
     } else {
       if (zeroOutside && !f.acc.isValueOn(openvdb::Coord::round(index))) {
         return Eigen::Vector3f::Zero();
