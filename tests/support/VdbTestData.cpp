@@ -115,6 +115,17 @@ void readMetadata(const openvdb::MetaMap& meta, std::map<std::string, T>& out) {
   }
 }
 
+// Grid `name` of `path`, read by openvdb::io::File alone (no tickfx code), in memory.
+openvdb::GridBase::Ptr readGridByOpenVdb(const std::filesystem::path& path,
+                                         const std::string& name) {
+  openvdb::initialize();
+  openvdb::io::File in(path.string());
+  in.open(false);
+  const openvdb::GridBase::Ptr grid = in.readGrid(name);
+  in.close();
+  return grid;
+}
+
 }  // namespace
 
 std::string toString(Compression compression) { return infoOf(compression).name; }
@@ -186,11 +197,7 @@ void writePointsFile(const std::filesystem::path& path, const PointsFileSpec& sp
 }
 
 PointsGridRead readPointsGrid(const std::filesystem::path& path, const std::string& name) {
-  openvdb::initialize();
-  openvdb::io::File in(path.string());
-  in.open(false);
-  const openvdb::GridBase::Ptr base = in.readGrid(name);
-  in.close();
+  const openvdb::GridBase::Ptr base = readGridByOpenVdb(path, name);
   const auto grid = openvdb::gridPtrCast<vdbp::PointDataGrid>(base);
   if (!grid) {
     throw std::runtime_error(path.string() + ": grid '" + name + "' is a " + base->type() +
@@ -287,12 +294,12 @@ std::unique_ptr<VectorField> oneVoxelFrames(const VectorField::Settings& setting
 
 Positions boxSamples(const std::filesystem::path& path, const std::string& grid,
                      const Positions& world, bool zeroOutside) {
-  openvdb::initialize();
-  openvdb::io::File in(path.string());
-  in.open();
-  const openvdb::Vec3SGrid::Ptr g = openvdb::gridPtrCast<openvdb::Vec3SGrid>(in.readGrid(grid));
-  in.close();
-  if (!g) throw std::runtime_error(path.string() + ": grid '" + grid + "' is not a vec3s grid");
+  const openvdb::GridBase::Ptr base = readGridByOpenVdb(path, grid);
+  const auto g = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base);
+  if (!g) {
+    throw std::runtime_error(path.string() + ": grid '" + grid + "' is a " + base->type() +
+                             ", not a vec3s grid");
+  }
   auto acc = g->getConstAccessor();
   Positions out;
   out.reserve(world.size());
