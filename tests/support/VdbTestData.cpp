@@ -48,11 +48,11 @@ const CompressionInfo& infoOf(Compression c) {
   throw std::logic_error("no such Compression");
 }
 
-void writeOneGrid(const std::filesystem::path& path, const openvdb::GridBase::Ptr& grid,
-                  Compression compression) {
+void writeGrids(const std::filesystem::path& path, const openvdb::GridCPtrVec& grids,
+                Compression compression) {
   openvdb::io::File out(path.string());
   if (compression != Compression::Default) out.setCompression(infoOf(compression).flags);
-  out.write(openvdb::GridCPtrVec{grid});
+  out.write(grids);
   out.close();
 }
 
@@ -131,23 +131,29 @@ openvdb::GridBase::Ptr readGridByOpenVdb(const std::filesystem::path& path,
 std::string toString(Compression compression) { return infoOf(compression).name; }
 
 void writeGridFile(const std::filesystem::path& path, const GridFileSpec& spec) {
+  writeGridsFile(path, {spec});
+}
+
+void writeGridsFile(const std::filesystem::path& path, const std::vector<GridFileSpec>& specs) {
   openvdb::initialize();
-  openvdb::GridBase::Ptr grid;
-  switch (spec.type) {
-    case GridType::Float:
-      grid = makeGrid<openvdb::FloatGrid>(spec);
-      break;
-    case GridType::Double:
-      grid = makeGrid<openvdb::DoubleGrid>(spec);
-      break;
-    case GridType::Vec3s:
-      grid = makeGrid<openvdb::Vec3SGrid>(spec);
-      break;
-    case GridType::Vec3d:
-      grid = makeGrid<openvdb::Vec3DGrid>(spec);
-      break;
+  openvdb::GridCPtrVec grids;
+  for (const GridFileSpec& spec : specs) {
+    switch (spec.type) {
+      case GridType::Float:
+        grids.push_back(makeGrid<openvdb::FloatGrid>(spec));
+        break;
+      case GridType::Double:
+        grids.push_back(makeGrid<openvdb::DoubleGrid>(spec));
+        break;
+      case GridType::Vec3s:
+        grids.push_back(makeGrid<openvdb::Vec3SGrid>(spec));
+        break;
+      case GridType::Vec3d:
+        grids.push_back(makeGrid<openvdb::Vec3DGrid>(spec));
+        break;
+    }
   }
-  writeOneGrid(path, grid, spec.compression);
+  writeGrids(path, grids, specs.empty() ? Compression::Default : specs.front().compression);
 }
 
 void writePointsFile(const std::filesystem::path& path, const PointsFileSpec& spec) {
@@ -193,7 +199,7 @@ void writePointsFile(const std::filesystem::path& path, const PointsFileSpec& sp
     }
   }
   grid->setName(spec.grid);
-  writeOneGrid(path, grid, spec.compression);
+  writeGrids(path, {grid}, spec.compression);
 }
 
 PointsGridRead readPointsGrid(const std::filesystem::path& path, const std::string& name) {

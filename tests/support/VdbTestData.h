@@ -77,6 +77,9 @@ struct GridFileSpec {
 /// Writes the grid of `spec` as the only grid of a new file `path` (replacing it), with
 /// openvdb::io::File.
 void writeGridFile(const std::filesystem::path& path, const GridFileSpec& spec);
+/// Writes the grids of `specs`, in this order, as the only grids of a new file `path` (replacing
+/// it), with the first's compression (io::File compresses a whole file alike).
+void writeGridsFile(const std::filesystem::path& path, const std::vector<GridFileSpec>& specs);
 
 /// An attribute that every point of writePointsFile gets with the same value
 /// (openvdb::points::appendAttribute), or an empty group (appendGroup).
