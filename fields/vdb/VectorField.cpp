@@ -256,7 +256,11 @@ struct ImplT final : VectorField::Impl {
 
   template <class Sampler>
   static Eigen::Vector3f at(Frame& f, const openvdb::Vec3d& world, bool zeroOutside) {
-    const openvdb::Vec3d index = f.toIndex(world);
+    return atIndex<Sampler>(f, f.toIndex(world), zeroOutside);
+  }
+  // at(), given the frame's index-space position of the world position (f.toIndex(world)).
+  template <class Sampler>
+  static Eigen::Vector3f atIndex(Frame& f, const openvdb::Vec3d& index, bool zeroOutside) {
     if constexpr (std::is_same_v<Sampler, LeafBoxSampler>) {
       ValueT u;
       if (!f.cells.sample(f.acc, index, zeroOutside, u)) return Eigen::Vector3f::Zero();
@@ -280,11 +284,12 @@ struct ImplT final : VectorField::Impl {
           second(*impl.grids[frames.second]),
           blend(frames.second != frames.first && frames.weight != 0.0f),
           zero(s.outside != VectorField::Outside::Background) {}
-    // Asks for the cache lines of the cell at `world` in the first frame, where it lies in the
-    // neighbourhood's first leaf (LeafBoxSampler only).
-    void prefetch(const openvdb::Vec3d& world) const { first.cells.prefetch(first.toIndex(world)); }
     Eigen::Vector3f operator()(const openvdb::Vec3d& world) {
-      const Eigen::Vector3f u = at<Sampler>(first, world, zero);
+      return (*this)(world, first.toIndex(world));
+    }
+    // The sample at `world`, given its index in the first frame (first.toIndex(world)).
+    Eigen::Vector3f operator()(const openvdb::Vec3d& world, const openvdb::Vec3d& firstIndex) {
+      const Eigen::Vector3f u = atIndex<Sampler>(first, firstIndex, zero);
       if (!blend) return u;
       const Eigen::Vector3f u1 = at<Sampler>(second, world, zero);
       const float w = frames.weight, one = 1.0f - w;
@@ -303,15 +308,31 @@ struct ImplT final : VectorField::Impl {
     const ConstVec3Rows p = in.position.rows(rows);
     const ConstVec3Rows v = in.velocity.rows(rows);
     const Eigen::Index n = rows.count();
-    for (Eigen::Index j = 0; j < n; ++j) {
-      if constexpr (std::is_same_v<Sampler, LeafBoxSampler>) {
-        if (j + kPrefetchRows < n) {
-          const Eigen::Index k = j + kPrefetchRows;
-          field.prefetch(openvdb::Vec3d(p.x[k], p.y[k], p.z[k]));
-        }
+    // float → double is exact; the sample is rounded to float once.
+    const auto world = [&p](Eigen::Index j) { return openvdb::Vec3d(p.x[j], p.y[j], p.z[j]); };
+    // LeafBoxSampler: the first frame's index of rows j to j + kPrefetchRows - 1, at
+    // ahead[row % kPrefetchRows], worked out once: when the row kPrefetchRows ahead is
+    // prefetched, and used when it is sampled.
+    openvdb::Vec3d ahead[kPrefetchRows];
+    if constexpr (std::is_same_v<Sampler, LeafBoxSampler>) {
+      for (Eigen::Index k = 0; k < std::min(n, kPrefetchRows); ++k) {
+        ahead[k] = field.first.toIndex(world(k));
       }
-      // float → double is exact; the sample is rounded to float once.
-      const Eigen::Vector3f u = field(openvdb::Vec3d(p.x[j], p.y[j], p.z[j]));
+    }
+    for (Eigen::Index j = 0; j < n; ++j) {
+      Eigen::Vector3f u;
+      if constexpr (std::is_same_v<Sampler, LeafBoxSampler>) {
+        openvdb::Vec3d& slot = ahead[static_cast<std::size_t>(j) % kPrefetchRows];
+        const openvdb::Vec3d index = slot;
+        if (j + kPrefetchRows < n) {
+          const openvdb::Vec3d later = field.first.toIndex(world(j + kPrefetchRows));
+          slot = later;
+          field.first.cells.prefetch(later);
+        }
+        u = field(world(j), index);
+      } else {
+        u = field(world(j));
+      }
       if (drag) {
         out.x[j] += s.scale * (u.x() - v.x[j]);
         out.y[j] += s.scale * (u.y() - v.y[j]);
