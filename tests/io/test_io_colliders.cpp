@@ -374,8 +374,7 @@ hits = true
 
   const vdb_test::PointsGridRead grid = vdb_test::readPointsGrid(dir_ / "f.vdb", "points");
   ASSERT_FALSE(grid.leaves.empty());
-  std::map<std::string, std::string> types;  // the first leaf's attributes: name -> value type
-  for (const vdb_test::PointAttributeInfo& a : grid.leaves.front()) types[a.name] = a.valueType;
+  std::map<std::string, std::string> types = vdb_test::attributeTypes(grid.leaves.front());
   const std::vector<std::pair<std::string, std::string>> expected = {{"hitnum", "int32"},
                                                                      {"hittime", "float"},
                                                                      {"hitpos", "vec3s"},

@@ -213,8 +213,7 @@ TEST_F(ioSubEmittersOnDisk, ColourOpacityAndSizeGoToEveryCacheFormat) {
             std::string::npos);
   const vdb_test::PointsGridRead grid = vdb_test::readPointsGrid(dir_ / "f.vdb", "points");
   ASSERT_FALSE(grid.leaves.empty());
-  std::map<std::string, std::string> types;  // the first leaf's attributes: name -> value type
-  for (const vdb_test::PointAttributeInfo& a : grid.leaves.front()) types[a.name] = a.valueType;
+  std::map<std::string, std::string> types = vdb_test::attributeTypes(grid.leaves.front());
   for (const auto& [name, type] : std::vector<std::pair<std::string, std::string>>{
            {"Cd", "vec3s"}, {"Alpha", "float"}, {"pscale", "float"}, {"emitter", "int32"}}) {
     ASSERT_TRUE(types.count(name)) << name;

@@ -171,10 +171,9 @@ TEST_F(ioVdbPoints, OpenVdbReadsEveryAttributeBitwiseAndTheMetadata) {
   std::vector<std::string> names;
   for (const std::vector<vdbt::PointAttributeInfo>& leaf : grid.leaves) {
     names.clear();
-    std::map<std::string, std::string> types;
+    std::map<std::string, std::string> types = vdbt::attributeTypes(leaf);
     for (const vdbt::PointAttributeInfo& a : leaf) {
       names.push_back(a.name);
-      types[a.name] = a.valueType;
       if (a.name == "P") {
         EXPECT_EQ(a.codec, "null");
       }

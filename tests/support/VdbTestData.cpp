@@ -76,7 +76,7 @@ Value valueOf(const T& t) {
 }
 
 template <typename GridT>
-openvdb::GridBase::Ptr makeGrid(const GridFileSpec& spec) {
+openvdb::GridBase::Ptr makeGridAs(const GridFileSpec& spec) {
   using V = typename GridT::ValueType;
   typename GridT::Ptr grid = GridT::create(valueAs<V>(spec.background));
   grid->setName(spec.name);
@@ -91,6 +91,21 @@ openvdb::GridBase::Ptr makeGrid(const GridFileSpec& spec) {
   }
   grid->setSaveFloatAsHalf(spec.halfFloats);
   return grid;
+}
+
+// The grid of `spec`, of its type.
+openvdb::GridBase::Ptr makeGrid(const GridFileSpec& spec) {
+  switch (spec.type) {
+    case GridType::Float:
+      return makeGridAs<openvdb::FloatGrid>(spec);
+    case GridType::Double:
+      return makeGridAs<openvdb::DoubleGrid>(spec);
+    case GridType::Vec3s:
+      return makeGridAs<openvdb::Vec3SGrid>(spec);
+    case GridType::Vec3d:
+      return makeGridAs<openvdb::Vec3DGrid>(spec);
+  }
+  throw std::logic_error("no such GridType");
 }
 
 template <typename GridT>
@@ -137,22 +152,7 @@ void writeGridFile(const std::filesystem::path& path, const GridFileSpec& spec) 
 void writeGridsFile(const std::filesystem::path& path, const std::vector<GridFileSpec>& specs) {
   openvdb::initialize();
   openvdb::GridCPtrVec grids;
-  for (const GridFileSpec& spec : specs) {
-    switch (spec.type) {
-      case GridType::Float:
-        grids.push_back(makeGrid<openvdb::FloatGrid>(spec));
-        break;
-      case GridType::Double:
-        grids.push_back(makeGrid<openvdb::DoubleGrid>(spec));
-        break;
-      case GridType::Vec3s:
-        grids.push_back(makeGrid<openvdb::Vec3SGrid>(spec));
-        break;
-      case GridType::Vec3d:
-        grids.push_back(makeGrid<openvdb::Vec3DGrid>(spec));
-        break;
-    }
-  }
+  for (const GridFileSpec& spec : specs) grids.push_back(makeGrid(spec));
   writeGrids(path, grids, specs.empty() ? Compression::Default : specs.front().compression);
 }
 
@@ -265,6 +265,12 @@ PointsGridRead readPointsGrid(const std::filesystem::path& path, const std::stri
     }
   }
   return out;
+}
+
+std::map<std::string, std::string> attributeTypes(const std::vector<PointAttributeInfo>& leaf) {
+  std::map<std::string, std::string> types;
+  for (const PointAttributeInfo& a : leaf) types[a.name] = a.valueType;
+  return types;
 }
 
 GridProbe probeGridReadByTickfx(const std::filesystem::path& path, const std::string& grid,

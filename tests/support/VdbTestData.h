@@ -150,6 +150,9 @@ struct PointsGridRead {
 /// OpenVDB's exceptions for a missing file or grid.
 PointsGridRead readPointsGrid(const std::filesystem::path& path, const std::string& grid);
 
+/// A leaf's attributes (one of PointsGridRead::leaves) by name: name → value type.
+std::map<std::string, std::string> attributeTypes(const std::vector<PointAttributeInfo>& leaf);
+
 /// A grid as tickfx's checked reader gives it, looked at through OpenVDB.
 struct GridProbe {
   std::string type;  // GridBase::type(): "Tree_vec3s_5_4_3", "Tree_double_5_4_3", ...
