@@ -32,6 +32,11 @@ using Lanes4 = float __attribute__((vector_size(16)));
 /// lane IEEE arithmetic: the bits of the rows computed one by one.
 using Lanes8 = float __attribute__((vector_size(32)));
 
+/// Sixteen rows: the register of AVX-512, used only inside the AVX-512 clones of the update loops
+/// (updateBlocksAvx512), as Lanes8 in the AVX2 ones. Its comparisons compile to mask registers
+/// (flushTiny()).
+using Lanes16 = float __attribute__((vector_size(64)));
+
 /// The integer lanes of a Lane, for its bits.
 template <class Lane>
 struct LaneBits;
@@ -42,6 +47,10 @@ struct LaneBits<Lanes4> {
 template <>
 struct LaneBits<Lanes8> {
   using type = std::int32_t __attribute__((vector_size(32)));
+};
+template <>
+struct LaneBits<Lanes16> {
+  using type = std::int32_t __attribute__((vector_size(64)));
 };
 
 /// The number of rows a Lane holds (1 for float).
@@ -76,15 +85,23 @@ Lane flushTiny(Lane value) {
   } else {
     using Bits = typename LaneBits<Lane>::type;
     const auto bits = std::bit_cast<Bits>(value);
-    // all ones where kept: at least kSmallestStored, infinite or NaN
-    const Bits keep = (bits & 0x7fffffff) >= static_cast<std::int32_t>(kSmallestStoredBits);
-    return std::bit_cast<Lane>(bits & (keep | std::int32_t{-0x7fffffff - 1}));
+    const Bits magnitude = bits & 0x7fffffff;
+    if constexpr (std::is_same_v<Lane, Lanes16>) {
+      // With AVX-512 the comparison is a mask register and the select one masked AND: three
+      // instructions, where the form below takes four.
+      const Bits tiny = magnitude < static_cast<std::int32_t>(kSmallestStoredBits);
+      return std::bit_cast<Lane>(tiny ? bits & std::int32_t{-0x7fffffff - 1} : bits);
+    } else {
+      // all ones where kept: at least kSmallestStored, infinite or NaN
+      const Bits keep = magnitude >= static_cast<std::int32_t>(kSmallestStoredBits);
+      return std::bit_cast<Lane>(bits & (keep | std::int32_t{-0x7fffffff - 1}));
+    }
   }
 }
 
 /// Where a row kernel reads and writes: row `i` of each column it is given (Lane = float), or
-/// rows i..i+kLanes-1 (Lane = Lanes4 or Lanes8). A kernel is written once over `auto row` and
-/// `auto` values, and runs a Lane of rows at a time in the loop's body and one at a time in its
+/// rows i..i+kLanes-1 (Lane = Lanes4, Lanes8 or Lanes16). A kernel is written once over `auto row`
+/// and `auto` values, and runs a Lane of rows at a time in the loop's body and one at a time in its
 /// tail. Without kCopies, copy() writes nothing: the loop's previous positions go to no reader.
 template <class Lane, bool kCopies = true>
 struct RowsAt {
@@ -220,7 +237,7 @@ bool loopAt(const Loop& loop, const Kernel& kernel, Eigen::Index offset, Eigen::
 /// tile's components in turn, each over the whole tile, would read two or three columns at a
 /// time and restart the processor's prefetch streams at every turn; in blocks of this many rows
 /// all the tile's columns stream at once, and a tick of 10⁶ rows runs about twice as fast
-/// (docs/performance.md). A multiple of every loop's group of rows (2 · Lanes8).
+/// (docs/performance.md). A multiple of every loop's group of rows (2 · Lanes16).
 inline constexpr Eigen::Index kComponentBlockRows = 128;
 
 /// `updateComponent(c, offset, count, loop)` for the three components c, block by block
@@ -257,6 +274,15 @@ template <bool kCheck, bool kCopies, class UpdateComponent>
     Eigen::Index n, const UpdateComponent& updateComponent) {
   return updateBlocksAs<Lanes8, kCheck, kCopies>(n, updateComponent);
 }
+
+/// updateBlocksAs() compiled for AVX-512 (F), sixteen rows a register, flattened as the AVX2
+/// clone is: the same operations on the same values, so the same bits (test_passes and
+/// test_subnormals run every path).
+template <bool kCheck, bool kCopies, class UpdateComponent>
+[[gnu::noinline, gnu::target("avx2,avx512f"), gnu::flatten]] bool updateBlocksAvx512(
+    Eigen::Index n, const UpdateComponent& updateComponent) {
+  return updateBlocksAs<Lanes16, kCheck, kCopies>(n, updateComponent);
+}
 #endif
 
 /// updateBlocksAs() on the path activeIsa() names, checked (summing what the kernels return)
@@ -264,7 +290,14 @@ template <bool kCheck, bool kCopies, class UpdateComponent>
 template <bool kCheck, bool kCopies, class UpdateComponent>
 bool updateBlocks(Eigen::Index n, const UpdateComponent& updateComponent) {
 #ifdef TICKFX_AVX2_CLONES
-  if (activeIsa() == Isa::Avx2) return updateBlocksAvx2<kCheck, kCopies>(n, updateComponent);
+  switch (activeIsa()) {
+    case Isa::Avx512:
+      return updateBlocksAvx512<kCheck, kCopies>(n, updateComponent);
+    case Isa::Avx2:
+      return updateBlocksAvx2<kCheck, kCopies>(n, updateComponent);
+    case Isa::Baseline:
+      break;
+  }
 #endif
   return updateBlocksBaseline<kCheck, kCopies>(n, updateComponent);
 }

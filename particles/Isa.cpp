@@ -7,15 +7,18 @@
 namespace tickfx {
 namespace {
 
-bool avx2Here() {
+// The widest Isa this processor runs. __builtin_cpu_supports() reports AVX and AVX-512 only where
+// the system also saves their registers (XGETBV), as libgcc and compiler-rt read them.
+Isa widestHere() {
 #ifdef TICKFX_AVX2_CLONES
-  static const bool has = [] {
+  static const Isa widest = [] {
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
+    if (__builtin_cpu_supports("avx2") == 0) return Isa::Baseline;
+    return __builtin_cpu_supports("avx512f") != 0 ? Isa::Avx512 : Isa::Avx2;
   }();
-  return has;
+  return widest;
 #else
-  return false;
+  return Isa::Baseline;
 #endif
 }
 
@@ -24,12 +27,12 @@ std::atomic<int> forced{-1};
 
 }  // namespace
 
-bool isaAvailable(Isa isa) { return isa == Isa::Baseline || avx2Here(); }
+bool isaAvailable(Isa isa) { return isa <= widestHere(); }
 
 Isa activeIsa() {
   const int f = forced.load(std::memory_order_relaxed);
   if (f >= 0) return static_cast<Isa>(f);
-  return avx2Here() ? Isa::Avx2 : Isa::Baseline;
+  return widestHere();
 }
 
 void forceIsa(std::optional<Isa> isa) {
@@ -37,6 +40,16 @@ void forceIsa(std::optional<Isa> isa) {
   forced.store(isa ? static_cast<int>(*isa) : -1, std::memory_order_relaxed);
 }
 
-const char* isaName(Isa isa) { return isa == Isa::Avx2 ? "AVX2" : "baseline"; }
+const char* isaName(Isa isa) {
+  switch (isa) {
+    case Isa::Avx2:
+      return "AVX2";
+    case Isa::Avx512:
+      return "AVX-512";
+    case Isa::Baseline:
+      break;
+  }
+  return "baseline";
+}
 
 }  // namespace tickfx

@@ -290,7 +290,8 @@ SpawnTargets advanced(const SpawnTargets& t, std::size_t rows) {
 void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
                std::size_t count, const SpawnTargets& out) {
   Chunk chunk;
-  const bool avx2 = activeIsa() == Isa::Avx2;
+  // No AVX-512 clone here: the AVX2 one serves there too (Isa is ordered by width).
+  const bool avx2 = activeIsa() >= Isa::Avx2;
   for (std::size_t k = 0; k < count; k += kChunk) {
     chunk.n = std::min(kChunk, count - k);
 #ifdef TICKFX_AVX2_CLONES

@@ -90,11 +90,17 @@ std::string describe(const ParticleInit& p) {
 }
 
 #if defined(__x86_64__)
-// The AVX2 path is chosen where the processor has it, and only there.
-TEST(EmitterBatch, TheAvx2PathIsAvailableExactlyWhereTheProcessorHasIt) {
+// The AVX2 and AVX-512 paths are chosen where the processor has them, and only there; the
+// default is the widest.
+TEST(EmitterBatch, TheWiderPathsAreAvailableExactlyWhereTheProcessorHasThem) {
   __builtin_cpu_init();
-  EXPECT_EQ(isaAvailable(Isa::Avx2), __builtin_cpu_supports("avx2") != 0);
+  const bool avx2 = __builtin_cpu_supports("avx2") != 0;
+  const bool avx512 = avx2 && __builtin_cpu_supports("avx512f") != 0;
+  EXPECT_EQ(isaAvailable(Isa::Avx2), avx2);
+  EXPECT_EQ(isaAvailable(Isa::Avx512), avx512);
   EXPECT_TRUE(isaAvailable(Isa::Baseline));
+  EXPECT_EQ(activeIsa(), avx512 ? Isa::Avx512 : avx2 ? Isa::Avx2 : Isa::Baseline);
+  EXPECT_STREQ(isaName(Isa::Avx512), "AVX-512");
 }
 #endif
 

@@ -12,6 +12,7 @@ namespace tickfx::test {
 inline std::vector<Isa> isasHere() {
   std::vector<Isa> out{Isa::Baseline};
   if (isaAvailable(Isa::Avx2)) out.push_back(Isa::Avx2);
+  if (isaAvailable(Isa::Avx512)) out.push_back(Isa::Avx512);
   return out;
 }
 
