@@ -14,14 +14,15 @@
 //   AoS loop          std::vector<{Vector3f position, velocity}>, one thread: what a user writes.
 //   hand SoA loop     six float arrays through __restrict pointers, 1 thread and all threads:
 //                     the best hand loop (48 bytes moved a particle-step), the same bits as AoS;
-//                     where the processor has AVX2, also compiled for it (1 thread), since
-//                     tickfx's update loops take their AVX2 clones there (particles/Isa.h).
+//                     where the processor has AVX2 (AVX-512), also compiled for it (1 thread),
+//                     since tickfx's update loops take their clones there (particles/Isa.h).
 //   tickfx integrate  SemiImplicitEuler::step on the pool: force evaluation and state update
 //                     only, the part of a tick that does the physics.
 //   tickfx step()     ParticleSystem::step(): the above plus emitters, ForceSet::beginTick, age
 //                     recomputation and removal of the dead, i.e. what a tick costs a user.
-//   tickfx step() SSE2  step() with the loops forced to their baseline path (where AVX2 is the
-//                     default): what the AVX2 clones gain.
+//   tickfx step() SSE2  step() with the loops forced to their baseline path (where AVX2 or
+//                     AVX-512 is the default): what the clones gain; with AVX-512 the default,
+//                     also `step() AVX2`, forced to the AVX2 clones.
 //   tickfx fused x4   stepTicks(4): frames of four ticks, each block of rows taken through all
 //                     four while in cache (fused frames), the same bits as four step() calls.
 // Each tickfx case runs with 1 thread and with all threads, so the table separates the gain of
@@ -58,6 +59,7 @@
 #include "fields/PeriodicWind.h"
 #include "fields/SpringNetwork.h"
 #include "integrators/SemiImplicitEuler.h"
+#include "particles/Column.h"
 #include "particles/Isa.h"
 #include "particles/ParticleSystem.h"
 #include "particles/Random.h"
@@ -154,16 +156,41 @@ class HandWrittenLoop {
   std::int64_t tick_ = 0;
 };
 
+// A hand loop's column: n floats in the pool's own storage (allocateColumnStorage: cache-line
+// aligned, huge pages from 2 MiB on), so that the loops compared differ in their loops, not in
+// their pages. With std::vector's 4 KiB pages the hand loop's batches at 10⁷ ranged from 10 to
+// 57 ms a tick on a KVM guest, where the pool's ranged from 9 to 17.
+class HandColumn {
+ public:
+  explicit HandColumn(std::size_t n)
+      : n_(n),
+        data_(static_cast<float*>(tickfx::allocateColumnStorage(
+            std::max<std::size_t>(64, (n * sizeof(float) + 63) / 64 * 64)))) {}
+  HandColumn(const HandColumn&) = delete;
+  HandColumn& operator=(const HandColumn&) = delete;
+  ~HandColumn() { std::free(data_); }
+  std::size_t size() const { return n_; }
+  float* data() { return data_; }
+  float& operator[](std::size_t i) { return data_[i]; }
+  float operator[](std::size_t i) const { return data_[i]; }
+  const float* begin() const { return data_; }
+  const float* end() const { return data_ + n_; }
+
+ private:
+  std::size_t n_;
+  float* data_;
+};
+
 // The best loop a user could write: one float array a component (structure of arrays), raw
 // `__restrict` pointers so the compiler vectorises without alias checks, blocks of rows shared
 // among threads. The same sums in the same order as the AoS loop, so the two agree bit for bit.
 // 24 bytes read and 24 written a particle-step.
 class HandSoaLoop {
  public:
-  /// With `avx2`, the same loop compiled for AVX2 (the compiler vectorises it eight floats wide):
-  /// what tickfx's own AVX2 path is measured against too.
-  explicit HandSoaLoop(std::size_t n, bool avx2 = false) : avx2_(avx2), wind_(windSettings()) {
-    for (auto* column : {&px_, &py_, &pz_, &vx_, &vy_, &vz_}) column->resize(n);
+  /// With `isa` AVX2 or AVX-512, the same loop compiled for it (the compiler vectorises it eight
+  /// or sixteen floats wide): what tickfx's own clones are measured against too.
+  explicit HandSoaLoop(std::size_t n, tickfx::Isa isa = tickfx::Isa::Baseline)
+      : isa_(isa), px_(n), py_(n), pz_(n), vx_(n), vy_(n), vz_(n), wind_(windSettings()) {
     for (std::size_t i = 0; i < n; ++i) {
       const Particle p = initialParticle(i);
       px_[i] = p.position.x();
@@ -227,7 +254,12 @@ class HandSoaLoop {
   };
   void rows(const Accel& a, std::size_t begin, std::size_t end) {
 #ifdef TICKFX_AVX2_CLONES
-    if (avx2_) {
+    if (isa_ == tickfx::Isa::Avx512) {
+      rowsOfAvx512(px_.data(), py_.data(), pz_.data(), vx_.data(), vy_.data(), vz_.data(), a, begin,
+                   end);
+      return;
+    }
+    if (isa_ == tickfx::Isa::Avx2) {
       rowsOfAvx2(px_.data(), py_.data(), pz_.data(), vx_.data(), vy_.data(), vz_.data(), a, begin,
                  end);
       return;
@@ -237,6 +269,13 @@ class HandSoaLoop {
   }
 #ifdef TICKFX_AVX2_CLONES
   [[gnu::target("avx2"), gnu::flatten]] static void rowsOfAvx2(
+      float* __restrict px, float* __restrict py, float* __restrict pz, float* __restrict vx,
+      float* __restrict vy, float* __restrict vz, const Accel a, std::size_t begin,
+      std::size_t end) {
+    rowsOf(px, py, pz, vx, vy, vz, a, begin, end);
+  }
+  // The flags of tickfx's AVX-512 clones (integrators/CheckedRows.h).
+  [[gnu::target("avx2,avx512f"), gnu::flatten]] static void rowsOfAvx512(
       float* __restrict px, float* __restrict py, float* __restrict pz, float* __restrict vx,
       float* __restrict vy, float* __restrict vz, const Accel a, std::size_t begin,
       std::size_t end) {
@@ -259,8 +298,8 @@ class HandSoaLoop {
     }
   }
 
-  bool avx2_;
-  std::vector<float> px_, py_, pz_, vx_, vy_, vz_;
+  tickfx::Isa isa_;
+  HandColumn px_, py_, pz_, vx_, vy_, vz_;
   tickfx::PeriodicWind wind_;
   Eigen::Vector3f windDirection_;
   std::int64_t tick_ = 0;
@@ -373,13 +412,17 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   std::fflush(stdout);
   HandWrittenLoop aos(n);
   HandSoaLoop soaOne(n), soaAll(n);
-  // The hand loop and step() on the other path of the processor: AVX2 for the hand loop where
-  // the processor has it, the baseline (SSE2) for tickfx, whose default is AVX2 there.
+  // The hand loop and step() on the other paths of the processor: the hand loop compiled for
+  // AVX2 and AVX-512 where the processor has them; tickfx forced to the baseline (SSE2) and,
+  // where AVX-512 is its default, to AVX2.
   const bool avx2 = tickfx::isaAvailable(tickfx::Isa::Avx2);
-  std::optional<HandSoaLoop> soaAvx2;
-  if (avx2) soaAvx2.emplace(n, true);
+  const bool avx512 = tickfx::isaAvailable(tickfx::Isa::Avx512);
+  std::optional<HandSoaLoop> soaAvx2, soaAvx512;
+  if (avx2) soaAvx2.emplace(n, tickfx::Isa::Avx2);
+  if (avx512) soaAvx512.emplace(n, tickfx::Isa::Avx512);
   std::unique_ptr<tickfx::ParticleSystem> one = makeSystem(n, 1);
   std::unique_ptr<tickfx::ParticleSystem> baselineOne = avx2 ? makeSystem(n, 1) : nullptr;
+  std::unique_ptr<tickfx::ParticleSystem> avx2One = avx512 ? makeSystem(n, 1) : nullptr;
   std::unique_ptr<tickfx::ParticleSystem> all = allThreads > 1 ? makeSystem(n, 0) : nullptr;
   // The same system without the per-tick non-finite check: what the check costs a tick.
   std::unique_ptr<tickfx::ParticleSystem> unchecked =
@@ -394,8 +437,10 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   soaOne.tick(arenaOne);
   soaAll.tick(arenaAll);
   if (soaAvx2) soaAvx2->tick(arenaOne);
-  const bool soaSame =
-      soaOne.sameBitsAs(aos) && soaAll.sameBitsAs(aos) && (!soaAvx2 || soaAvx2->sameBitsAs(aos));
+  if (soaAvx512) soaAvx512->tick(arenaOne);
+  const bool soaSame = soaOne.sameBitsAs(aos) && soaAll.sameBitsAs(aos) &&
+                       (!soaAvx2 || soaAvx2->sameBitsAs(aos)) &&
+                       (!soaAvx512 || soaAvx512->sameBitsAs(aos));
   std::printf("  check after one tick, hand SoA vs AoS: %s\n",
               soaSame ? "the same bits" : "MISMATCH");
   one->step();
@@ -403,6 +448,10 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   if (baselineOne) {
     const tickfx::ForcedIsa forced(tickfx::Isa::Baseline);
     baselineOne->step();
+  }
+  if (avx2One) {
+    const tickfx::ForcedIsa forced(tickfx::Isa::Avx2);
+    avx2One->step();
   }
   Difference d = compare(aos, one->pool());
   if (all) {
@@ -442,6 +491,11 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
       for (std::int64_t i = 0; i < ticks; ++i) soaAvx2->tick(arenaOne);
     });
   }
+  if (soaAvx512) {
+    cases.emplace_back("hand SoA loop AVX-512, " + threadsLabel(1), [&](std::int64_t ticks) {
+      for (std::int64_t i = 0; i < ticks; ++i) soaAvx512->tick(arenaOne);
+    });
+  }
   cases.emplace_back("tickfx integrate, " + threadsLabel(1), [&](std::int64_t ticks) {
     integrate(arenaOne, integrateOne, *one, tickOne, ticks);
   });
@@ -462,6 +516,12 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
     cases.emplace_back("tickfx step(), 1 t., SSE2", [&](std::int64_t ticks) {
       const tickfx::ForcedIsa forced(tickfx::Isa::Baseline);
       for (std::int64_t i = 0; i < ticks; ++i) baselineOne->step();
+    });
+  }
+  if (avx2One) {
+    cases.emplace_back("tickfx step(), 1 t., AVX2", [&](std::int64_t ticks) {
+      const tickfx::ForcedIsa forced(tickfx::Isa::Avx2);
+      for (std::int64_t i = 0; i < ticks; ++i) avx2One->step();
     });
   }
   if (all) {
@@ -511,7 +571,9 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   std::fflush(stdout);
 
   checksum += (soaAvx2 ? soaAvx2->positionSum() : 0.0) +
-              (baselineOne ? positionSum(baselineOne->pool()) : 0.0);
+              (soaAvx512 ? soaAvx512->positionSum() : 0.0) +
+              (baselineOne ? positionSum(baselineOne->pool()) : 0.0) +
+              (avx2One ? positionSum(avx2One->pool()) : 0.0);
   checksum += positionSum(aos) + soaOne.positionSum() + soaAll.positionSum() +
               positionSum(one->pool()) + positionSum(unchecked->pool()) +
               (all ? positionSum(all->pool()) : 0.0) + positionSum(fusedOne->pool()) +
@@ -635,19 +697,26 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
         "tick step 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread paired round by "
         "round, target >= 0.9x; %.2fx by the medians; %.2fx AoS)\n",
         z, rate(step).c_str(), step.pairedHand, step.stepsPerSecond / h, step.stepsPerSecond / a);
-    const Row soaAvx2 = row("hand SoA loop AVX2, 1 thread"),
-              stepSse2 = row("tickfx step(), 1 t., SSE2");
-    if (soaAvx2.stepsPerSecond > 0.0) {
+    // The wider paths, where the processor has them: each hand loop against the baseline one
+    // and step() on its widest path; step() forced to each narrower path of its own.
+    const char* widest = tickfx::isaName(tickfx::activeIsa());
+    for (const char* isa : {"AVX2", "AVX-512"}) {
+      const Row wide = row(std::string("hand SoA loop ") + isa + ", 1 thread");
+      if (wide.stepsPerSecond <= 0.0) continue;
       std::printf(
-          "tick hand SoA AVX2 1 thread %s: %s particle-steps/s (%.2fx hand SoA; tickfx step() "
+          "tick hand SoA %s 1 thread %s: %s particle-steps/s (%.2fx hand SoA; tickfx step() on %s "
           "%.2fx it)\n",
-          z, rate(soaAvx2).c_str(), soaAvx2.stepsPerSecond / h,
-          step.stepsPerSecond / soaAvx2.stepsPerSecond);
+          isa, z, rate(wide).c_str(), wide.stepsPerSecond / h, widest,
+          step.stepsPerSecond / wide.stepsPerSecond);
+    }
+    for (const char* isa : {"SSE2", "AVX2"}) {
+      const Row forced = row(std::string("tickfx step(), 1 t., ") + isa);
+      if (forced.stepsPerSecond <= 0.0) continue;
       std::printf(
-          "tick step SSE2 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread; %.2fx step() "
-          "on AVX2)\n",
-          z, rate(stepSse2).c_str(), stepSse2.stepsPerSecond / h,
-          stepSse2.stepsPerSecond / step.stepsPerSecond);
+          "tick step %s 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread; %.2fx step() "
+          "on %s)\n",
+          isa, z, rate(forced).c_str(), forced.stepsPerSecond / h,
+          forced.stepsPerSecond / step.stepsPerSecond, widest);
     }
     const Row fused = row(fusedLabel(1));
     std::printf(
