@@ -237,18 +237,23 @@ bool loopAt(const Loop& loop, const Kernel& kernel, Eigen::Index offset, Eigen::
 /// tile's components in turn, each over the whole tile, would read two or three columns at a
 /// time and restart the processor's prefetch streams at every turn; in blocks of this many rows
 /// all the tile's columns stream at once, and a tick of 10⁶ rows runs about twice as fast
-/// (docs/performance.md). A multiple of every loop's group of rows (2 · Lanes16).
-inline constexpr Eigen::Index kComponentBlockRows = 128;
+/// (docs/performance.md). Sixteen lanes take 512: each entry into a component's loop loads its
+/// pointers and broadcasts its constants again, which 128 rows (eight registers) left unamortised,
+/// and in cache a tick ran 1.4 times faster with 512; on four and eight lanes 512 gained nothing.
+/// A multiple of the loop's group of rows (2 · kLanes<Lane>).
+template <class Lane>
+inline constexpr Eigen::Index kComponentBlockRows = std::is_same_v<Lane, Lanes16> ? 512 : 128;
 
 /// `updateComponent(c, offset, count, loop)` for the three components c, block by block
-/// (kComponentBlockRows) over n rows; whether some call returned true. A row's components are
+/// (kComponentBlockRows<Lane>) over n rows; whether some call returned true. A row's components are
 /// independent, so the order changes no bit.
 template <class Lane, bool kCheck, bool kCopies, class UpdateComponent>
 [[gnu::always_inline]] inline bool updateBlocksAs(Eigen::Index n,
                                                   const UpdateComponent& updateComponent) {
   bool suspect = false;
-  for (Eigen::Index offset = 0; offset < n; offset += kComponentBlockRows) {
-    const Eigen::Index count = std::min(kComponentBlockRows, n - offset);
+  constexpr Eigen::Index kRows = kComponentBlockRows<Lane>;
+  for (Eigen::Index offset = 0; offset < n; offset += kRows) {
+    const Eigen::Index count = std::min(kRows, n - offset);
     for (int c = 0; c < 3; ++c) {
       suspect |= updateComponent(c, offset, count, RowLoop<Lane, kCheck, kCopies>{});
     }
