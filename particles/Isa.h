@@ -1,6 +1,6 @@
 // The instruction sets tickfx's widest loops are compiled for, chosen at run time. A loop has a
 // baseline form (SSE2 on x86-64, NEON on aarch64: what the build targets) and, on x86-64, an AVX2
-// clone and, for the update loops, an AVX-512 clone; all give the same bits, because the loops use
+// clone and an AVX-512 clone; all give the same bits, because the loops use
 // integer operations and IEEE arithmetic that rounds alike at any vector width (no FMA:
 // -ffp-contract=off, and the clones do not enable it). Tests force each path and compare them bit
 // for bit.
@@ -16,8 +16,7 @@
 
 namespace tickfx {
 
-/// Ordered by width: a loop without a clone for the active Isa takes its widest one below it (the
-/// emitters' sampler has no AVX-512 clone and runs its AVX2 one there).
+/// Ordered by width: a loop without a clone for the active Isa would take its widest one below it.
 enum class Isa { Baseline = 0, Avx2 = 1, Avx512 = 2 };
 
 /// Whether `isa` can run on this processor (Baseline always; Avx2 on an x86-64 processor with

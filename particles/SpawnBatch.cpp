@@ -272,6 +272,16 @@ void spawnChunk(const SpawnRecipe& r, std::uint64_t first, std::uint64_t stride,
                                                           const SpawnTargets& out) {
   spawnChunk<true>(r, first, stride, c, out);
 }
+
+// spawnChunk() compiled for AVX-512 (F, DQ, VL), flattened as the AVX2 clone is: its loops
+// vectorise eight doubles wide, and the draws' 64-bit multiplies become one instruction
+// (vpmullq, AVX-512DQ), which SSE2 and AVX2 emulate with three. The same integer and IEEE
+// operations, so the same bits (test_emitter_batch forces every path).
+[[gnu::target("avx2,avx512f,avx512dq,avx512vl"), gnu::flatten]] void spawnChunkAvx512(
+    const SpawnRecipe& r, std::uint64_t first, std::uint64_t stride, Chunk& c,
+    const SpawnTargets& out) {
+  spawnChunk<true>(r, first, stride, c, out);
+}
 #endif
 
 SpawnTargets advanced(const SpawnTargets& t, std::size_t rows) {
@@ -290,19 +300,22 @@ SpawnTargets advanced(const SpawnTargets& t, std::size_t rows) {
 void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
                std::size_t count, const SpawnTargets& out) {
   Chunk chunk;
-  // No AVX-512 clone here: the AVX2 one serves there too (Isa is ordered by width).
-  const bool avx2 = activeIsa() >= Isa::Avx2;
+  const Isa isa = activeIsa();
   for (std::size_t k = 0; k < count; k += kChunk) {
     chunk.n = std::min(kChunk, count - k);
 #ifdef TICKFX_AVX2_CLONES
-    if (avx2) {
+    if (isa == Isa::Avx512) {
+      spawnChunkAvx512(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
+      continue;
+    }
+    if (isa == Isa::Avx2) {
       spawnChunkAvx2(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
       continue;
     }
 #endif
     spawnChunk<false>(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
   }
-  (void)avx2;
+  (void)isa;
 }
 
 void spawnBatch(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
