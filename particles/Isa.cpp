@@ -14,7 +14,12 @@ Isa widestHere() {
   static const Isa widest = [] {
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx2") == 0) return Isa::Baseline;
-    return __builtin_cpu_supports("avx512f") != 0 ? Isa::Avx512 : Isa::Avx2;
+    // The AVX-512 clones are compiled for F, and the sampler's also for DQ (vpmullq) and VL:
+    // all three, or none is taken (Knights Landing has F without DQ and VL).
+    const bool avx512 = __builtin_cpu_supports("avx512f") != 0 &&
+                        __builtin_cpu_supports("avx512dq") != 0 &&
+                        __builtin_cpu_supports("avx512vl") != 0;
+    return avx512 ? Isa::Avx512 : Isa::Avx2;
   }();
   return widest;
 #else

@@ -20,8 +20,8 @@ namespace tickfx {
 enum class Isa { Baseline = 0, Avx2 = 1, Avx512 = 2 };
 
 /// Whether `isa` can run on this processor (Baseline always; Avx2 on an x86-64 processor with
-/// AVX2, Avx512 on one with AVX2 and AVX-512F whose system saves the 512-bit registers, in a build
-/// by GCC or Clang).
+/// AVX2, Avx512 on one with AVX2 and AVX-512 F, DQ and VL whose system saves the 512-bit registers,
+/// in a build by GCC or Clang).
 bool isaAvailable(Isa isa);
 
 /// The path the loops take now: the forced one (forceIsa()), else the widest available. Cheap:

@@ -95,7 +95,9 @@ std::string describe(const ParticleInit& p) {
 TEST(EmitterBatch, TheWiderPathsAreAvailableExactlyWhereTheProcessorHasThem) {
   __builtin_cpu_init();
   const bool avx2 = __builtin_cpu_supports("avx2") != 0;
-  const bool avx512 = avx2 && __builtin_cpu_supports("avx512f") != 0;
+  const bool avx512 = avx2 && __builtin_cpu_supports("avx512f") != 0 &&
+                      __builtin_cpu_supports("avx512dq") != 0 &&
+                      __builtin_cpu_supports("avx512vl") != 0;
   EXPECT_EQ(isaAvailable(Isa::Avx2), avx2);
   EXPECT_EQ(isaAvailable(Isa::Avx512), avx512);
   EXPECT_TRUE(isaAvailable(Isa::Baseline));
