@@ -299,23 +299,25 @@ SpawnTargets advanced(const SpawnTargets& t, std::size_t rows) {
 
 void spawnRows(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,
                std::size_t count, const SpawnTargets& out) {
+  // The path is chosen once: every chunk of the batch takes it.
+  auto* chunkOn = &spawnChunk<false>;
+#ifdef TICKFX_AVX2_CLONES
+  switch (activeIsa()) {
+    case Isa::Avx512:
+      chunkOn = &spawnChunkAvx512;
+      break;
+    case Isa::Avx2:
+      chunkOn = &spawnChunkAvx2;
+      break;
+    case Isa::Baseline:
+      break;
+  }
+#endif
   Chunk chunk;
-  const Isa isa = activeIsa();
   for (std::size_t k = 0; k < count; k += kChunk) {
     chunk.n = std::min(kChunk, count - k);
-#ifdef TICKFX_AVX2_CLONES
-    if (isa == Isa::Avx512) {
-      spawnChunkAvx512(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
-      continue;
-    }
-    if (isa == Isa::Avx2) {
-      spawnChunkAvx2(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
-      continue;
-    }
-#endif
-    spawnChunk<false>(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
+    chunkOn(recipe, firstSerial + k * stride, stride, chunk, advanced(out, k));
   }
-  (void)isa;
 }
 
 void spawnBatch(const SpawnRecipe& recipe, std::uint64_t firstSerial, std::uint64_t stride,

@@ -221,9 +221,11 @@ TEST_P(FusedFrames, StopAtTheTickThatWentNonFiniteWithItsState) {
 
 // The copy of a frame's start is written by each path's own stores (particles/Isa.h): every path
 // must restore the state it saved, for the schemes that save the previous position and the
-// acceleration too.
-TEST(FusedFrames, StopWithTheStateOneByOneOnEveryPath) {
+// acceleration too. The default path is the one StopAtTheTickThatWentNonFiniteWithItsState runs.
+TEST(FusedFrames, StopWithTheStateOneByOneOnEveryOtherPath) {
+  const Isa widest = activeIsa();
   for (const Isa isa : test::isasHere()) {
+    if (isa == widest) continue;
     const ForcedIsa forced(isa);
     for (const char* integrator : {"semi_implicit_euler", "position_verlet", "velocity_verlet"}) {
       SCOPED_TRACE(std::string(isaName(isa)) + ", " + integrator);
