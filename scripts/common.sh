@@ -6,7 +6,7 @@ TICKFX_BUILD=${TICKFX_BUILD:-$TICKFX_ROOT/build}
 
 # Everything tickfx builds with, from Debian's archive only.
 TICKFX_PACKAGES=(
-  cmake ninja-build g++ clang clang-format pkg-config
+  cmake ninja-build g++ clang clang-format lld pkg-config
   libeigen3-dev libtbb-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenvdb-dev libopenvdb-tools libboost-dev libboost-iostreams-dev zlib1g-dev
@@ -79,10 +79,17 @@ ensure_packages() {
 # library) are parsed a few times instead of once a file. scripts/test's Release build took 397 s
 # file by file on 2 cores. A plain `cmake -B build` still compiles file by file: developers build
 # that way, which is what keeps every file's includes its own.
+#
+# Linked by LLVM's lld (Debian's lld, for g++ and clang++ alike): it
+# links a sanitised test in a quarter of GNU ld's time (0.75 s against 2.95 s), about a minute of
+# scripts/test's builds on 2 cores. A linker does no arithmetic, so no bit changes.
 configure() {
   local dir=$1
   shift
-  cmake -S "$TICKFX_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON "$@"
+  local lld=-fuse-ld=lld
+  cmake -S "$TICKFX_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON \
+    "-DCMAKE_EXE_LINKER_FLAGS=$lld" "-DCMAKE_SHARED_LINKER_FLAGS=$lld" \
+    "-DCMAKE_MODULE_LINKER_FLAGS=$lld" "$@"
 }
 
 # configure_and_build BUILD_DIR [cmake args...]: configures and builds everything on every core.
