@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include "FuzzOneThread.h"
 #include "FuzzScratch.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
@@ -44,6 +45,11 @@ bool consistent(const tickfx::io::FrameData& f) {
 }
 
 }  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  tickfx::fuzz::runOnOneThread();
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto path = tickfx::fuzz::writeScratch(kScratchName, data, size);
