@@ -47,7 +47,6 @@ endforeach()
 if(NOT DEFINED VARIANTS)
   set(VARIANTS clang-native gcc-native)
 endif()
-set(variants ${VARIANTS})
 set(gcc-debug_compiler ${GXX})
 set(gcc-debug_type Debug)
 set(gcc-debug_flags "-O0")
@@ -75,7 +74,7 @@ function(run_step what)
   endif()
 endfunction()
 
-foreach(v ${variants})
+foreach(v ${VARIANTS})
   set(dir ${WORK_DIR}/${v})
   # A kept variant directory makes a second run incremental; one configured with another generator
   # or compiler cannot be reconfigured in place, so it is started afresh.
@@ -123,7 +122,7 @@ foreach(v ${variants})
 endforeach()
 
 set(${MAIN_NAME}_tickfx ${MAIN_TICKFX})
-golden_check(failures ${MAIN_NAME} ${variants})
+golden_check(failures ${MAIN_NAME} ${VARIANTS})
 if(failures GREATER 0)
   message(FATAL_ERROR "determinism.compilers: ${failures} build(s) or run(s) did not give the "
                       "golden hash of ${GOLDEN_FILE} or ${GOLDEN_EFFECTS_FILE}. The promise is "
