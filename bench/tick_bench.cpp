@@ -25,6 +25,9 @@
 //                     also `step() AVX2`, forced to the AVX2 clones.
 //   tickfx fused x4   stepTicks(4): frames of four ticks, each block of rows taken through all
 //                     four while in cache (fused frames), the same bits as four step() calls.
+//                     Under nonfinite = "stop" (the default) a frame first copies its rows'
+//                     state, to replay the frame tick by tick if it goes non-finite; `keep`
+//                     runs without the check, as the hand loops do: the like-for-like ratio.
 // Each tickfx case runs with 1 thread and with all threads, so the table separates the gain of
 // the layout from the gain of threading.
 //
@@ -430,6 +433,10 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   // Systems advanced kFusedTicks ticks a frame: fused frames (ParticleSystem's class comment).
   std::unique_ptr<tickfx::ParticleSystem> fusedOne = makeSystem(n, 1);
   std::unique_ptr<tickfx::ParticleSystem> fusedAll = allThreads > 1 ? makeSystem(n, 0) : nullptr;
+  // Fused frames without the non-finite check, as the hand loop runs: under "stop" a frame first
+  // copies its rows' state, so that it can be replayed tick by tick if it goes non-finite.
+  std::unique_ptr<tickfx::ParticleSystem> fusedUnchecked =
+      makeSystem(n, 1, tickfx::NonfinitePolicy::Keep);
 
   // Tick 0 from the identical initial state on every side.
   tbb::task_arena arenaOne(1), arenaAll(allThreads);
@@ -536,6 +543,9 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   };
   cases.emplace_back(fusedLabel(1), [&](std::int64_t ticks) { frames(*fusedOne, ticks); });
   cases.back().ticksPerFrame = kFusedTicks;
+  cases.emplace_back(fusedLabel(1) + ", keep",
+                     [&](std::int64_t ticks) { frames(*fusedUnchecked, ticks); });
+  cases.back().ticksPerFrame = kFusedTicks;
   if (fusedAll) {
     cases.emplace_back(fusedLabel(allThreads),
                        [&](std::int64_t ticks) { frames(*fusedAll, ticks); });
@@ -577,6 +587,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   checksum += positionSum(aos) + soaOne.positionSum() + soaAll.positionSum() +
               positionSum(one->pool()) + positionSum(unchecked->pool()) +
               (all ? positionSum(all->pool()) : 0.0) + positionSum(fusedOne->pool()) +
+              positionSum(fusedUnchecked->pool()) +
               (fusedAll ? positionSum(fusedAll->pool()) : 0.0);
   return d.withinRoundOff && soaSame;
 }
@@ -718,12 +729,18 @@ void printFigures(const std::vector<Row>& rows, const std::vector<std::size_t>& 
           isa, z, rate(forced).c_str(), forced.stepsPerSecond / h,
           forced.stepsPerSecond / step.stepsPerSecond, widest);
     }
-    const Row fused = row(fusedLabel(1));
+    const Row fused = row(fusedLabel(1)), fusedKeep = row(fusedLabel(1) + ", keep");
     std::printf(
         "tick fused %lld ticks a frame 1 thread %s: %s particle-steps/s (%.2fx hand SoA 1 thread "
         "paired, target >= 1.5x at 1e7; %.2fx by the medians; %.2fx tickfx step())\n",
         static_cast<long long>(kFusedTicks), z, rate(fused).c_str(), fused.pairedHand,
         fused.stepsPerSecond / h, fused.stepsPerSecond / step.stepsPerSecond);
+    std::printf(
+        "tick fused %lld ticks a frame 1 thread keep %s: %s particle-steps/s (%.2fx hand SoA 1 "
+        "thread paired, target >= 1.5x at 1e7, like for like: no non-finite check, as the hand "
+        "loop; %.2fx by the medians)\n",
+        static_cast<long long>(kFusedTicks), z, rate(fusedKeep).c_str(), fusedKeep.pairedHand,
+        fusedKeep.stepsPerSecond / h);
     if (allThreads == 1) continue;
     const Row fusedAll = row(fusedLabel(allThreads));
     std::printf(
