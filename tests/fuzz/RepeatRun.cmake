@@ -2,9 +2,10 @@
 # empty working corpus, and fails unless both runs leave the same corpus files (their names are
 # the inputs' SHA-1s). What makes a run repeat is in tests/fuzz/CMakeLists.txt; this catches a
 # change that brings back a thread, an exported instrumented function or a clock.
-# Inputs: FUZZER (the target), WORK (a scratch folder), RUNS, SEEDS (folders, ';'-separated),
-# LAUNCHER (optional: the command to run the target under, ';'-separated, e.g. setarch;-R).
-foreach(var FUZZER WORK RUNS SEEDS)
+# Inputs: FUZZER (the target), WORK (a scratch folder), RUNS, OPTIONS (libFuzzer's, those of the
+# fuzz.<reader> tests), SEEDS (folders), LAUNCHER (optional: the command to run the target under,
+# e.g. setarch;-R); lists ';'-separated.
+foreach(var FUZZER WORK RUNS OPTIONS SEEDS)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "RepeatRun.cmake: -D${var}=... is required")
   endif()
@@ -15,8 +16,8 @@ foreach(run a b)
   file(REMOVE_RECURSE ${WORK}/${run})
   file(MAKE_DIRECTORY ${WORK}/${run}/corpus)
   execute_process(
-    COMMAND ${LAUNCHER} ${FUZZER} -runs=${RUNS} -seed=1 -reload=0 -timeout=10 -rss_limit_mb=2048
-            -artifact_prefix=${WORK}/${run}/ ${WORK}/${run}/corpus ${SEEDS}
+    COMMAND ${LAUNCHER} ${FUZZER} -runs=${RUNS} ${OPTIONS} -artifact_prefix=${WORK}/${run}/
+            ${WORK}/${run}/corpus ${SEEDS}
     RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "fuzz.repeatable: run ${run} of ${FUZZER} failed (${rc}):\n${out}")

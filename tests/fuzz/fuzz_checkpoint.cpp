@@ -18,7 +18,6 @@
 #include <string>
 
 #include "../support/LittleEndianBytes.h"
-#include "FuzzOneThread.h"
 #include "FuzzScratch.h"
 #include "io/effect/EffectLoader.h"
 #include "io/state/Checkpoint.h"
@@ -98,7 +97,6 @@ using tickfx::test::storeU64;
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tickfx::fuzz::runOnOneThread();
   if (const char* seed = std::getenv("TICKFX_FUZZ_WRITE_SEED")) {
     auto system = makeSystem();
     system->stepTicks(40);  // the rope swinging, spray particles alive and some already dead

@@ -17,7 +17,6 @@
 #include <variant>
 #include <vector>
 
-#include "FuzzOneThread.h"
 #include "FuzzScratch.h"
 #include "io/effect/EffectLoader.h"
 #include "io/effect/EffectParser.h"
@@ -63,11 +62,6 @@ double bakedVoxels(const tickfx::io::EffectSettings& effect) {
 }
 
 }  // namespace
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tickfx::fuzz::runOnOneThread();
-  return 0;
-}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

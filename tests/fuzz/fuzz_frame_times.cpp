@@ -4,14 +4,8 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "FuzzOneThread.h"
 #include "FuzzScratch.h"
 #include "app/FrameTimes.h"
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tickfx::fuzz::runOnOneThread();
-  return 0;
-}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto path = tickfx::fuzz::writeScratch("frames.txt", data, size);

@@ -6,14 +6,8 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "FuzzOneThread.h"
 #include "fields/vdb/LevelSetCollider.h"
 #include "io/mesh/MeshFile.h"
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tickfx::fuzz::runOnOneThread();
-  return 0;
-}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);

@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "FuzzOneThread.h"
 #include "FuzzScratch.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/PlyCache.h"
@@ -45,11 +44,6 @@ bool consistent(const tickfx::io::FrameData& f) {
 }
 
 }  // namespace
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tickfx::fuzz::runOnOneThread();
-  return 0;
-}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto path = tickfx::fuzz::writeScratch(kScratchName, data, size);
