@@ -20,15 +20,23 @@ CheckedPair<Lane> explicitEulerRow(float dt, Lane acceleration, At at, float* po
   return {nextP, nextV};
 }
 
+// The row kernel as stepSingleEvaluation() takes it.
+auto rowOf(float dt) {
+  return [dt](auto acceleration, auto at, float* pos, float* vel, float* last) {
+    return explicitEulerRow(dt, acceleration, at, pos, vel, last);
+  };
+}
+
 }  // namespace
 
 void ExplicitEuler::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                               const StepRows& rows, NonfiniteCheck* check) {
-  const float dt = time.dt();
-  stepSingleEvaluation(pool, forces, time, rows, check, scratch_,
-                       [dt](auto acceleration, auto at, float* pos, float* vel, float* last) {
-                         return explicitEulerRow(dt, acceleration, at, pos, vel, last);
-                       });
+  stepSingleEvaluation(pool, forces, time, rows, check, scratch_, rowOf(time.dt()));
+}
+
+bool ExplicitEuler::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                              StateBound& bound) const {
+  return boundSingleEvaluation(pool, forces, time, rowOf(time.dt()), bound);
 }
 
 }  // namespace tickfx

@@ -14,6 +14,11 @@ void Integrator::step(ParticlePool& pool, const ForceSet& forces, const StepTime
   stepRows(pool, forces, time, StepRows::wholePool(pool, keepPrevious), check);
 }
 
+bool Integrator::boundTick(ParticlePool& /*pool*/, const ForceSet& /*forces*/,
+                           const StepTime& /*time*/, StateBound& /*bound*/) const {
+  return false;
+}
+
 void Integrator::prepare(ParticlePool& pool, const ForceSet& forces) {
   prepareColumns(pool);
   if (readsPreviousPosition()) pool.keepPrevious(true);

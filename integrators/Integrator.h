@@ -15,7 +15,8 @@
 
 namespace tickfx {
 
-class Advection;  // integrators/Advection.h, internal
+class Advection;    // integrators/Advection.h, internal
+struct StateBound;  // integrators/StateBound.h
 
 /// The tick being integrated: from t = tick/rate to (tick+1)/rate seconds.
 struct StepTime {
@@ -64,6 +65,16 @@ class Integrator {
   /// `keepPrevious`: see StepRows::keepPrevious.
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
             NonfiniteCheck* check = nullptr, bool keepPrevious = true);
+
+  /// Widens `bound` (of the magnitudes of the position and velocity of every row a tick steps)
+  /// to what they can be after tick `time`, by the scheme's own row kernel run on bounds
+  /// (integrators/StateBound.h), and returns true; when bound.provesFinite() then holds, the tick
+  /// makes no value that is not finite. False, `bound` untouched, where the scheme cannot say:
+  /// forces not in the one pass's forms (ForceSet::uniformAndDrag), or a scheme whose state is
+  /// more than the position and velocity (position Verlet's previous position, velocity Verlet's
+  /// acceleration), the default.
+  virtual bool boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                         StateBound& bound) const;
 
   /// Readies the pool's columns and this integrator for `forces` (velocity Verlet's kept
   /// acceleration, the advection scheme), so that stepRows() may then run on disjoint blocks

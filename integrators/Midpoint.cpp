@@ -1,9 +1,41 @@
 #include "integrators/Midpoint.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/MagnitudeRows.h"
 #include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
+namespace {
+
+// The one pass's kernel under the forms' accelerations `a`: both evaluations in the row's
+// registers, the midpoint velocity, then the acceleration at t + dt/2 from it (the position does
+// not enter a uniform force or a drag).
+auto underForms(float dt) {
+  const float halfDt = 0.5f * dt;
+  return [dt, halfDt](const auto& a) {
+    return [dt, halfDt, a](auto at, float* pos, float* vel, float* last) {
+      const auto position = at.load(pos);
+      const auto velocity = at.load(vel);
+      const auto mid = velocity + a.at(0, velocity) * halfDt;
+      const auto next = position + mid * dt;
+      const auto nextV = velocity + a.at(1, mid) * dt;
+      at.copy(last, position);
+      at.store(pos, next);
+      at.store(vel, nextV);
+      return CheckedPair{next, nextV};  // the new velocity is not in the new position
+    };
+  };
+}
+
+}  // namespace
+
+bool Midpoint::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                         StateBound& bound) const {
+  const auto forms = tickForms(pool, forces, time, {0, 1});
+  if (!forms) return false;
+  bound = boundTickUnderForms(*forms, underForms(time.dt()), bound);
+  return true;
+}
 
 void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                          const StepRows& rows, NonfiniteCheck* check) {
@@ -13,21 +45,7 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
   Vec3Column& v = pool.velocity();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1);
   if (const auto forms = tickForms(pool, forces, time, {0, 1})) {
-    // Both evaluations in the row's registers: the midpoint velocity, then the acceleration at
-    // t + dt/2 from it (the position does not enter a uniform force or a drag).
-    runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, [dt, halfDt](const auto& a) {
-      return [dt, halfDt, a](auto at, float* pos, float* vel, float* last) {
-        const auto position = at.load(pos);
-        const auto velocity = at.load(vel);
-        const auto mid = velocity + a.at(0, velocity) * halfDt;
-        const auto next = position + mid * dt;
-        const auto nextV = velocity + a.at(1, mid) * dt;
-        at.copy(last, position);
-        at.store(pos, next);
-        at.store(vel, nextV);
-        return CheckedPair{next, nextV};  // the new velocity is not in the new position
-      };
-    });
+    runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, underForms(dt));
     return;
   }
   const TileCheck tiles = forcePassCheck(check, pool, forces, rows);

@@ -16,6 +16,8 @@ class Midpoint final : public Integrator {
   std::string_view name() const override { return "midpoint"; }
   int order() const override { return 2; }
   int evaluationsPerStep() const override { return 2; }
+  bool boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 StateBound& bound) const override;
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Midpoint; }
 
  protected:

@@ -1,6 +1,7 @@
 #include "integrators/RungeKutta4.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/MagnitudeRows.h"
 #include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
@@ -9,7 +10,42 @@ namespace {
 // Slots of the stage scratch; kState stands for the pool's own columns (the state at t).
 enum Slot : int { kState = kPoolColumn, K1 = 0, K2, K3, K4, P2, V2, P3, V3, P4, V4 };
 
+// The one pass's kernel under the forms' accelerations `a`: the four stages of a row in its
+// registers, by the passes' own operations. The stage positions are not needed (a uniform force
+// or a drag does not read the position), and the slopes and stage velocities never leave the row.
+auto underForms(float h) {
+  const float halfH = 0.5f * h;
+  const float sixthH = h / 6.0f;
+  return [=](const auto& a) {
+    return [=](auto at, float* pos, float* vel, float* last) {
+      const auto position = at.load(pos);
+      const auto velocity = at.load(vel);
+      const auto k1 = a.at(0, velocity);
+      const auto v2 = velocity + k1 * halfH;
+      const auto k2 = a.at(1, v2);
+      const auto v3 = velocity + k2 * halfH;
+      const auto k3 = a.at(1, v3);
+      const auto v4 = velocity + k3 * h;
+      const auto k4 = a.at(2, v4);
+      const auto nextP = position + ((velocity + v2 * 2.0f) + (v3 * 2.0f + v4)) * sixthH;
+      const auto nextV = velocity + ((k1 + k2 * 2.0f) + (k3 * 2.0f + k4)) * sixthH;
+      at.copy(last, position);
+      at.store(pos, nextP);
+      at.store(vel, nextV);
+      return CheckedPair{nextP, nextV};
+    };
+  };
+}
+
 }  // namespace
+
+bool RungeKutta4::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                            StateBound& bound) const {
+  const auto forms = tickForms(pool, forces, time, {0, 1, 2});
+  if (!forms) return false;
+  bound = boundTickUnderForms(*forms, underForms(time.dt()), bound);
+  return true;
+}
 
 void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                             const StepRows& rows, NonfiniteCheck* check) {
@@ -21,28 +57,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
 
   if (const auto forms = tickForms(pool, forces, time, {0, 1, 2})) {
-    // The four stages of a row in its registers, by the passes' own operations: the stage
-    // positions are not needed (a uniform force or a drag does not read the position), and the
-    // slopes and stage velocities never leave the row.
-    runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, [=](const auto& a) {
-      return [=](auto at, float* pos, float* vel, float* last) {
-        const auto position = at.load(pos);
-        const auto velocity = at.load(vel);
-        const auto k1 = a.at(0, velocity);
-        const auto v2 = velocity + k1 * halfH;
-        const auto k2 = a.at(1, v2);
-        const auto v3 = velocity + k2 * halfH;
-        const auto k3 = a.at(1, v3);
-        const auto v4 = velocity + k3 * h;
-        const auto k4 = a.at(2, v4);
-        const auto nextP = position + ((velocity + v2 * 2.0f) + (v3 * 2.0f + v4)) * sixthH;
-        const auto nextV = velocity + ((k1 + k2 * 2.0f) + (k3 * 2.0f + k4)) * sixthH;
-        at.copy(last, position);
-        at.store(pos, nextP);
-        at.store(vel, nextV);
-        return CheckedPair{nextP, nextV};
-      };
-    });
+    runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, underForms(h));
     return;
   }
   auto velocityRows = [&](const Tile& tile, int slot) {

@@ -13,6 +13,8 @@ class RungeKutta4 final : public Integrator {
   std::string_view name() const override { return "rk4"; }
   int order() const override { return 4; }
   int evaluationsPerStep() const override { return 4; }
+  bool boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 StateBound& bound) const override;
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::RungeKutta4; }
 
  protected:

@@ -13,6 +13,8 @@ class SemiImplicitEuler final : public Integrator {
   std::string_view name() const override { return "semi_implicit_euler"; }
   int order() const override { return 1; }
   int evaluationsPerStep() const override { return 1; }
+  bool boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 StateBound& bound) const override;
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Euler; }
 
  protected:

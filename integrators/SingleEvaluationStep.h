@@ -8,10 +8,31 @@
 
 #include "integrators/CheckedRows.h"
 #include "integrators/Integrator.h"
+#include "integrators/MagnitudeRows.h"
 #include "integrators/StagePasses.h"
 #include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
+
+/// The one pass's kernel of `row` under the forms' accelerations `a` (see runOnePass).
+template <class Row>
+auto singleEvaluationUnderForms(const Row& row) {
+  return [&row](const auto& a) {
+    return [row, a](auto at, float* pos, float* vel, float* last) {
+      return row(a.at(0, at.load(vel)), at, pos, vel, last);
+    };
+  };
+}
+
+/// Integrator::boundTick() of a scheme whose row is `row` (see stepSingleEvaluation).
+template <class Row>
+bool boundSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                           const Row& row, StateBound& bound) {
+  const auto forms = tickForms(pool, forces, time, {0});
+  if (!forms) return false;
+  bound = boundTickUnderForms(*forms, singleEvaluationUnderForms(row), bound);
+  return true;
+}
 
 /// Advances `rows` one tick: `row(acceleration, at, pos, vel, last)` updates the rows `at` (a
 /// RowsAt) of one component (acceleration in m/s², a value of at's lane type; the columns as
@@ -22,11 +43,7 @@ void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const Step
                           const StepRows& rows, NonfiniteCheck* check, StageScratch& scratch,
                           const Row& row) {
   if (const auto forms = tickForms(pool, forces, time, {0})) {
-    runStateUpdateUnderForms(pool, scratch, rows, check, *forms, [&row](const auto& a) {
-      return [row, a](auto at, float* pos, float* vel, float* last) {
-        return row(a.at(0, at.load(vel)), at, pos, vel, last);
-      };
-    });
+    runStateUpdateUnderForms(pool, scratch, rows, check, *forms, singleEvaluationUnderForms(row));
     return;
   }
   Vec3Column& p = pool.position();

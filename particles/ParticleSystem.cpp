@@ -18,6 +18,8 @@
 #include "fields/ForceSet.h"
 #include "fields/SpringNetwork.h"
 #include "integrators/Integrator.h"
+#include "integrators/StateBound.h"
+#include "particles/Assert.h"
 #include "particles/Clock.h"
 #include "particles/ExactTime.h"
 #include "particles/Isa.h"
@@ -277,9 +279,14 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
   integrator_->prepare(pool_, *forces_);
   forces_->beginTick(pool_, first);  // no module's own tables; whether any particle is pinned
   const bool stop = settings_.nonfinite == NonfinitePolicy::Stop;
-  if (stop) {
+  // Under Stop a frame goes back to its start if it goes non-finite, from a copy made as it runs,
+  // unless it is proven finite before it runs; its end is then measured for the next one's proof.
+  bool measures = false;
+  const bool copies = stop && !provesFrameFinite(ticks, std::min(stepped, startRows), measures);
+  if (copies) {
     if (!frameStart_) frameStart_ = std::make_unique<FrameStart>();
     frameStart_->reserve(pool_, integrator_->readsPreviousPosition());
+    ++framesCopied_;
   }
   // Every row is copied in the frame's last tick: none kept (keeping them would move them all to
   // the storage's front once the rows dropped there by deaths fill it).
@@ -300,10 +307,14 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
     }
     begin = end;
   }
-  NonfiniteCheck* const check = stop ? &nonfiniteCheck_ : nullptr;
+  // A frame proven finite is not checked, but where asserts are on: one that went non-finite all
+  // the same would be a wrong proof, found below.
+  NonfiniteCheck* const check = copies || (stop && kAssertsEnabled) ? &nonfiniteCheck_ : nullptr;
+  // The bounds of the frame's end, each block's taken while it is in cache.
+  LargestMagnitudes end;
   parallelForTasks(blocks.size(), [&](std::size_t i) {
     const Block& block = blocks[i];
-    if (stop && block.begin < startRows) {
+    if (copies && block.begin < startRows) {
       frameStart_->save(pool_, block.begin, std::min(block.end, startRows));
     }
     for (std::int64_t j = block.firstTick; j < ticks; ++j) {
@@ -320,8 +331,10 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
       integrator_->stepRows(pool_, *forces_, StepTime{first + j, settings_.stepRateHz}, blockRows,
                             check);
     }
+    if (measures) end.add(pool_, block.begin, block.end);
   });
   if (stop && nonfiniteCheck_.found()) {
+    TICKFX_ASSERT(copies, "a frame proven finite made a non-finite value (Integrator::boundTick)");
     // Back to the frame's start: its ticks one by one then stop at the one that went non-finite.
     nonfiniteCheck_.clear();
     pool_.dropNewest(startRows, startId);
@@ -332,9 +345,44 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
   pool_.markAllStepped();
   phase.reset();
   endTicks(first + ticks, keepVelocities);
+  if (measures) {
+    const StateBound bound = end.bound();
+    nonfiniteCheck_.setSteppedRowsBounds(bound.position, bound.velocity);
+  }
   if (keepPrevious) previousTick_ = tick_;
   fusedTicks_ += ticks;
   return true;
+}
+
+// Whether the frame of `ticks` from tick_ (its births spawned: rows [fresh, size) have not been
+// stepped) is proven finite before it runs: bounds of its start state, carried through every
+// tick by Integrator::boundTick, stay within StateBound::kLimit. The bounds of the rows stepped
+// before come from the frame before (measured at its end) or, the first time, from a scan;
+// those of the fresh rows from a scan (they are few, and in cache). `measures`: whether the
+// scheme and forces can be bounded at all, so that the frame's end is worth measuring.
+bool ParticleSystem::provesFrameFinite(std::int64_t ticks, std::size_t fresh, bool& measures) {
+  const std::int64_t rate = settings_.stepRateHz;
+  StateBound probe;
+  measures = integrator_->boundTick(pool_, *forces_, StepTime{tick_, rate}, probe);
+  if (!measures) return false;
+  const auto scan = [&](std::size_t b, std::size_t e) {
+    LargestMagnitudes largest;
+    parallelForRows(e - b,
+                    [&](std::size_t rb, std::size_t re) { largest.add(pool_, b + rb, b + re); });
+    return largest.bound();
+  };
+  StateBound bound;  // no rows stepped before: nothing to bound
+  if (fresh > 0) {
+    bound = {nonfiniteCheck_.steppedPositionBound(), nonfiniteCheck_.steppedVelocityBound()};
+    if (std::isinf(bound.position) || std::isinf(bound.velocity))
+      bound = scan(0, fresh);  // unknown
+  }
+  if (fresh < pool_.size()) bound = wider(bound, scan(fresh, pool_.size()));
+  for (std::int64_t j = 0; j < ticks; ++j) {
+    if (!bound.provesFinite()) return false;
+    if (!integrator_->boundTick(pool_, *forces_, StepTime{tick_ + j, rate}, bound)) return false;
+  }
+  return bound.provesFinite();
 }
 
 void ParticleSystem::emitTick(std::int64_t tick) {

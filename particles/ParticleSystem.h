@@ -123,6 +123,10 @@ class ParticleSystem {
 
   /// Ticks run in fused frames so far (see the class comment): for tests and benches.
   std::int64_t fusedTicks() const { return fusedTicks_; }
+  /// Fused frames so far that copied their start under NonfinitePolicy::Stop, to go back to if
+  /// they went non-finite; the others were proven finite before they ran (Integrator::boundTick):
+  /// for tests and benches.
+  std::int64_t framesCopied() const { return framesCopied_; }
   /// Ticks completed so far: the state is the state after tick tickCount() − 1 (or the initial
   /// state for 0), at time tickCount() / stepRate seconds.
   std::int64_t tickCount() const { return tick_; }
@@ -256,6 +260,7 @@ class ParticleSystem {
   void stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* check, bool keepPrevious);
   bool fusesTicks(std::int64_t ticks) const;
   bool runFusedTicks(std::int64_t ticks, bool shown);
+  bool provesFrameFinite(std::int64_t ticks, std::size_t fresh, bool& measures);
   // After the ticks up to `tick` (the count it sets): ages, the kept velocities' rows matched to
   // the deaths, the dead removed. Shared by a tick and a fused frame.
   void endTicks(std::int64_t tick, bool keepVelocities);
@@ -293,6 +298,7 @@ class ParticleSystem {
   Shard shard_;  // the whole run unless setShard()
   std::int64_t tick_ = 0;
   std::int64_t fusedTicks_ = 0;
+  std::int64_t framesCopied_ = 0;
   // The tick count after the newest tick that kept its starting positions (-1: none).
   std::int64_t previousTick_ = -1;
   bool keepPreviousAlways_ = false;

@@ -7,6 +7,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 #include "CliTestSupport.h"
 #include "Sanitized.h"
@@ -83,7 +84,10 @@ TEST_F(Profile, ThePhasesAddUpToTheRunsWallTime) {
   for (const char* phase : {"startup", "load", "growth", "emission", "step", "deaths", "capture",
                             "checkpoint", "cache write", "release"}) {
     ASSERT_EQ(rows.count(phase), 1u) << phase << " missing from\n" << r.out;
-    EXPECT_GT(rows.at(phase).wall, 0.0) << phase;
+    // Freeing this run's 20 MB takes under the half millisecond a row rounds to.
+    if (std::string_view(phase) != "release") {
+      EXPECT_GT(rows.at(phase).wall, 0.0) << phase;
+    }
     EXPECT_GE(rows.at(phase).serialShare, 0.0) << phase;
     EXPECT_LE(rows.at(phase).serialShare, 100.0) << phase;
   }

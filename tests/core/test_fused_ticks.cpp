@@ -234,6 +234,80 @@ TEST(FusedFrames, StopWithTheStateOneByOneOnEveryOtherPath) {
   }
 }
 
+// Gravity, a wind and a drag: the one pass's forms, under which the schemes that bound their tick
+// (Integrator::boundTick) prove a frame finite before it runs.
+ForceSet formForces() {
+  ForceSet forces = test::gravityAndWind();
+  forces.add(std::make_unique<LinearDrag>(0.3f, Eigen::Vector3f(1.0f, 0.0f, 0.0f)));
+  return forces;
+}
+
+bool boundsItsTick(const std::string& integrator) {
+  return integrator != "position_verlet" && integrator != "velocity_verlet";
+}
+
+// Under NonfinitePolicy::Stop (the default) a frame proven finite copies nothing of its start,
+// and gives the bits of the ticks one by one all the same; the other schemes copy every frame.
+TEST_P(FusedFrames, ProvenFiniteCopyNothingWithTheBitsOfTicksOneByOne) {
+  const std::string& integrator = GetParam();
+  const auto reference = makeSystem(integrator, 1, formForces(), true);
+  const auto fused = makeSystem(integrator, 3, formForces(), false);
+  std::int64_t fusedFrames = 0;
+  for (const Flicks frame : frames()) {
+    reference->advance(frame);
+    if (fused->advance(frame).ticks >= 2) ++fusedFrames;
+    expectSameState(*fused, *reference);
+    if (HasFailure()) return;
+  }
+  ASSERT_GT(fusedFrames, 10);
+  EXPECT_EQ(fused->fusedTicks() > 0, true);
+  EXPECT_EQ(fused->framesCopied(), boundsItsTick(integrator) ? 0 : fusedFrames);
+}
+
+// A state a host writes near the float limit (after proven frames, whose measured bounds the
+// edit must void) is not proven: its frames copy their start, and the run stops at the tick the
+// ticks one by one stop at, inside a frame, with their state.
+TEST_P(FusedFrames, AStateNearTheFloatLimitIsNotProvenAndStopsAtItsTick) {
+  const std::string& integrator = GetParam();
+  const auto edit = [](ParticleSystem& system) {
+    ParticlePool& pool = system.editPool();
+    // The newest particle, which lives on for some ticks: p + v·dt overflows in the next ones.
+    const auto row = static_cast<Eigen::Index>(pool.size() - 1);
+    pool.position().x[row] = 3.3e38f;
+    pool.velocity().x[row] = 3.0e38f;
+  };
+  const auto probe = makeSystem(integrator, 1, formForces(), true);
+  for (int i = 0; i < 3; ++i) probe->advance(frameOf(4));
+  edit(*probe);
+  const std::int64_t edited = probe->tickCount();
+  while (!probe->nonfiniteStop() && probe->tickCount() < edited + 100) probe->step();
+  ASSERT_TRUE(probe->nonfiniteStop().has_value());
+  const std::int64_t after = probe->nonfiniteStop()->tick - edited;
+  std::int64_t frame = 3;
+  while (after % frame == 0) ++frame;
+
+  const auto fused = makeSystem(integrator, 2, formForces(), false);
+  const auto reference = makeSystem(integrator, 2, formForces(), true);
+  for (int i = 0; i < 3; ++i) {
+    fused->advance(frameOf(4));
+    reference->advance(frameOf(4));
+  }
+  const std::int64_t copied = fused->framesCopied();
+  EXPECT_EQ(copied, boundsItsTick(integrator) ? 0 : 3);
+  edit(*fused);
+  edit(*reference);
+  while (!reference->nonfiniteStop()) {
+    reference->advance(frameOf(frame));
+    fused->advance(frameOf(frame));
+  }
+  ASSERT_TRUE(fused->nonfiniteStop().has_value());
+  EXPECT_EQ(fused->nonfiniteStop()->tick, probe->nonfiniteStop()->tick);
+  EXPECT_EQ(fused->nonfiniteStop()->particles, reference->nonfiniteStop()->particles);
+  EXPECT_EQ(fused->nonfiniteStop()->firstIds, reference->nonfiniteStop()->firstIds);
+  EXPECT_GT(fused->framesCopied(), copied);
+  expectSameState(*fused, *reference);
+}
+
 TEST(FusedFrames, AFrameThatMayFillThePoolRunsTickByTick) {
   const auto make = [](bool oneByOne) {
     SystemSettings settings;

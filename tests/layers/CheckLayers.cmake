@@ -10,7 +10,8 @@ set(allowed_up
   "particles/ParticleSystem.cpp -> fields/ColliderSet.h"
   "particles/ParticleSystem.cpp -> fields/ForceSet.h"
   "particles/ParticleSystem.cpp -> fields/SpringNetwork.h"
-  "particles/ParticleSystem.cpp -> integrators/Integrator.h")
+  "particles/ParticleSystem.cpp -> integrators/Integrator.h"
+  "particles/ParticleSystem.cpp -> integrators/StateBound.h")
 
 set(problems "")
 set(checked 0)

@@ -1,0 +1,60 @@
+// A proof, before a fused frame runs, that its ticks cannot leave the finite range: bounds of the
+// state's magnitudes, measured where the rows are in cache and carried through each tick by the
+// scheme (Integrator::boundTick, integrators/MagnitudeRows.h). Under NonfinitePolicy::Stop a
+// frame that cannot go non-finite needs no copy of its start to go back to (ParticleSystem's
+// fused frames; what the copy costs: docs/performance.md).
+#pragma once
+
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "particles/ParticlePool.h"
+
+namespace tickfx {
+
+/// Upper bounds of |x| over every component of every row's position (m) and velocity (m/s).
+struct StateBound {
+  double position = 0.0;
+  double velocity = 0.0;
+
+  /// The largest magnitude a bound may reach and still prove a tick finite: every value a tick
+  /// computes stays below it, so no operation overflows (FLT_MAX is about 2¹²⁸) and, its operands
+  /// finite, none makes a NaN.
+  static constexpr double kLimit = 0x1p126;
+
+  /// Whether both bounds are at most kLimit (false for a NaN).
+  bool provesFinite() const { return position <= kLimit && velocity <= kLimit; }
+};
+
+/// The larger of each pair of bounds, a NaN where either is one.
+inline double wider(double a, double b) {
+  return std::isnan(a) || std::isnan(b) ? NAN : a < b ? b : a;
+}
+inline StateBound wider(const StateBound& a, const StateBound& b) {
+  return {wider(a.position, b.position), wider(a.velocity, b.velocity)};
+}
+
+/// The largest magnitude among values [begin, end) of `column`, as the bits of a float (sign
+/// cleared; non-negative floats order as their bits): +∞ or a NaN when one is not finite. The
+/// same whatever the order the rows are taken in.
+std::uint32_t magnitudeBits(const float* column, std::size_t begin, std::size_t end);
+
+/// The float whose bits magnitudeBits() gave, as a bound: +∞ for an infinity or a NaN.
+double boundOfBits(std::uint32_t bits);
+
+/// The largest magnitudes of the positions and velocities of the rows added, from any threads in
+/// any order (a max: the same bound whatever the split).
+class LargestMagnitudes {
+ public:
+  /// Takes in rows [begin, end) of `pool`'s positions and velocities.
+  void add(const ParticlePool& pool, std::size_t begin, std::size_t end);
+  /// The bound of every row added (0 for none; +∞ where one was not finite).
+  StateBound bound() const;
+
+ private:
+  std::atomic<std::uint32_t> bits_[2] = {0, 0};  // position, velocity
+};
+
+}  // namespace tickfx
