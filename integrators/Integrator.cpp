@@ -19,6 +19,11 @@ bool Integrator::boundTick(ParticlePool& /*pool*/, const ForceSet& /*forces*/,
   return false;
 }
 
+bool Integrator::boundSpawned(ParticlePool& /*pool*/, const ForceSet& /*forces*/,
+                              const StepTime& /*time*/, StateBound& /*bound*/) const {
+  return true;
+}
+
 void Integrator::prepare(ParticlePool& pool, const ForceSet& forces) {
   prepareColumns(pool);
   if (readsPreviousPosition()) pool.keepPrevious(true);

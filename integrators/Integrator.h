@@ -16,7 +16,7 @@
 namespace tickfx {
 
 class Advection;    // integrators/Advection.h, internal
-struct StateBound;  // integrators/StateBound.h
+struct StateBound;  // particles/StateBound.h
 
 /// The tick being integrated: from t = tick/rate to (tick+1)/rate seconds.
 struct StepTime {
@@ -66,15 +66,20 @@ class Integrator {
   void step(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
             NonfiniteCheck* check = nullptr, bool keepPrevious = true);
 
-  /// Widens `bound` (of the magnitudes of the position and velocity of every row a tick steps)
-  /// to what they can be after tick `time`, by the scheme's own row kernel run on bounds
-  /// (integrators/StateBound.h), and returns true; when bound.provesFinite() then holds, the tick
-  /// makes no value that is not finite. False, `bound` untouched, where the scheme cannot say:
-  /// forces not in the one pass's forms (ForceSet::uniformAndDrag), or a scheme whose state is
-  /// more than the position and velocity (position Verlet's previous position, velocity Verlet's
-  /// acceleration), the default.
+  /// Widens `bound` (of the magnitudes of the state of every row a tick steps: StateBound) to what
+  /// they can be after tick `time`, by the scheme's own row kernel run on bounds
+  /// (integrators/MagnitudeRows.h), and returns true; when bound.provesFinite() then holds, the
+  /// tick makes no value that is not finite. False, `bound` untouched, where the scheme cannot
+  /// say: under forces not in the one pass's forms (ForceSet::uniformAndDrag), and by default.
   virtual bool boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                          StateBound& bound) const;
+  /// For a scheme with a third state column (StateBound::extra: position Verlet's previous
+  /// position, velocity Verlet's acceleration), widens bound.extra to what the scheme starts that
+  /// column with for rows spawned for tick `time` within bound.position and bound.velocity, and
+  /// returns whether it could (as boundTick()). The default, for the others: true, as there is
+  /// nothing to start.
+  virtual bool boundSpawned(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                            StateBound& bound) const;
 
   /// Readies the pool's columns and this integrator for `forces` (velocity Verlet's kept
   /// acceleration, the advection scheme), so that stepRows() may then run on disjoint blocks

@@ -3,10 +3,11 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 
 #include "integrators/CheckedRows.h"
-#include "integrators/StateBound.h"
 #include "integrators/UniformAndDragRows.h"
+#include "particles/StateBound.h"
 
 namespace tickfx {
 
@@ -54,25 +55,54 @@ struct BoundsAt {
   void copy(float* column, Magnitude value) const { store(column, value); }
 };
 
-/// The bound after one tick of a scheme's one pass (runStateUpdateUnderForms: a kernel over the
-/// position, the velocity and the previous position) under `forms`, from `start`: the kernel
-/// `kernelFor` gives for each component, run on bounds. Each bound is at least the one it starts
-/// from, so that a row spawned later in a frame, within `start`, is within the bounds of every
-/// tick it steps.
+/// Where a scheme's one-pass kernel keeps StateBound::extra: nowhere, in the previous position
+/// (position Verlet), or in a fourth column after it (velocity Verlet's acceleration).
+enum class ExtraColumn { kNone, kPrevious, kFourth };
+
+/// The bound after one tick of a scheme's one pass (runOnePass: a kernel over the position, the
+/// velocity, the previous position and, for kFourth, one more column) under `forms`, from
+/// `start`: the kernel `kernelFor` gives for each component, run on bounds. Each bound is at least
+/// the one it starts from, so that a row spawned later in a frame, within `start`, is within the
+/// bounds of every tick it steps.
 template <class KernelFor>
 StateBound boundTickUnderForms(const TickForms& forms, const KernelFor& kernelFor,
-                               const StateBound& start) {
+                               const StateBound& start, ExtraColumn extra = ExtraColumn::kNone) {
   StateBound out = start;
   for (int c = 0; c < 3; ++c) {
     withFormAccelerations(forms, c, [&](const auto& accelerations) {
-      float slots[3] = {};
-      double bound[3] = {start.position, start.velocity, 0.0};
-      kernelFor(accelerations)(BoundsAt{slots, bound}, &slots[0], &slots[1], &slots[2]);
-      out = wider(out, StateBound{bound[0], bound[1]});
+      float slots[4] = {};
+      double bound[4] = {start.position, start.velocity,
+                         extra == ExtraColumn::kPrevious ? start.extra : 0.0, start.extra};
+      const BoundsAt at{slots, bound};
+      const auto kernel = kernelFor(accelerations);
+      if constexpr (std::is_invocable_v<decltype(kernel), BoundsAt, float*, float*, float*>) {
+        kernel(at, &slots[0], &slots[1], &slots[2]);
+      } else {
+        kernel(at, &slots[0], &slots[1], &slots[2], &slots[3]);
+      }
+      const double after = extra == ExtraColumn::kPrevious ? bound[2]
+                           : extra == ExtraColumn::kFourth ? bound[3]
+                                                           : 0.0;
+      out = wider(out, StateBound{bound[0], bound[1], after});
       return 0;
     });
   }
   return out;
+}
+
+/// The bound of `bound.extra` widened by what `start(accelerations, position, velocity)` (a
+/// scheme's start of a spawned row's third column, on Magnitude values) makes under `forms` from
+/// rows within bound.position and bound.velocity.
+template <class Start>
+void boundSpawnedUnderForms(const TickForms& forms, const Start& start, StateBound& bound) {
+  for (int c = 0; c < 3; ++c) {
+    withFormAccelerations(forms, c, [&](const auto& accelerations) {
+      const Magnitude made =
+          start(accelerations, Magnitude{bound.position}, Magnitude{bound.velocity});
+      bound.extra = wider(bound.extra, made.m);
+      return 0;
+    });
+  }
 }
 
 }  // namespace tickfx

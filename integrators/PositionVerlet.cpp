@@ -1,14 +1,15 @@
 #include "integrators/PositionVerlet.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/MagnitudeRows.h"
 #include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
 namespace {
 
 // A new particle has no history: the position it would have had a step ago, p − v·dt + a·dt²/2.
-inline float startingPrevious(float position, float velocity, float acceleration, float dt,
-                              float halfDt2) {
+template <class Lane>
+Lane startingPrevious(Lane position, Lane velocity, Lane acceleration, float dt, float halfDt2) {
   return position - velocity * dt + acceleration * halfDt2;
 }
 
@@ -27,7 +28,41 @@ Lane positionVerletRow(float dt2, float invDt, Lane acceleration, At at, float* 
   return velocity;
 }
 
+// The one pass's kernel under the forms' accelerations `a`.
+auto underForms(float dt2, float invDt) {
+  return [dt2, invDt](const auto& a) {
+    return [dt2, invDt, a](auto at, float* pos, float* vel, float* last) {
+      return positionVerletRow(dt2, invDt, a.at(0, at.load(vel)), at, pos, vel, last);
+    };
+  };
+}
+
 }  // namespace
+
+bool PositionVerlet::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                               StateBound& bound) const {
+  const auto forms = tickForms(pool, forces, time, {0});
+  if (!forms) return false;
+  const float dt = time.dt();
+  bound = boundTickUnderForms(*forms, underForms(dt * dt, static_cast<float>(time.stepRateHz)),
+                              bound, ExtraColumn::kPrevious);
+  return true;
+}
+
+bool PositionVerlet::boundSpawned(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                                  StateBound& bound) const {
+  const auto forms = tickForms(pool, forces, time, {0});
+  if (!forms) return false;
+  const float dt = time.dt();
+  const float halfDt2 = 0.5f * (dt * dt);
+  boundSpawnedUnderForms(
+      *forms,
+      [dt, halfDt2](const auto& a, Magnitude position, Magnitude velocity) {
+        return startingPrevious(position, velocity, a.at(0, velocity), dt, halfDt2);
+      },
+      bound);
+  return true;
+}
 
 void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                                const StepRows& rows, NonfiniteCheck* check) {
@@ -60,14 +95,7 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
         });
       }
     };
-    runOnePass(
-        pool, scratch_, rows, check, *forms,
-        [dt2, invDt](const auto& a) {
-          return [dt2, invDt, a](auto at, float* pos, float* vel, float* last) {
-            return positionVerletRow(dt2, invDt, a.at(0, at.load(vel)), at, pos, vel, last);
-          };
-        },
-        startTile);
+    runOnePass(pool, scratch_, rows, check, *forms, underForms(dt2, invDt), startTile);
     return;
   }
   const TileCheck tiles = forcePassCheck(check, pool, forces, rows);

@@ -21,6 +21,10 @@ class PositionVerlet final : public Integrator {
   int order() const override { return 2; }
   int evaluationsPerStep() const override { return 1; }
   bool readsPreviousPosition() const override { return true; }
+  bool boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 StateBound& bound) const override;
+  bool boundSpawned(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                    StateBound& bound) const override;
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Euler; }
 
  protected:

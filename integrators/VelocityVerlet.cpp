@@ -1,9 +1,55 @@
 #include "integrators/VelocityVerlet.h"
 
 #include "integrators/CheckedRows.h"
+#include "integrators/MagnitudeRows.h"
 #include "integrators/UniformAndDragRows.h"
 
 namespace tickfx {
+namespace {
+
+// The one pass's kernel under the forms' `accelerations`: the position, the predicted velocity,
+// a(t + dt) from it and the new velocity in the row's registers (the position does not enter a
+// uniform force or a drag).
+auto underForms(float dt) {
+  const float halfDt = 0.5f * dt;
+  const float halfDt2 = 0.5f * dt * dt;
+  return [=](const auto& accelerations) {
+    return [=](auto row, float* pos, float* vel, float* last, float* acc) {
+      const auto position = row.load(pos);
+      const auto velocity = row.load(vel);
+      const auto acceleration = row.load(acc);
+      const auto next = position + (velocity * dt + acceleration * halfDt2);
+      const auto accNext = accelerations.at(2, velocity + acceleration * dt);
+      const auto nextV = velocity + (acceleration + accNext) * halfDt;
+      row.copy(last, position);
+      row.store(pos, next);
+      row.store(vel, nextV);
+      row.store(acc, accNext);
+      return CheckedPair{next, nextV};  // the new velocity is not in next
+    };
+  };
+}
+
+}  // namespace
+
+bool VelocityVerlet::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                               StateBound& bound) const {
+  const auto forms = tickForms(pool, forces, time, {2});
+  if (!forms) return false;
+  bound = boundTickUnderForms(*forms, underForms(time.dt()), bound, ExtraColumn::kFourth);
+  return true;
+}
+
+// A spawned row starts with a(t) (startRows in integrate()): under the forms, the forms' own.
+bool VelocityVerlet::boundSpawned(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                                  StateBound& bound) const {
+  const auto forms = tickForms(pool, forces, time, {0});
+  if (!forms) return false;
+  boundSpawnedUnderForms(
+      *forms, [](const auto& a, Magnitude, Magnitude velocity) { return a.at(0, velocity); },
+      bound);
+  return true;
+}
 
 void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                                const StepRows& rows, NonfiniteCheck* check) {
@@ -24,26 +70,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
     forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0}, started, out);
   };
   if (const auto forms = tickForms(pool, forces, time, {2})) {
-    // The position, the predicted velocity, a(t + dt) from it and the new velocity in the row's
-    // registers (the position does not enter a uniform force or a drag).
-    runOnePass(
-        pool, scratch_, rows, check, *forms,
-        [=](const auto& accelerations) {
-          return [=](auto row, float* pos, float* vel, float* last, float* acc) {
-            const auto position = row.load(pos);
-            const auto velocity = row.load(vel);
-            const auto acceleration = row.load(acc);
-            const auto next = position + (velocity * dt + acceleration * halfDt2);
-            const auto accNext = accelerations.at(2, velocity + acceleration * dt);
-            const auto nextV = velocity + (acceleration + accNext) * halfDt;
-            row.copy(last, position);
-            row.store(pos, next);
-            row.store(vel, nextV);
-            row.store(acc, accNext);
-            return CheckedPair{next, nextV};  // the new velocity is not in next
-          };
-        },
-        startRows, a);
+    runOnePass(pool, scratch_, rows, check, *forms, underForms(dt), startRows, a);
     return;
   }
   const TileCheck tiles = forcePassCheck(check, pool, forces, rows);

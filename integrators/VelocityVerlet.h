@@ -15,6 +15,10 @@ class VelocityVerlet final : public Integrator {
   std::string_view name() const override { return "velocity_verlet"; }
   int order() const override { return 2; }
   int evaluationsPerStep() const override { return 1; }
+  bool boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                 StateBound& bound) const override;
+  bool boundSpawned(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
+                    StateBound& bound) const override;
   AdvectionScheme advectionScheme() const override { return AdvectionScheme::Heun; }
 
  protected:

@@ -2,7 +2,6 @@
 // that divides by zero. What the system does when a tick makes some, and what it reports.
 #pragma once
 
-#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -76,26 +75,11 @@ class NonfiniteCheck {
   /// constants too, a scheme then checks them by the floating-point exceptions its arithmetic
   /// raises (integrators/NonfiniteExceptions.h), at no cost per value, and scans the spawned rows.
   bool steppedRowsFinite() const { return steppedRowsFinite_; }
-  /// Also forgets the bounds below: whatever wrote the state says so.
-  void setSteppedRowsFinite(bool finite) {
-    steppedRowsFinite_ = finite;
-    positionBound_ = velocityBound_ = INFINITY;
-  }
-
-  /// Bounds of the magnitudes of the stepped rows' positions (m) and velocities (m/s), where the
-  /// ticks that made them measured them (a fused frame under NonfinitePolicy::Stop, which proves
-  /// the next frame finite from them); +∞ where unknown.
-  double steppedPositionBound() const { return positionBound_; }
-  double steppedVelocityBound() const { return velocityBound_; }
-  void setSteppedRowsBounds(double position, double velocity) {
-    positionBound_ = position;
-    velocityBound_ = velocity;
-  }
+  void setSteppedRowsFinite(bool finite) { steppedRowsFinite_ = finite; }
 
  private:
   RelaxedFlag found_;
   bool steppedRowsFinite_ = false;
-  double positionBound_ = INFINITY, velocityBound_ = INFINITY;
 };
 
 }  // namespace tickfx

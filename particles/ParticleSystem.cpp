@@ -18,13 +18,13 @@
 #include "fields/ForceSet.h"
 #include "fields/SpringNetwork.h"
 #include "integrators/Integrator.h"
-#include "integrators/StateBound.h"
 #include "particles/Assert.h"
 #include "particles/Clock.h"
 #include "particles/ExactTime.h"
 #include "particles/Isa.h"
 #include "particles/ParallelFor.h"
 #include "particles/PhaseProfile.h"
+#include "particles/StateBound.h"
 #include "particles/TaskExecutor.h"
 
 namespace tickfx {
@@ -312,6 +312,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
   NonfiniteCheck* const check = copies || (stop && kAssertsEnabled) ? &nonfiniteCheck_ : nullptr;
   // The bounds of the frame's end, each block's taken while it is in cache.
   LargestMagnitudes end;
+  const Vec3Column* const extra = extraColumnOf(pool_, integrator_->readsPreviousPosition());
   parallelForTasks(blocks.size(), [&](std::size_t i) {
     const Block& block = blocks[i];
     if (copies && block.begin < startRows) {
@@ -331,7 +332,7 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
       integrator_->stepRows(pool_, *forces_, StepTime{first + j, settings_.stepRateHz}, blockRows,
                             check);
     }
-    if (measures) end.add(pool_, block.begin, block.end);
+    if (measures) end.add(pool_, extra, block.begin, block.end);
   });
   if (stop && nonfiniteCheck_.found()) {
     TICKFX_ASSERT(copies, "a frame proven finite made a non-finite value (Integrator::boundTick)");
@@ -346,8 +347,9 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
   phase.reset();
   endTicks(first + ticks, keepVelocities);
   if (measures) {
-    const StateBound bound = end.bound();
-    nonfiniteCheck_.setSteppedRowsBounds(bound.position, bound.velocity);
+    if (!endBounds_) endBounds_ = std::make_unique<StateBound>();
+    *endBounds_ = end.bound();
+    endBoundsTick_ = tick_;
   }
   if (keepPrevious) previousTick_ = tick_;
   fusedTicks_ += ticks;
@@ -358,26 +360,38 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
 // stepped) is proven finite before it runs: bounds of its start state, carried through every
 // tick by Integrator::boundTick, stay within StateBound::kLimit. The bounds of the rows stepped
 // before come from the frame before (measured at its end) or, the first time, from a scan;
-// those of the fresh rows from a scan (they are few, and in cache). `measures`: whether the
-// scheme and forces can be bounded at all, so that the frame's end is worth measuring.
+// those of the fresh rows' positions and velocities from a scan (they are few, and in cache),
+// and of the third column a scheme starts them with (Integrator::boundSpawned) from those.
+// `measures`: whether the scheme and forces can be bounded at all, so that the frame's end is
+// worth measuring.
 bool ParticleSystem::provesFrameFinite(std::int64_t ticks, std::size_t fresh, bool& measures) {
   const std::int64_t rate = settings_.stepRateHz;
   StateBound probe;
   measures = integrator_->boundTick(pool_, *forces_, StepTime{tick_, rate}, probe);
   if (!measures) return false;
-  const auto scan = [&](std::size_t b, std::size_t e) {
+  const auto scan = [&](const Vec3Column* extra, std::size_t b, std::size_t e) {
     LargestMagnitudes largest;
-    parallelForRows(e - b,
-                    [&](std::size_t rb, std::size_t re) { largest.add(pool_, b + rb, b + re); });
+    parallelForRows(
+        e - b, [&](std::size_t rb, std::size_t re) { largest.add(pool_, extra, b + rb, b + re); });
     return largest.bound();
   };
   StateBound bound;  // no rows stepped before: nothing to bound
   if (fresh > 0) {
-    bound = {nonfiniteCheck_.steppedPositionBound(), nonfiniteCheck_.steppedVelocityBound()};
-    if (std::isinf(bound.position) || std::isinf(bound.velocity))
-      bound = scan(0, fresh);  // unknown
+    const bool known = endBounds_ && endBoundsTick_ == tick_ && nonfiniteCheck_.steppedRowsFinite();
+    if (known) {
+      bound = *endBounds_;
+    } else {
+      bound = scan(extraColumnOf(pool_, integrator_->readsPreviousPosition()), 0, fresh);
+    }
   }
-  if (fresh < pool_.size()) bound = wider(bound, scan(fresh, pool_.size()));
+  if (fresh < pool_.size()) {
+    StateBound born = scan(nullptr, fresh, pool_.size());  // their third column is not set yet
+    for (std::int64_t j = 0; j < ticks; ++j) {
+      if (!integrator_->boundSpawned(pool_, *forces_, StepTime{tick_ + j, rate}, born))
+        return false;
+    }
+    bound = wider(bound, born);
+  }
   for (std::int64_t j = 0; j < ticks; ++j) {
     if (!bound.provesFinite()) return false;
     if (!integrator_->boundTick(pool_, *forces_, StepTime{tick_ + j, rate}, bound)) return false;

@@ -21,6 +21,8 @@
 
 namespace tickfx {
 
+struct StateBound;  // particles/StateBound.h
+
 // The system composes the layers above particles/: its forces (fields/ForceSet.h) and its scheme
 // (integrators/Integrator.h). This header only declares them; a host that builds a system
 // includes fields/ForceSet.h for the ForceSet it hands over.
@@ -313,6 +315,11 @@ class ParticleSystem {
   // Under NonfinitePolicy::Stop, the state a fused frame started from, to go back to.
   struct FrameStart;
   std::unique_ptr<FrameStart> frameStart_;
+  // Under NonfinitePolicy::Stop, bounds of the state measured at the end of the newest fused frame
+  // (particles/StateBound.h), from which the next proves itself finite. Valid while
+  // endBoundsTick_ == tick_ and the check holds the stepped rows finite (editPool() voids that).
+  std::unique_ptr<StateBound> endBounds_;
+  std::int64_t endBoundsTick_ = -1;
   // Also holds whether the rows the next tick steps are finite: the ticks so far were checked
   // and editPool() has not been called since (set by endTicks()).
   NonfiniteCheck nonfiniteCheck_;

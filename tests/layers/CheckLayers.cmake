@@ -10,8 +10,7 @@ set(allowed_up
   "particles/ParticleSystem.cpp -> fields/ColliderSet.h"
   "particles/ParticleSystem.cpp -> fields/ForceSet.h"
   "particles/ParticleSystem.cpp -> fields/SpringNetwork.h"
-  "particles/ParticleSystem.cpp -> integrators/Integrator.h"
-  "particles/ParticleSystem.cpp -> integrators/StateBound.h")
+  "particles/ParticleSystem.cpp -> integrators/Integrator.h")
 
 set(problems "")
 set(checked 0)

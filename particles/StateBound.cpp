@@ -1,4 +1,4 @@
-#include "integrators/StateBound.h"
+#include "particles/StateBound.h"
 
 #include <algorithm>
 #include <bit>
@@ -76,9 +76,11 @@ double boundOfBits(std::uint32_t bits) {
   return magnitude >= 0x7f800000U ? INFINITY : static_cast<double>(std::bit_cast<float>(magnitude));
 }
 
-void LargestMagnitudes::add(const ParticlePool& pool, std::size_t begin, std::size_t end) {
-  const Vec3Column* state[2] = {&pool.position(), &pool.velocity()};
-  for (int s = 0; s < 2; ++s) {
+void LargestMagnitudes::add(const ParticlePool& pool, const Vec3Column* extra, std::size_t begin,
+                            std::size_t end) {
+  const Vec3Column* state[3] = {&pool.position(), &pool.velocity(), extra};
+  for (int s = 0; s < 3; ++s) {
+    if (state[s] == nullptr) continue;
     std::uint32_t largest = 0;
     for (int c = 0; c < 3; ++c)
       largest = std::max(largest, magnitudeBits((*state[s])[c].data(), begin, end));
@@ -89,7 +91,7 @@ void LargestMagnitudes::add(const ParticlePool& pool, std::size_t begin, std::si
 }
 
 StateBound LargestMagnitudes::bound() const {
-  return {boundOfBits(bits_[0].load()), boundOfBits(bits_[1].load())};
+  return {boundOfBits(bits_[0].load()), boundOfBits(bits_[1].load()), boundOfBits(bits_[2].load())};
 }
 
 }  // namespace tickfx

@@ -14,18 +14,20 @@
 
 namespace tickfx {
 
-/// Upper bounds of |x| over every component of every row's position (m) and velocity (m/s).
+/// Upper bounds of |x| over every component of every row's state: position (m), velocity (m/s)
+/// and the scheme's third column where it has one (extraColumnOf()).
 struct StateBound {
   double position = 0.0;
   double velocity = 0.0;
+  double extra = 0.0;
 
   /// The largest magnitude a bound may reach and still prove a tick finite: every value a tick
   /// computes stays below it, so no operation overflows (FLT_MAX is about 2¹²⁸) and, its operands
   /// finite, none makes a NaN.
   static constexpr double kLimit = 0x1p126;
 
-  /// Whether both bounds are at most kLimit (false for a NaN).
-  bool provesFinite() const { return position <= kLimit && velocity <= kLimit; }
+  /// Whether every bound is at most kLimit (false for a NaN).
+  bool provesFinite() const { return position <= kLimit && velocity <= kLimit && extra <= kLimit; }
 };
 
 /// The larger of each pair of bounds, a NaN where either is one.
@@ -33,7 +35,15 @@ inline double wider(double a, double b) {
   return std::isnan(a) || std::isnan(b) ? NAN : a < b ? b : a;
 }
 inline StateBound wider(const StateBound& a, const StateBound& b) {
-  return {wider(a.position, b.position), wider(a.velocity, b.velocity)};
+  return {wider(a.position, b.position), wider(a.velocity, b.velocity), wider(a.extra, b.extra)};
+}
+
+/// The state column beyond the position and velocity that a scheme reads from tick to tick:
+/// position Verlet's previous position (`readsPrevious`), velocity Verlet's kept acceleration;
+/// nullptr for the others.
+inline const Vec3Column* extraColumnOf(const ParticlePool& pool, bool readsPrevious) {
+  if (readsPrevious) return &pool.previousPosition();
+  return pool.keepsAcceleration() ? &pool.acceleration() : nullptr;
 }
 
 /// The largest magnitude among values [begin, end) of `column`, as the bits of a float (sign
@@ -44,17 +54,18 @@ std::uint32_t magnitudeBits(const float* column, std::size_t begin, std::size_t 
 /// The float whose bits magnitudeBits() gave, as a bound: +∞ for an infinity or a NaN.
 double boundOfBits(std::uint32_t bits);
 
-/// The largest magnitudes of the positions and velocities of the rows added, from any threads in
-/// any order (a max: the same bound whatever the split).
+/// The largest magnitudes of the state of the rows added, from any threads in any order (a max:
+/// the same bound whatever the split).
 class LargestMagnitudes {
  public:
-  /// Takes in rows [begin, end) of `pool`'s positions and velocities.
-  void add(const ParticlePool& pool, std::size_t begin, std::size_t end);
+  /// Takes in rows [begin, end) of `pool`'s positions and velocities, and of `extra` unless null
+  /// (extraColumnOf()).
+  void add(const ParticlePool& pool, const Vec3Column* extra, std::size_t begin, std::size_t end);
   /// The bound of every row added (0 for none; +∞ where one was not finite).
   StateBound bound() const;
 
  private:
-  std::atomic<std::uint32_t> bits_[2] = {0, 0};  // position, velocity
+  std::atomic<std::uint32_t> bits_[3] = {0, 0, 0};  // position, velocity, extra
 };
 
 }  // namespace tickfx
