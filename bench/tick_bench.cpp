@@ -25,9 +25,10 @@
 //                     also `step() AVX2`, forced to the AVX2 clones.
 //   tickfx fused x4   stepTicks(4): frames of four ticks, each block of rows taken through all
 //                     four while in cache (fused frames), the same bits as four step() calls.
-//                     Under nonfinite = "stop" (the default) a frame first copies its rows'
-//                     state, to replay the frame tick by tick if it goes non-finite; `keep`
-//                     runs without the check, as the hand loops do: the like-for-like ratio.
+//                     Under nonfinite = "stop" (the default) a frame is first proven finite
+//                     from bounds of its state (particles/StateBound.h; where it cannot be, it
+//                     copies its rows' state, to replay the frame tick by tick if it goes
+//                     non-finite); `keep` runs without either, as the hand loops do.
 // Each tickfx case runs with 1 thread and with all threads, so the table separates the gain of
 // the layout from the gain of threading.
 //
@@ -433,8 +434,7 @@ bool runSize(std::size_t n, const Options& o, int allThreads, std::vector<Row>& 
   // Systems advanced kFusedTicks ticks a frame: fused frames (ParticleSystem's class comment).
   std::unique_ptr<tickfx::ParticleSystem> fusedOne = makeSystem(n, 1);
   std::unique_ptr<tickfx::ParticleSystem> fusedAll = allThreads > 1 ? makeSystem(n, 0) : nullptr;
-  // Fused frames without the non-finite check, as the hand loop runs: under "stop" a frame first
-  // copies its rows' state, so that it can be replayed tick by tick if it goes non-finite.
+  // Fused frames under "keep", as the hand loop runs (the header says what "stop" adds).
   std::unique_ptr<tickfx::ParticleSystem> fusedUnchecked =
       makeSystem(n, 1, tickfx::NonfinitePolicy::Keep);
 
