@@ -14,10 +14,11 @@ namespace tickfx {
 /// The value of a Lane in a row kernel run on bounds instead of rows (boundTickUnderForms): an
 /// upper bound of the magnitude of that value in any row whose inputs are within their bounds.
 /// Sums and differences add magnitudes, products multiply them, each widened by 2⁻²⁰ for the
-/// float operation's rounding (at most 2⁻²⁴ relative) and this double one's. A result past
-/// StateBound::kLimit becomes +∞, so that the float operation it stands for is never assumed not
-/// to overflow. The kernels use no division, so Magnitude has none: one added to a kernel does
-/// not compile until it is given a sound bound here.
+/// float operation's rounding (at most 2⁻²⁴ relative; a subnormal result may round up by 2⁻¹⁴⁹
+/// more, which the factor 4 between StateBound::kLimit and FLT_MAX absorbs) and this double
+/// one's. A result past kLimit becomes +∞, so that the float operation it stands for is never
+/// assumed not to overflow. The kernels use no division, so Magnitude has none: one added to a
+/// kernel does not compile until it is given a sound bound here.
 struct Magnitude {
   double m = 0.0;
 
