@@ -198,7 +198,7 @@ std::pair<std::size_t, std::size_t> checkGrid(const std::string& file, std::uint
   const bool halfFloat =
       checkMetadata(in, (end - begin) / kLeafMaskBytes).halfFloat && value.halfSize != 0;
   checkTransform(in);
-  const TreeStorage storage{value, compression, halfFloat};
+  const TreeStorage storage{value, compression, halfFloat, kind->second.points};
   const std::vector<LeafMask> leaves = checkTreeTopology(in, storage);
   const std::size_t block = in.pos();
   if (kind->second.points) {

@@ -50,7 +50,14 @@ class NodeCheck {
   void root() {
     const std::size_t at = in_.pos();
     if (in_.get<std::int32_t>() != 1) in_.corrupt(at, "a tree with other than one buffer");
-    in_.take(storage_.value.size);  // the background value
+    const std::size_t backgroundAt = in_.pos();
+    const char* background = in_.take(storage_.value.size);
+    // A PointDataGrid's leaves are made with the background as their value, and OpenVDB asserts
+    // that it is zero (PointDataLeafNode::assertNonModifiableUnlessZero).
+    if (storage_.points &&
+        std::any_of(background, background + storage_.value.size, [](char c) { return c != 0; })) {
+      in_.corrupt(backgroundAt, "a point data tree whose background is not zero");
+    }
     const auto tiles = in_.get<std::uint32_t>();
     const auto children = in_.get<std::uint32_t>();
     // The root's table is a std::map: OpenVDB writes tiles, then children, each in the map's

@@ -31,6 +31,7 @@ struct TreeStorage {
   ValueLayout value;
   std::uint32_t compression;  // kZip, kActiveMask and kBlosc: the grid's compression flags
   bool half;                  // the values are stored as half floats
+  bool points;                // a PointDataGrid's tree (its background must be zero)
 };
 
 /// Tree::readTopology: the root's tiles and children, in order, unique and aligned to their nodes,
