@@ -542,6 +542,31 @@ TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {
                                           "expected)");
 }
 
+// OpenVDB makes a point tree's leaves with its background as their value and asserts that it is
+// zero: a file with another background is refused at that byte, before OpenVDB reads it. The
+// background is the only run of bytes early in the file whose change gives that refusal.
+TEST_F(ioVdbPoints, APointTreeWhoseBackgroundIsNotZeroIsRefused) {
+  writeVdbPointCache(test::onePointFrame(), sampleMetadata(), path("one.vdb"));
+  const std::string bytes = fileBytes(path("one.vdb"));
+  const std::string file = path("changed.vdb").string();
+  std::vector<std::size_t> refusedAt;
+  std::string first;
+  for (std::size_t i = 0; i < std::min<std::size_t>(bytes.size(), 2000); ++i) {
+    std::string changed = bytes;
+    changed[i] = static_cast<char>(changed[i] ^ 0x40);
+    std::ofstream(file, std::ios::binary) << changed;
+    const std::string error = errorOf(file);
+    if (error.find("background is not zero") == std::string::npos) continue;
+    if (refusedAt.empty()) first = error;
+    refusedAt.push_back(i);
+  }
+  ASSERT_EQ(refusedAt.size(), 4u);  // a PointIndex32's four bytes
+  EXPECT_EQ(refusedAt.back() - refusedAt.front(), 3u);
+  EXPECT_EQ(first, file + ": grid 'points': cannot read the grid (the file is corrupt at byte " +
+                       std::to_string(refusedAt.front()) +
+                       ": a point data tree whose background is not zero)");
+}
+
 TEST_F(ioVdbPoints, AFailedWriteLeavesNoFile) {
   FrameData frame = oddFrame();
   // Into a directory that does not exist: the error names the file, nothing is left behind.
