@@ -164,10 +164,10 @@ struct ParticleSystem::FrameStart {
   // a core's L2 cache.
   static constexpr std::size_t kStreamedRows = std::size_t{1} << 18;
 
-  Vec3Column position, velocity, previous, acceleration;
+  Vec3Column position, velocity, extra;
 
-  void reserve(const ParticlePool& pool, bool previousToo) {
-    withPrevious = previousToo;
+  void reserve(const ParticlePool& pool, bool previousRead) {
+    readsPrevious = previousRead;
     streamed = pool.size() >= kStreamedRows;
 #if defined(__SSE2__)
     streamRows = &streamRowsSse2;
@@ -181,8 +181,7 @@ struct ParticleSystem::FrameStart {
     };
     grow(position);
     grow(velocity);
-    if (withPrevious) grow(previous);
-    if (pool.keepsAcceleration()) grow(acceleration);
+    if (extraColumnOf(pool, readsPrevious)) grow(extra);
   }
   // Vec3Column::copyRows with stores that bypass the cache where the machine has them, for a pool
   // larger than the caches: the copy is read back only when a frame goes non-finite, so caching it
@@ -224,15 +223,15 @@ struct ParticleSystem::FrameStart {
   }
 #endif
 #endif
-  // The state a tick reads: the previous position only for a scheme that reads it (the others
-  // write it afresh each tick), the acceleration only when the pool keeps it.
-  bool withPrevious = false;
+  // The state a tick reads: the position, the velocity and the scheme's third column, the one its
+  // proof bounds too (extraColumnOf: the previous position only for a scheme that reads it, as
+  // the others write it afresh each tick).
+  bool readsPrevious = false;
 
-  void save(ParticlePool& pool, std::size_t b, std::size_t e) {
+  void save(const ParticlePool& pool, std::size_t b, std::size_t e) {
     store(pool.position(), position, b, e);
     store(pool.velocity(), velocity, b, e);
-    if (withPrevious) store(pool.previousPosition(), previous, b, e);
-    if (pool.keepsAcceleration()) store(pool.acceleration(), acceleration, b, e);
+    if (const Vec3Column* third = extraColumnOf(pool, readsPrevious)) store(*third, extra, b, e);
 #if defined(__SSE2__)
     if (streamed) _mm_sfence();  // ordered before the frame's end, like any other store
 #endif
@@ -240,8 +239,7 @@ struct ParticleSystem::FrameStart {
   void restore(ParticlePool& pool, std::size_t b, std::size_t e) const {
     pool.position().copyRows(position, b, e);
     pool.velocity().copyRows(velocity, b, e);
-    if (withPrevious) pool.previousPosition().copyRows(previous, b, e);
-    if (pool.keepsAcceleration()) pool.acceleration().copyRows(acceleration, b, e);
+    if (Vec3Column* third = extraColumnOf(pool, readsPrevious)) third->copyRows(extra, b, e);
   }
 };
 

@@ -45,6 +45,10 @@ inline const Vec3Column* extraColumnOf(const ParticlePool& pool, bool readsPrevi
   if (readsPrevious) return &pool.previousPosition();
   return pool.keepsAcceleration() ? &pool.acceleration() : nullptr;
 }
+inline Vec3Column* extraColumnOf(ParticlePool& pool, bool readsPrevious) {
+  if (readsPrevious) return &pool.previousPosition();
+  return pool.keepsAcceleration() ? &pool.acceleration() : nullptr;
+}
 
 /// The largest magnitude among values [begin, end) of `column`, as the bits of a float (sign
 /// cleared; non-negative floats order as their bits): +∞ or a NaN when one is not finite. The
