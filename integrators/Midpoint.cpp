@@ -27,11 +27,18 @@ auto underForms(float dt) {
   };
 }
 
+// The tick's forms at the stages its one pass reads: t and t + dt/2. integrate() and boundTick()
+// both ask here, so the bound runs on the forms the tick runs on.
+std::optional<TickForms> midpointForms(ParticlePool& pool, const ForceSet& forces,
+                                       const StepTime& time) {
+  return tickForms(pool, forces, time, {0, 1});
+}
+
 }  // namespace
 
 bool Midpoint::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                          StateBound& bound) const {
-  const auto forms = tickForms(pool, forces, time, {0, 1});
+  const auto forms = midpointForms(pool, forces, time);
   if (!forms) return false;
   bound = boundTickUnderForms(*forms, underForms(time.dt()), bound);
   return true;
@@ -44,7 +51,7 @@ void Midpoint::integrate(ParticlePool& pool, const ForceSet& forces, const StepT
   Vec3Column& p = pool.position();
   Vec3Column& v = pool.velocity();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1);
-  if (const auto forms = tickForms(pool, forces, time, {0, 1})) {
+  if (const auto forms = midpointForms(pool, forces, time)) {
     runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, underForms(dt));
     return;
   }

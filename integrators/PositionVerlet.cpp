@@ -37,11 +37,18 @@ auto underForms(float dt2, float invDt) {
   };
 }
 
+// The tick's forms at the stages its one pass reads: t. integrate(), boundTick() and boundSpawned()
+// all ask here, so the bound runs on the forms the tick runs on.
+std::optional<TickForms> positionVerletForms(ParticlePool& pool, const ForceSet& forces,
+                                             const StepTime& time) {
+  return tickForms(pool, forces, time, {0});
+}
+
 }  // namespace
 
 bool PositionVerlet::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                                StateBound& bound) const {
-  const auto forms = tickForms(pool, forces, time, {0});
+  const auto forms = positionVerletForms(pool, forces, time);
   if (!forms) return false;
   const float dt = time.dt();
   bound = boundTickUnderForms(*forms, underForms(dt * dt, static_cast<float>(time.stepRateHz)),
@@ -51,7 +58,7 @@ bool PositionVerlet::boundTick(ParticlePool& pool, const ForceSet& forces, const
 
 bool PositionVerlet::boundSpawned(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                                   StateBound& bound) const {
-  const auto forms = tickForms(pool, forces, time, {0});
+  const auto forms = positionVerletForms(pool, forces, time);
   if (!forms) return false;
   const float dt = time.dt();
   const float halfDt2 = 0.5f * (dt * dt);
@@ -87,7 +94,7 @@ void PositionVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
           startingPrevious(pr[c][i], vr[c][i], acceleration(offset + i, vr[c][i]), dt, halfDt2);
     }
   };
-  if (const auto forms = tickForms(pool, forces, time, {0})) {
+  if (const auto forms = positionVerletForms(pool, forces, time)) {
     const auto startTile = [&](const Tile& tile) {
       for (int c = 0; c < 3; ++c) {
         withFormAccelerations(*forms, c, [&](const auto& a) {

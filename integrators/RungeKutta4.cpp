@@ -37,11 +37,18 @@ auto underForms(float h) {
   };
 }
 
+// The tick's forms at the stages its one pass reads: t, t + dt/2 and t + dt. integrate() and
+// boundTick() both ask here, so the bound runs on the forms the tick runs on.
+std::optional<TickForms> rungeKutta4Forms(ParticlePool& pool, const ForceSet& forces,
+                                          const StepTime& time) {
+  return tickForms(pool, forces, time, {0, 1, 2});
+}
+
 }  // namespace
 
 bool RungeKutta4::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                             StateBound& bound) const {
-  const auto forms = tickForms(pool, forces, time, {0, 1, 2});
+  const auto forms = rungeKutta4Forms(pool, forces, time);
   if (!forms) return false;
   bound = boundTickUnderForms(*forms, underForms(time.dt()), bound);
   return true;
@@ -56,7 +63,7 @@ void RungeKutta4::integrate(ParticlePool& pool, const ForceSet& forces, const St
   Vec3Column& v = pool.velocity();
   const TickInstant t0 = time.stage(0), tHalf = time.stage(1), t1 = time.stage(2);
 
-  if (const auto forms = tickForms(pool, forces, time, {0, 1, 2})) {
+  if (const auto forms = rungeKutta4Forms(pool, forces, time)) {
     runStateUpdateUnderForms(pool, scratch_, rows, check, *forms, underForms(h));
     return;
   }

@@ -24,11 +24,18 @@ auto singleEvaluationUnderForms(const Row& row) {
   };
 }
 
+/// The tick's forms at the one stage such a scheme reads, t: stepSingleEvaluation() and
+/// boundSingleEvaluation() both ask here, so the bound runs on the forms the tick runs on.
+inline std::optional<TickForms> singleEvaluationForms(ParticlePool& pool, const ForceSet& forces,
+                                                      const StepTime& time) {
+  return tickForms(pool, forces, time, {0});
+}
+
 /// Integrator::boundTick() of a scheme whose row is `row` (see stepSingleEvaluation).
 template <class Row>
 bool boundSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                            const Row& row, StateBound& bound) {
-  const auto forms = tickForms(pool, forces, time, {0});
+  const auto forms = singleEvaluationForms(pool, forces, time);
   if (!forms) return false;
   bound = boundTickUnderForms(*forms, singleEvaluationUnderForms(row), bound);
   return true;
@@ -42,7 +49,7 @@ template <class Row>
 void stepSingleEvaluation(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                           const StepRows& rows, NonfiniteCheck* check, StageScratch& scratch,
                           const Row& row) {
-  if (const auto forms = tickForms(pool, forces, time, {0})) {
+  if (const auto forms = singleEvaluationForms(pool, forces, time)) {
     runStateUpdateUnderForms(pool, scratch, rows, check, *forms, singleEvaluationUnderForms(row));
     return;
   }

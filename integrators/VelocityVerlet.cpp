@@ -30,11 +30,19 @@ auto underForms(float dt) {
   };
 }
 
+// The tick's forms at the stages its one pass reads: t + dt (a(t) is the one kept from the tick
+// before). integrate() and boundTick() both ask here, so the bound runs on the forms the tick runs
+// on.
+std::optional<TickForms> velocityVerletForms(ParticlePool& pool, const ForceSet& forces,
+                                             const StepTime& time) {
+  return tickForms(pool, forces, time, {2});
+}
+
 }  // namespace
 
 bool VelocityVerlet::boundTick(ParticlePool& pool, const ForceSet& forces, const StepTime& time,
                                StateBound& bound) const {
-  const auto forms = tickForms(pool, forces, time, {2});
+  const auto forms = velocityVerletForms(pool, forces, time);
   if (!forms) return false;
   bound = boundTickUnderForms(*forms, underForms(time.dt()), bound, ExtraColumn::kFourth);
   return true;
@@ -69,7 +77,7 @@ void VelocityVerlet::integrate(ParticlePool& pool, const ForceSet& forces, const
     Vec3Rows out = rowsOf(a, started);
     forces.evaluate({pool, Vec3View::of(p), Vec3View::of(v), t0}, started, out);
   };
-  if (const auto forms = tickForms(pool, forces, time, {2})) {
+  if (const auto forms = velocityVerletForms(pool, forces, time)) {
     runOnePass(pool, scratch_, rows, check, *forms, underForms(dt), startRows, a);
     return;
   }
