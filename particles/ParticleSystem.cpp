@@ -360,13 +360,21 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
 // before come from the frame before (measured at its end) or, the first time, from a scan;
 // those of the fresh rows' positions and velocities from a scan (they are few, and in cache),
 // and of the third column a scheme starts them with (Integrator::boundSpawned) from those.
-// `measures`: whether the scheme and forces can be bounded at all, so that the frame's end is
-// worth measuring.
+// `measures`: whether the scheme and forces can be bounded at all (false only where a bound
+// failed to be made), so that the frame's end is worth measuring.
 bool ParticleSystem::provesFrameFinite(std::int64_t ticks, std::size_t fresh, bool& measures) {
   const std::int64_t rate = settings_.stepRateHz;
-  StateBound probe;
-  measures = integrator_->boundTick(pool_, *forces_, StepTime{tick_, rate}, probe);
-  if (!measures) return false;
+  const bool known =
+      fresh > 0 && endBounds_ && endBoundsTick_ == tick_ && nonfiniteCheck_.steppedRowsFinite();
+  // A scan is a pass over rows: before one, the first tick's bound is asked for once more (its
+  // forms: a wind's sine), to learn whether the scheme and forces can be bounded at all. Without
+  // a scan, the loop below learns it from that very bound.
+  if ((fresh > 0 && !known) || fresh < pool_.size()) {
+    StateBound probe;
+    measures = integrator_->boundTick(pool_, *forces_, StepTime{tick_, rate}, probe);
+    if (!measures) return false;
+  }
+  measures = true;
   const auto scan = [&](const Vec3Column* extra, std::size_t b, std::size_t e) {
     LargestMagnitudes largest;
     parallelForRows(
@@ -375,7 +383,6 @@ bool ParticleSystem::provesFrameFinite(std::int64_t ticks, std::size_t fresh, bo
   };
   StateBound bound;  // no rows stepped before: nothing to bound
   if (fresh > 0) {
-    const bool known = endBounds_ && endBoundsTick_ == tick_ && nonfiniteCheck_.steppedRowsFinite();
     if (known) {
       bound = *endBounds_;
     } else {
@@ -392,7 +399,10 @@ bool ParticleSystem::provesFrameFinite(std::int64_t ticks, std::size_t fresh, bo
   }
   for (std::int64_t j = 0; j < ticks; ++j) {
     if (!bound.provesFinite()) return false;
-    if (!integrator_->boundTick(pool_, *forces_, StepTime{tick_ + j, rate}, bound)) return false;
+    if (!integrator_->boundTick(pool_, *forces_, StepTime{tick_ + j, rate}, bound)) {
+      measures = false;  // the forms are those of every tick (ForceSet::uniformAndDrag)
+      return false;
+    }
   }
   return bound.provesFinite();
 }
