@@ -364,33 +364,38 @@ bool ParticleSystem::runFusedTicks(std::int64_t ticks, bool shown) {
 // failed to be made), so that the frame's end is worth measuring.
 bool ParticleSystem::provesFrameFinite(std::int64_t ticks, std::size_t fresh, bool& measures) {
   const std::int64_t rate = settings_.stepRateHz;
-  const bool known =
-      fresh > 0 && endBounds_ && endBoundsTick_ == tick_ && nonfiniteCheck_.steppedRowsFinite();
-  // A scan is a pass over rows: before one, the first tick's bound is asked for once more (its
-  // forms: a wind's sine), to learn whether the scheme and forces can be bounded at all. Without
-  // a scan, the loop below learns it from that very bound.
-  if ((fresh > 0 && !known) || fresh < pool_.size()) {
-    StateBound probe;
-    measures = integrator_->boundTick(pool_, *forces_, StepTime{tick_, rate}, probe);
-    if (!measures) return false;
-  }
   measures = true;
-  const auto scan = [&](const Vec3Column* extra, std::size_t b, std::size_t e) {
+  const auto boundTick = [&](std::int64_t j, StateBound& b) {
+    // The forms are those of every tick (ForceSet::uniformAndDrag): one failure is all of them.
+    measures = measures && integrator_->boundTick(pool_, *forces_, StepTime{tick_ + j, rate}, b);
+    return measures;
+  };
+  // Rows [b, e)'s bound into `out`. A scan is a pass over rows: before the first, the first
+  // tick's bound is asked for once more (its forms: a wind's sine), to learn whether the scheme
+  // and forces can be bounded at all. Without a scan, the loop below learns it from that very
+  // bound.
+  bool probed = false;
+  const auto scan = [&](const Vec3Column* extra, std::size_t b, std::size_t e, StateBound& out) {
+    StateBound probe;
+    if (!probed && !boundTick(0, probe)) return false;
+    probed = true;
     LargestMagnitudes largest;
     parallelForRows(
         e - b, [&](std::size_t rb, std::size_t re) { largest.add(pool_, extra, b + rb, b + re); });
-    return largest.bound();
+    out = largest.bound();
+    return true;
   };
   StateBound bound;  // no rows stepped before: nothing to bound
   if (fresh > 0) {
-    if (known) {
+    if (endBounds_ && endBoundsTick_ == tick_ && nonfiniteCheck_.steppedRowsFinite()) {
       bound = *endBounds_;
-    } else {
-      bound = scan(extraColumnOf(pool_, integrator_->readsPreviousPosition()), 0, fresh);
+    } else if (!scan(extraColumnOf(pool_, integrator_->readsPreviousPosition()), 0, fresh, bound)) {
+      return false;
     }
   }
   if (fresh < pool_.size()) {
-    StateBound born = scan(nullptr, fresh, pool_.size());  // their third column is not set yet
+    StateBound born;  // their third column is not set yet
+    if (!scan(nullptr, fresh, pool_.size(), born)) return false;
     for (std::int64_t j = 0; j < ticks; ++j) {
       if (!integrator_->boundSpawned(pool_, *forces_, StepTime{tick_ + j, rate}, born))
         return false;
@@ -398,11 +403,7 @@ bool ParticleSystem::provesFrameFinite(std::int64_t ticks, std::size_t fresh, bo
     bound = wider(bound, born);
   }
   for (std::int64_t j = 0; j < ticks; ++j) {
-    if (!bound.provesFinite()) return false;
-    if (!integrator_->boundTick(pool_, *forces_, StepTime{tick_ + j, rate}, bound)) {
-      measures = false;  // the forms are those of every tick (ForceSet::uniformAndDrag)
-      return false;
-    }
+    if (!bound.provesFinite() || !boundTick(j, bound)) return false;
   }
   return bound.provesFinite();
 }

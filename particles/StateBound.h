@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
 #include "particles/ParticlePool.h"
 
@@ -46,8 +47,7 @@ inline const Vec3Column* extraColumnOf(const ParticlePool& pool, bool readsPrevi
   return pool.keepsAcceleration() ? &pool.acceleration() : nullptr;
 }
 inline Vec3Column* extraColumnOf(ParticlePool& pool, bool readsPrevious) {
-  if (readsPrevious) return &pool.previousPosition();
-  return pool.keepsAcceleration() ? &pool.acceleration() : nullptr;
+  return const_cast<Vec3Column*>(extraColumnOf(std::as_const(pool), readsPrevious));
 }
 
 /// The largest magnitude among values [begin, end) of `column`, as the bits of a float (sign
