@@ -5,6 +5,7 @@
 #include <string>
 
 #include "fields/ColliderShapes.h"
+#include "fields/ContactRows.h"
 #include "fields/ShapeCollider.h"
 #include "particles/DetMath.h"
 
@@ -158,25 +159,21 @@ Eigen::Vector3f Collider::carried(const Contact& c) const {
   return collide::toWorld(tick_.end, c.restPoint);
 }
 
-float Collider::margin(float scale) { return std::max(1.0f, scale) * 0x1p-20f; }
+std::uint64_t Collider::contactRows(const collide::RowsJob& job) const {
+  struct Alone {
+    const Collider* self;
+    const Collider* first(const V3& a, float from, const V3& b, Contact& out) const {
+      return self->firstContact(a, from, b, out) ? self : nullptr;
+    }
+    V3 respond(const Collider& hit, const Contact& c, const V3& v) const {
+      return hit.respond(c, v);
+    }
+  };
+  return collide::contactRows(job, Alone{this});
+}
 
 Eigen::Vector3f Collider::respond(const Contact& c, const Eigen::Vector3f& v) const {
-  const V3 u = c.surfaceVelocity;
-  const V3 relative = v - u;
-  const float approach = collide::dot(relative, c.normal);
-  if (!(approach < 0.0f)) return v;
-  if (settings_.response == ColliderResponse::Stick ||
-      settings_.response == ColliderResponse::Kill) {
-    return u;
-  }
-  const float e = settings_.response == ColliderResponse::Bounce ? restitution_ : 0.0f;
-  const V3 normalPart = c.normal * approach;
-  V3 tangential = relative - normalPart;
-  const float speed = collide::length(tangential);
-  const float loss = friction_ * ((1.0f + e) * -approach);
-  if (speed > 0.0f)
-    tangential = loss >= speed ? V3::Zero() : V3(tangential * ((speed - loss) / speed));
-  return u + tangential - normalPart * e;
+  return collide::respondWith(settings_.response, restitution_, friction_, c, v);
 }
 
 std::unique_ptr<Collider> makeCollider(const ColliderSettings& s) {

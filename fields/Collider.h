@@ -13,6 +13,10 @@
 
 namespace tickfx {
 
+namespace collide {
+struct RowsJob;
+}
+
 enum class ColliderType { Plane, Sphere, Box, LevelSet };
 /// Which side of the surface particles stay on: outside an obstacle, inside a container.
 enum class ColliderSide { Outside, Inside };
@@ -102,6 +106,10 @@ class Collider {
   /// columns with no call a row: most particles are nowhere near most colliders.
   virtual void screen(const float* const a[3], const float* const b[3], std::size_t n,
                       std::uint8_t* flags) const = 0;
+  /// ColliderSet's contact loop over a block's flagged rows, this collider the set's only one;
+  /// returns the contacts made. The default calls firstContact() a contact; a shape collider
+  /// runs the same loop with its test inlined (the same bits).
+  virtual std::uint64_t contactRows(const collide::RowsJob& job) const;
   /// How far (m) a particle at world position `x` at the tick's end lies on the allowed side of
   /// the surface, the particles' radius taken off: negative inside. For tests and lints.
   float clearance(const Eigen::Vector3f& x) const;
@@ -117,7 +125,7 @@ class Collider {
   /// 1 m and the coordinates' magnitude. Every particle ends a tick with clearance() above
   /// −margin(); a contact places it at clearance() >= 0 in the collider's frame, and a particle
   /// resting on a surface lies within rounding of it, which is no contact.
-  static float margin(float scale);
+  static float margin(float scale) { return (scale > 1.0f ? scale : 1.0f) * 0x1p-20f; }
 
   /// `v` after contact `c`: with u the surface's velocity and v_r = v − u split into its normal
   /// part v_n = (v_r · n) n and tangential part v_t, a contact approaching the surface

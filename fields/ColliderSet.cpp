@@ -3,6 +3,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "fields/ContactRows.h"
 #include "particles/Assert.h"
 #include "particles/ParallelFor.h"
 
@@ -65,7 +66,6 @@ void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t st
 
 void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz,
                             bool history) {
-  paths_.clear();
   contacts_ = 0;
   if (colliders_.empty()) return;
   for (auto& c : colliders_) c->beginTick(tick, stepRateHz);
@@ -80,6 +80,7 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
   t.blocks = (pool.size() + kParallelBlockRows - 1) / kParallelBlockRows;
   blockPaths_.resize(std::max(blockPaths_.size(), t.blocks));
   for (std::size_t k = 0; k < t.blocks; ++k) blockPaths_[k].clear();
+  blockContactCounts_.assign(t.blocks, 0);
   t.counts = nullptr;
   if (!countColumn_.empty()) {
     t.counts = pool.attribute(pool.findAttribute(countColumn_)).data();
@@ -102,121 +103,73 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
   TICKFX_ASSERT((given[0] != nullptr && !tick_.history) || pool.keepsPrevious(),
                 "paths start at the pool's previous positions, which it does not keep");
   const TickState& t = tick_;
-  const float dt = t.dt;
+  const std::size_t block = begin / kParallelBlockRows;
   Vec3Column& pos = pool.position();
   Vec3Column& vel = pool.velocity();
   Vec3Column& prev = pool.previousPosition();
+  collide::RowsJob job;
+  job.begin = begin;
+  job.count = end - begin;
+  for (std::size_t c = 0; c < 3; ++c) {
+    const auto axis = static_cast<int>(c);
+    job.starts[c] = given[0] != nullptr ? given[c] : prev[axis].data() + begin;
+    job.position[c] = pos[axis].data();
+    job.velocity[c] = vel[axis].data();
+    job.previous[c] = prev[axis].data();
+  }
   // Only a kill flags a row: a mutable dead() would have the tick's end scan every row for none.
-  std::uint8_t* const dead = t.kills ? pool.dead().data() : nullptr;
-  const std::uint64_t* ids = pool.id().data();
-  std::vector<CollisionPath>& found = blockPaths_[begin / kParallelBlockRows];
+  job.dead = t.kills ? pool.dead().data() : nullptr;
+  job.ids = pool.id().data();
+  job.dt = t.dt;
+  job.start = t.start;
+  job.history = t.history;
+  job.hits = t.hits;
+  job.counts = t.counts;
+  job.found = &blockPaths_[block];
+  job.records = t.counts != nullptr ? &blockContacts_[block] : nullptr;
   // Which rows may touch a collider: a screen over the block's columns first.
   thread_local std::vector<std::uint8_t> flags;
-  flags.assign(end - begin, 0);
-  const float* starts[3];
-  for (int c = 0; c < 3; ++c)
-    starts[c] = given[0] != nullptr ? given[static_cast<std::size_t>(c)] : prev[c].data() + begin;
+  flags.assign(job.count, 0);
+  const float* const starts[3] = {job.starts[0], job.starts[1], job.starts[2]};
   const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
-  for (const auto& c : colliders_) c->screen(starts, ends, end - begin, flags.data());
-  // Most rows are screened out: skipped eight at a time, through a pointer read once (the
-  // thread_local vector would be looked up again every row).
-  const std::uint8_t* const flagged = flags.data();
-  const std::size_t count = end - begin;
-  for (std::size_t k = 0; k < count; ++k) {
-    if ((k & 7) == 0 && k + 8 <= count) {
-      std::uint64_t eight = 0;
-      std::memcpy(&eight, flagged + k, sizeof eight);
-      if (eight == 0) {
-        k += 7;
-        continue;
-      }
-    }
-    if (flagged[k] == 0) continue;
-    const std::size_t i = begin + k;
-    const auto row = static_cast<Eigen::Index>(i);
-    Eigen::Vector3f a(starts[0][k], starts[1][k], starts[2][k]);
-    Eigen::Vector3f b(pos.x[row], pos.y[row], pos.z[row]);
-    Eigen::Vector3f v(vel.x[row], vel.y[row], vel.z[row]);
-    CollisionPath path;
-    float from = 0.0f;
-    int recorded = 0;
-    Contact lastHit;
-    Eigen::Vector3f hitVelocity = Eigen::Vector3f::Zero();
-    std::vector<ContactRecord>* records =
-        t.counts != nullptr ? &blockContacts_[begin / kParallelBlockRows] : nullptr;
-    while (path.contacts < kMaxContactsPerTick) {
-      Contact best, contact;
+  for (const auto& c : colliders_) c->screen(starts, ends, job.count, flags.data());
+  job.flagged = flags.data();
+  if (colliders_.size() == 1) {
+    blockContactCounts_[block] = colliders_.front()->contactRows(job);
+    return;
+  }
+  struct Several {
+    const std::vector<std::unique_ptr<Collider>>& colliders;
+    const Collider* first(const Eigen::Vector3f& a, float from, const Eigen::Vector3f& b,
+                          Contact& best) const {
       const Collider* hit = nullptr;
-      for (const auto& c : colliders_) {
+      Contact contact;
+      for (const auto& c : colliders) {
         if (c->firstContact(a, from, b, contact) &&
             (hit == nullptr || contact.fraction < best.fraction)) {
           best = contact;
           hit = c.get();
         }
       }
-      if (hit == nullptr) break;
-      if (path.contacts == 0) path.start = a;
-      path.fraction[path.contacts] = best.fraction;
-      path.point[path.contacts] = best.point;
-      ++path.contacts;
-      if (records != nullptr) {
-        records->push_back(ContactRecord{
-            static_cast<std::uint32_t>(i),
-            static_cast<std::uint32_t>(t.counts[i]) + static_cast<std::uint32_t>(path.contacts - 1),
-            best.point, best.normal, v});
-      }
-      if (t.hits[0] != nullptr && hit->settings().recordHits) {
-        ++recorded;
-        lastHit = best;
-        hitVelocity = v;
-      }
-      v = hit->respond(best, v);
-      a = best.point;
-      from = best.fraction;
-      if (hit->settings().response == ColliderResponse::Kill) {
-        dead[i] = static_cast<std::uint8_t>(dead[i] | 1);
-        b = a;
-        break;
-      }
-      // The rest of the tick at the new velocity; after the last contact allowed, carried
-      // along with the collider.
-      b = path.contacts < kMaxContactsPerTick ? Eigen::Vector3f(a + v * ((1.0f - from) * dt))
-                                              : hit->carried(best);
+      return hit;
     }
-    if (path.contacts == 0) continue;
-    if (t.counts != nullptr) t.counts[i] += static_cast<float>(path.contacts);
-    for (int c = 0; c < 3; ++c) {
-      pos[c][row] = b[c];
-      vel[c][row] = v[c];
-      if (t.history) prev[c][row] = b[c] - v[c] * dt;
+    Eigen::Vector3f respond(const Collider& hit, const Contact& c, const Eigen::Vector3f& v) const {
+      return hit.respond(c, v);
     }
-    if (recorded > 0) {
-      const float values[kHitColumns.size()] = {t.hits[0][i] + static_cast<float>(recorded),
-                                                t.start + lastHit.fraction * dt,
-                                                lastHit.point.x(),
-                                                lastHit.point.y(),
-                                                lastHit.point.z(),
-                                                lastHit.normal.x(),
-                                                lastHit.normal.y(),
-                                                lastHit.normal.z(),
-                                                hitVelocity.x(),
-                                                hitVelocity.y(),
-                                                hitVelocity.z()};
-      for (std::size_t h = 0; h < kHitColumns.size(); ++h) t.hits[h][i] = values[h];
-    }
-    path.id = ids[i];
-    found.push_back(path);
-  }
+  };
+  blockContactCounts_[block] = collide::contactRows(job, Several{colliders_});
 }
 
 void ColliderSet::endTick() {
   if (colliders_.empty()) return;
-  for (std::size_t k = 0; k < tick_.blocks; ++k) {
-    for (const CollisionPath& p : blockPaths_[k]) {
-      contacts_ += static_cast<std::uint64_t>(p.contacts);
-      paths_.push_back(p);
-    }
-  }
+  for (std::size_t k = 0; k < tick_.blocks; ++k) contacts_ += blockContactCounts_[k];
+}
+
+std::vector<CollisionPath> ColliderSet::paths() const {
+  std::vector<CollisionPath> all;
+  for (const std::vector<CollisionPath>& block : pathBlocks())
+    all.insert(all.end(), block.begin(), block.end());
+  return all;
 }
 
 }  // namespace tickfx

@@ -38,7 +38,13 @@ struct CollisionPath {
   Eigen::Vector3f start = Eigen::Vector3f::Zero();
   int contacts = 0;
   std::array<float, kMaxContactsPerTick> fraction{};
-  std::array<Eigen::Vector3f, kMaxContactsPerTick> point{};
+  // (Each zero: Eigen leaves a default-constructed vector's values unset, and a path's bits
+  // should not depend on the stack it was made on.)
+  std::array<Eigen::Vector3f, kMaxContactsPerTick> point = [] {
+    std::array<Eigen::Vector3f, kMaxContactsPerTick> zero;
+    zero.fill(Eigen::Vector3f::Zero());
+    return zero;
+  }();
 
   /// The position at fraction `alpha` in [0, 1] of the tick, `end` being the tick's: exactly
   /// `start` at 0 and `end` at 1, linear between consecutive points.
@@ -100,8 +106,15 @@ class ColliderSet {
     return {blockContacts_.data(), tick_.blocks};
   }
 
-  /// The paths of the rows that touched a collider in the last collide(), in row order.
-  const std::vector<CollisionPath>& paths() const { return paths_; }
+  /// The paths of the rows that touched a collider in the last collide(): one list a block of
+  /// kParallelBlockRows rows, each in row order. Kept as the blocks found them: a tick whose
+  /// rows all touch (a heap resting on the ground) would otherwise copy every path once more,
+  /// on one thread.
+  std::span<const std::vector<CollisionPath>> pathBlocks() const {
+    return {blockPaths_.data(), tick_.blocks};
+  }
+  /// pathBlocks() in one list, in row order: a copy, for tests and diagnostics.
+  std::vector<CollisionPath> paths() const;
   /// Contacts made in the last collide().
   std::uint64_t contacts() const { return contacts_; }
 
@@ -119,9 +132,9 @@ class ColliderSet {
 
   std::vector<std::unique_ptr<Collider>> colliders_;
   TickState tick_;
-  std::vector<CollisionPath> paths_;
   std::vector<std::vector<CollisionPath>> blockPaths_;
-  std::string countColumn_;  // empty: contacts not recorded
+  std::vector<std::uint64_t> blockContactCounts_;  // contacts a block made, by collideRows()
+  std::string countColumn_;                        // empty: contacts not recorded
   std::vector<std::vector<ContactRecord>> blockContacts_;
   std::uint64_t contacts_ = 0;
 };

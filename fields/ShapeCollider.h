@@ -7,6 +7,7 @@
 
 #include "fields/Collider.h"
 #include "fields/ColliderShapes.h"
+#include "fields/ContactRows.h"
 
 namespace tickfx::collide {
 
@@ -38,32 +39,20 @@ class ShapeCollider final : public Collider {
       : Collider(settings), shape_(shape) {}
 
   bool firstContact(const V3& a, float fromFraction, const V3& b, Contact& out) const override {
-    V3 ra = a, rb = b;
-    ColliderPose from;
-    if (tick_.moving) {
-      from = tick_.at(fromFraction);
-      ra = toRest(from, a);
-      rb = toRest(tick_.end, b);
-    }
-    const float tolerance = margin(std::max(collide::maxAbs(ra), collide::maxAbs(rb)));
-    collide::Entry e;
-    if (!shape_.entry(ra, rb, tolerance, e)) return false;
-    const V3 point = settle(shape_, ra + (rb - ra) * e.s);
-    V3 normal = shape_.normalAt(point);
-    if (e.slope < 0.0f) normal = collide::facingPath(normal, rb - ra, e.slope);
-    out.fraction = fromFraction + e.s * (1.0f - fromFraction);
-    out.restPoint = point;
-    if (!tick_.moving) {
-      out.point = point;
-      out.normal = normal;
-      out.surfaceVelocity = V3::Zero();
-      return true;
-    }
-    const ColliderPose at = tick_.at(out.fraction);
-    out.point = toWorld(at, point);
-    out.normal = collide::mul(at.rotation, normal);
-    out.surfaceVelocity = tick_.surfaceVelocity(out.point, out.fraction);
-    return true;
+    return contactOf(a, fromFraction, b, out);
+  }
+
+  std::uint64_t contactRows(const RowsJob& job) const override {
+    struct Alone {
+      const ShapeCollider* self;
+      const Collider* first(const V3& a, float from, const V3& b, Contact& out) const {
+        return self->contactOf(a, from, b, out) ? self : nullptr;
+      }
+      V3 respond(const Collider& /*hit: self*/, const Contact& c, const V3& v) const {
+        return respondWith(self->settings_.response, self->restitution_, self->friction_, c, v);
+      }
+    };
+    return collide::contactRows(job, Alone{this});
   }
 
   const Shape& shape() const { return shape_; }
@@ -100,6 +89,36 @@ class ShapeCollider final : public Collider {
   }
 
  private:
+  // firstContact(), inline for contactRows().
+  bool contactOf(const V3& a, float fromFraction, const V3& b, Contact& out) const {
+    V3 ra = a, rb = b;
+    ColliderPose from;
+    if (tick_.moving) {
+      from = tick_.at(fromFraction);
+      ra = toRest(from, a);
+      rb = toRest(tick_.end, b);
+    }
+    const float tolerance = margin(std::max(collide::maxAbs(ra), collide::maxAbs(rb)));
+    collide::Entry e;
+    if (!shape_.entry(ra, rb, tolerance, e)) return false;
+    const V3 point = settle(shape_, ra + (rb - ra) * e.s);
+    V3 normal = shape_.normalAt(point);
+    if (e.slope < 0.0f) normal = collide::facingPath(normal, rb - ra, e.slope);
+    out.fraction = fromFraction + e.s * (1.0f - fromFraction);
+    out.restPoint = point;
+    if (!tick_.moving) {
+      out.point = point;
+      out.normal = normal;
+      out.surfaceVelocity = V3::Zero();
+      return true;
+    }
+    const ColliderPose at = tick_.at(out.fraction);
+    out.point = toWorld(at, point);
+    out.normal = collide::mul(at.rotation, normal);
+    out.surfaceVelocity = tick_.surfaceVelocity(out.point, out.fraction);
+    return true;
+  }
+
   Shape shape_;
 };
 

@@ -674,16 +674,19 @@ void ParticleSystem::followPaths(float alpha, const Vec3Destination& out) const 
   const auto& ids = pool_.id();
   const std::size_t n = pool_.size();
   float* const dst[3] = {out.x, out.y, out.z};
-  for (const CollisionPath& path : colliders_->paths()) {
-    // Rows are in id order; a particle the tick removed (a kill contact) is not shown.
-    const auto it =
-        std::lower_bound(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(n), path.id);
-    if (it == ids.begin() + static_cast<std::ptrdiff_t>(n) || *it != path.id) continue;
-    const auto row = static_cast<std::size_t>(it - ids.begin());
-    const auto r = static_cast<Eigen::Index>(row);
-    const Eigen::Vector3f end(pool_.position().x[r], pool_.position().y[r], pool_.position().z[r]);
-    const Eigen::Vector3f p = path.at(alpha, end);
-    for (int c = 0; c < 3; ++c) rowOf(dst[c], out.rowStride, row) = p[c];
+  for (const std::vector<CollisionPath>& block : colliders_->pathBlocks()) {
+    for (const CollisionPath& path : block) {
+      // Rows are in id order; a particle the tick removed (a kill contact) is not shown.
+      const auto it =
+          std::lower_bound(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(n), path.id);
+      if (it == ids.begin() + static_cast<std::ptrdiff_t>(n) || *it != path.id) continue;
+      const auto row = static_cast<std::size_t>(it - ids.begin());
+      const auto r = static_cast<Eigen::Index>(row);
+      const Eigen::Vector3f end(pool_.position().x[r], pool_.position().y[r],
+                                pool_.position().z[r]);
+      const Eigen::Vector3f p = path.at(alpha, end);
+      for (int c = 0; c < 3; ++c) rowOf(dst[c], out.rowStride, row) = p[c];
+    }
   }
 }
 

@@ -619,6 +619,81 @@ TEST(CollisionStarts, ABlocksBufferGivesTheBitsOfThePoolsColumn) {
   }
 }
 
+// A set of one shape collider runs the contact loop with that shape's test and response inlined
+// (ShapeCollider::contactRows); a set of several, through their virtual calls. The same collider
+// beside one that no path reaches must give the same bits: the state (hit columns included), the
+// contacts and every path, for each response, on a heap resting on the ground (a contact a row
+// every tick) under a spray that bounces off it, on 1 and 2 threads.
+struct Collided {
+  std::uint64_t hash = 0, contacts = 0;
+  std::vector<CollisionPath> paths;
+};
+
+Collided collidedWith(const std::vector<ColliderSettings>& colliders, int threads) {
+  auto system = systemWith("semi_implicit_euler", 60, gravityOnly(), colliders, threads);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  for (int i = 0; i < 12000; ++i) {
+    ParticleInit init;
+    const bool resting = i % 3 != 0;
+    init.position =
+        Eigen::Vector3f(4.0f * unit(rng), resting ? 0.0f : 1.5f + unit(rng), 4.0f * unit(rng));
+    init.velocity = resting ? Eigen::Vector3f(unit(rng), 0.0f, unit(rng))
+                            : Eigen::Vector3f(unit(rng), -5.0f + unit(rng), unit(rng));
+    system->editPool().spawn(init, 0);
+  }
+  Collided out;
+  for (int tick = 0; tick < 30; ++tick) {
+    system->step();
+    out.contacts += system->colliders()->contacts();
+  }
+  out.hash = stateHash(system->pool());
+  out.paths = system->colliders()->paths();
+  return out;
+}
+
+TEST(CollisionLoop, ACollidersInlinedLoopGivesTheBitsOfTheVirtualOne) {
+  ColliderSettings unreached;  // a ball far above everything
+  unreached.type = ColliderType::Sphere;
+  unreached.radius = 1.0;
+  unreached.center = Eigen::Vector3d(0.0, 1000.0, 0.0);
+  unreached.recordHits = true;
+  for (const ColliderResponse response : {ColliderResponse::Bounce, ColliderResponse::Slide,
+                                          ColliderResponse::Stick, ColliderResponse::Kill}) {
+    ColliderSettings ground = groundPlane(response, 0.6, 0.3);
+    ground.recordHits = true;
+    ColliderSettings ball;
+    ball.type = ColliderType::Sphere;
+    ball.radius = 1.0;
+    ball.center = Eigen::Vector3d(0.5, 0.0, -0.5);
+    ball.response = response;
+    ball.restitution = 0.4;
+    ball.friction = 0.5;
+    ball.recordHits = true;
+    for (const ColliderSettings& shape : {ground, ball}) {
+      const Collided alone = collidedWith({shape}, 1);
+      // Every row meets the ground at least once; some hundreds meet the ball.
+      EXPECT_GE(alone.contacts, shape.type == ColliderType::Plane ? 12000u : 600u)
+          << static_cast<int>(response);
+      for (const int threads : {1, 2}) {
+        const Collided beside = collidedWith({shape, unreached}, threads);
+        const std::string label = std::string(colliderTypeName(shape.type)) + ", response " +
+                                  std::to_string(static_cast<int>(response)) + ", " +
+                                  std::to_string(threads) + " thread(s)";
+        EXPECT_EQ(beside.hash, alone.hash) << label;
+        EXPECT_EQ(beside.contacts, alone.contacts) << label;
+        ASSERT_EQ(beside.paths.size(), alone.paths.size()) << label;
+        for (std::size_t k = 0; k < alone.paths.size(); ++k) {
+          const CollisionPath &p = alone.paths[k], &q = beside.paths[k];
+          ASSERT_TRUE(p.id == q.id && p.contacts == q.contacts && p.start == q.start &&
+                      p.fraction == q.fraction && p.point == q.point)
+              << label << ", path " << k;
+        }
+      }
+    }
+  }
+}
+
 // A host may replace the whole pool between ticks (editPool() = a snapshot), with a pool made
 // by a system without colliders: it has no previous-position column. Paths start where each
 // block's step wrote its starts, not in that column (it used to write past a column of no rows),
