@@ -37,8 +37,8 @@ struct RowsJob {
 
 // Collider::respond(): `v` after contact `c` with a collider of this response, restitution and
 // friction (see there), inline for the contact loop.
-inline V3 respondWith(ColliderResponse response, float restitution, float friction,
-                      const Contact& c, const V3& v) {
+[[gnu::always_inline]] inline V3 respondWith(ColliderResponse response, float restitution,
+                                             float friction, const Contact& c, const V3& v) {
   const V3 u = c.surfaceVelocity;
   const V3 relative = v - u;
   const float approach = dot(relative, c.normal);

@@ -90,7 +90,8 @@ class ShapeCollider final : public Collider {
 
  private:
   // firstContact(), inline for contactRows().
-  bool contactOf(const V3& a, float fromFraction, const V3& b, Contact& out) const {
+  [[gnu::always_inline]] bool contactOf(const V3& a, float fromFraction, const V3& b,
+                                        Contact& out) const {
     V3 ra = a, rb = b;
     ColliderPose from;
     if (tick_.moving) {
