@@ -17,8 +17,8 @@
 
 namespace tickfx::collide {
 
-// One block's rows, as collideRows() prepared them: columns at the block's rows, index k the
-// row begin + k.
+// One block's rows [begin, begin + count), as collideRows() prepared them. The flags and the
+// starts are the block's (row begin + k at index k); the pool's columns are whole (row i at i).
 struct RowsJob {
   std::size_t begin = 0, count = 0;
   const std::uint8_t* flagged = nullptr;  // the screen's flags, one a row
