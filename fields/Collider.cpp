@@ -160,16 +160,9 @@ Eigen::Vector3f Collider::carried(const Contact& c) const {
 }
 
 std::uint64_t Collider::contactRows(const collide::RowsJob& job) const {
-  struct Alone {
-    const Collider* self;
-    const Collider* first(const V3& a, float from, const V3& b, Contact& out) const {
-      return self->firstContact(a, from, b, out) ? self : nullptr;
-    }
-    V3 respond(const Collider& hit, const Contact& c, const V3& v) const {
-      return hit.respond(c, v);
-    }
-  };
-  return collide::contactRows(job, Alone{this});
+  const Collider* const self[] = {this};
+  return collide::contactRows(job,
+                              collide::VirtualColliders<const Collider* const*>{self, self + 1});
 }
 
 Eigen::Vector3f Collider::respond(const Contact& c, const Eigen::Vector3f& v) const {

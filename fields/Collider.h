@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -125,7 +126,7 @@ class Collider {
   /// 1 m and the coordinates' magnitude. Every particle ends a tick with clearance() above
   /// −margin(); a contact places it at clearance() >= 0 in the collider's frame, and a particle
   /// resting on a surface lies within rounding of it, which is no contact.
-  static float margin(float scale) { return (scale > 1.0f ? scale : 1.0f) * 0x1p-20f; }
+  static float margin(float scale) { return std::max(1.0f, scale) * 0x1p-20f; }
 
   /// `v` after contact `c`: with u the surface's velocity and v_r = v − u split into its normal
   /// part v_n = (v_r · n) n and tangential part v_t, a contact approaching the surface

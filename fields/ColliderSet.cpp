@@ -1,6 +1,5 @@
 #include "fields/ColliderSet.h"
 
-#include <cstring>
 #include <stdexcept>
 
 #include "fields/ContactRows.h"
@@ -130,34 +129,17 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
   // Which rows may touch a collider: a screen over the block's columns first.
   thread_local std::vector<std::uint8_t> flags;
   flags.assign(job.count, 0);
-  const float* const starts[3] = {job.starts[0], job.starts[1], job.starts[2]};
   const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
-  for (const auto& c : colliders_) c->screen(starts, ends, job.count, flags.data());
+  for (const auto& c : colliders_) c->screen(job.starts.data(), ends, job.count, flags.data());
   job.flagged = flags.data();
-  if (colliders_.size() == 1) {
-    blockContactCounts_[block] = colliders_.front()->contactRows(job);
-    return;
-  }
-  struct Several {
-    const std::vector<std::unique_ptr<Collider>>& colliders;
-    const Collider* first(const Eigen::Vector3f& a, float from, const Eigen::Vector3f& b,
-                          Contact& best) const {
-      const Collider* hit = nullptr;
-      Contact contact;
-      for (const auto& c : colliders) {
-        if (c->firstContact(a, from, b, contact) &&
-            (hit == nullptr || contact.fraction < best.fraction)) {
-          best = contact;
-          hit = c.get();
-        }
-      }
-      return hit;
-    }
-    Eigen::Vector3f respond(const Collider& hit, const Contact& c, const Eigen::Vector3f& v) const {
-      return hit.respond(c, v);
-    }
-  };
-  blockContactCounts_[block] = collide::contactRows(job, Several{colliders_});
+  // A lone collider runs the loop its own way (a shape's test inlined); several, through their
+  // virtual calls.
+  using Several = collide::VirtualColliders<const std::unique_ptr<Collider>*>;
+  blockContactCounts_[block] =
+      colliders_.size() == 1
+          ? colliders_.front()->contactRows(job)
+          : collide::contactRows(job,
+                                 Several{colliders_.data(), colliders_.data() + colliders_.size()});
 }
 
 void ColliderSet::endTick() {

@@ -130,6 +130,29 @@ int contactRow(const RowsJob& job, std::size_t k, const Colliders& colliders) {
   return path.contacts;
 }
 
+// The colliders [begin, end) through their virtual calls, as contactRow() takes them: a path's
+// earliest contact among them (an earlier collider winning a tie), answered by the collider hit.
+// `Iterator` dereferences to a pointer to a Collider (raw or owning).
+template <class Iterator>
+struct VirtualColliders {
+  Iterator begin, end;
+
+  const Collider* first(const V3& a, float from, const V3& b, Contact& best) const {
+    const Collider* hit = nullptr;
+    Contact contact;
+    for (Iterator c = begin; c != end; ++c) {
+      const Collider& collider = **c;
+      if (collider.firstContact(a, from, b, contact) &&
+          (hit == nullptr || contact.fraction < best.fraction)) {
+        best = contact;
+        hit = &collider;
+      }
+    }
+    return hit;
+  }
+  V3 respond(const Collider& hit, const Contact& c, const V3& v) const { return hit.respond(c, v); }
+};
+
 // contactRow() for every flagged row of the block, in row order; returns the contacts made.
 template <class Colliders>
 std::uint64_t contactRows(const RowsJob& job, const Colliders& colliders) {
