@@ -325,19 +325,15 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
   return true;
 }
 
-// The points grouped by leaf, as the leaves will hold them but for the order within a leaf: the
-// leaves in Coord order (ascending, as Coord's operator< orders them), a leaf's points in row
-// order within each of its voxels. Each point's values are copied here in that order (a stable
-// scatter by leaf writes few streams at once, where reading the rows in the grid's order would
-// miss the cache on every value), so that a leaf reads its points from one stretch of memory.
-// `local` orders each leaf's points by voxel, keeping their order within a voxel: the leaf's
-// array holds first its point local[start], then local[start + 1], ... (offsets in its stretch).
+// The points in the order the leaves' arrays hold them: the leaves in Coord order (ascending, as
+// Coord's operator< orders them), a leaf's points by voxel, and in row order within a voxel. Each
+// point's values are copied here in that order, so that a leaf's array is one stretch of each
+// column, written to the file as it is.
 struct GroupedPoints {
   std::vector<std::size_t> starts;  // each leaf's first point, and the end
   std::vector<openvdb::Coord> origins;
   // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
-  LargeArray<std::uint16_t> voxel;  // a point's voxel in its leaf (0 to 511)
-  LargeArray<std::uint32_t> local;
+  LargeArray<std::uint16_t> voxel;    // a point's voxel in its leaf (0 to 511)
   LargeArray<openvdb::Vec3f> offset;  // its position's offset in the voxel
   LargeArray<std::uint64_t> id;
   // velocity x, y, z, age, life, mass, then the frame's attributes (pointFloatColumns' order)
@@ -345,33 +341,12 @@ struct GroupedPoints {
 
   GroupedPoints(std::size_t n, std::size_t floatColumnCount)
       : voxel(allocateLargeArray<std::uint16_t>(n)),
-        local(allocateLargeArray<std::uint32_t>(n)),
         offset(allocateLargeArray<openvdb::Vec3f>(n)),
         id(allocateLargeArray<std::uint64_t>(n)) {
     for (std::size_t j = 0; j < floatColumnCount; ++j)
       columns.push_back(allocateLargeArray<float>(n));
   }
 };
-
-// Each leaf's `local` order: its points by voxel, their order kept within a voxel (a counting sort
-// of the leaf's voxels).
-void orderByVoxel(GroupedPoints& points) {
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.origins.size()),
-                    [&](const tbb::blocked_range<std::size_t>& leaves) {
-                      for (std::size_t l = leaves.begin(); l < leaves.end(); ++l) {
-                        const std::size_t begin = points.starts[l];
-                        const std::size_t count = points.starts[l + 1] - begin;
-                        const std::uint16_t* voxel = points.voxel.get() + begin;
-                        std::array<std::uint32_t, Leaf::SIZE> next{};
-                        for (std::size_t k = 0; k < count; ++k) ++next[voxel[k]];
-                        std::uint32_t sum = 0;
-                        for (std::uint32_t& n : next) sum += std::exchange(n, sum);
-                        std::uint32_t* local = points.local.get() + begin;
-                        for (std::size_t k = 0; k < count; ++k)
-                          local[next[voxel[k]]++] = static_cast<std::uint32_t>(k);
-                      }
-                    });
-}
 
 constexpr std::size_t kStandardFloatColumns = 6;  // velocity x, y, z, age, life, mass
 
@@ -409,7 +384,6 @@ GroupedPoints sortedPoints(const FrameData& frame) {
     }
   }
   points.starts.push_back(slots.size());
-  orderByVoxel(points);  // (the identity: the slots are sorted by voxel)
   return points;
 }
 
@@ -461,10 +435,86 @@ bool extendBounds(const float* x, std::size_t begin, std::size_t end, float& low
   return beyond;
 }
 
+// Consecutive leaves gathered for the counting sort: at most kBucketLeaves leaves and, unless a
+// leaf alone holds more, kBucketPoints points. Rows are first scattered by bucket (a few hundred
+// streams at 10⁶ points, where a scatter by leaf wrote thousands and missed the cache on nearly
+// every value), each bucket's rows in row order; then each bucket, small enough for the cache,
+// is put in order by leaf and voxel.
+constexpr std::size_t kBucketPoints = 8192;
+constexpr std::uint32_t kBucketLeaves = 16;
+constexpr unsigned kVoxelBits = 3 * Leaf::LOG2DIM;  // a voxel's index in its leaf
+static_assert(std::size_t{1} << kVoxelBits == Leaf::SIZE);
+static_assert((kBucketLeaves << kVoxelBits) - 1 <= std::numeric_limits<std::uint16_t>::max(),
+              "a point's key in its bucket (leaf, voxel) fits the voxel column's 16 bits");
+
+// The buckets of leaves whose points start at `starts` (and end at its last entry): first[b] is
+// bucket b's first leaf (first[count()] the number of leaves), of[l] the bucket of leaf l.
+struct Buckets {
+  std::vector<std::uint32_t> first, of;
+
+  explicit Buckets(const std::vector<std::size_t>& starts) : of(starts.size() - 1) {
+    std::size_t points = 0;
+    for (std::uint32_t l = 0; l < of.size(); ++l) {
+      const std::size_t count = starts[l + 1] - starts[l];
+      if (first.empty() || l - first.back() >= kBucketLeaves ||
+          (points > 0 && points + count > kBucketPoints)) {
+        first.push_back(l);
+        points = 0;
+      }
+      of[l] = static_cast<std::uint32_t>(first.size() - 1);
+      points += count;
+    }
+    first.push_back(static_cast<std::uint32_t>(of.size()));
+  }
+  std::size_t count() const { return first.size() - 1; }
+};
+
+// What orderBucket() reuses from one bucket to the next.
+struct BucketScratch {
+  std::vector<std::uint32_t> counts, rank;
+  std::vector<std::uint16_t> keys;
+  std::vector<openvdb::Vec3f> vectors;
+  std::vector<std::uint64_t> ids;
+  std::vector<float> floats;
+};
+
+// column[rank[i]] = column[i] for i < count, through a copy.
+template <typename T>
+void permute(T* __restrict column, const std::uint32_t* __restrict rank, std::size_t count,
+             std::vector<T>& copy) {
+  copy.assign(column, column + count);
+  for (std::size_t i = 0; i < count; ++i) column[rank[i]] = copy[i];
+}
+
+// Puts points [begin, end), a bucket of `leaves` leaves in row order whose voxel column holds
+// each point's key (its leaf's place in the bucket, then its voxel), in order by key, rows in
+// order among equal keys (a counting sort), every column moved alike; the voxel column then
+// holds each point's voxel.
+void orderBucket(GroupedPoints& points, std::size_t begin, std::size_t end, std::size_t leaves,
+                 BucketScratch& scratch) {
+  const std::size_t count = end - begin;
+  std::uint16_t* const key = points.voxel.get() + begin;
+  scratch.counts.assign(leaves << kVoxelBits, 0);
+  for (std::size_t i = 0; i < count; ++i) ++scratch.counts[key[i]];
+  std::uint32_t sum = 0;
+  for (std::uint32_t& c : scratch.counts) sum += std::exchange(c, sum);
+  scratch.rank.resize(count);
+  for (std::size_t i = 0; i < count; ++i) scratch.rank[i] = scratch.counts[key[i]]++;
+  const std::uint32_t* const rank = scratch.rank.data();
+  scratch.keys.assign(key, key + count);
+  for (std::size_t i = 0; i < count; ++i)
+    key[rank[i]] = static_cast<std::uint16_t>(scratch.keys[i] & (Leaf::SIZE - 1));
+  permute(points.offset.get() + begin, rank, count, scratch.vectors);
+  permute(points.id.get() + begin, rank, count, scratch.ids);
+  for (LargeArray<float>& column : points.columns)
+    permute(column.get() + begin, rank, count, scratch.floats);
+}
+
 // The fast way, when the leaves' bounding box holds few enough leaves to count them in a table
 // (any effect of sane size): a stable counting sort of the rows by the leaf's index in the box
-// (x, then y, then z: Coord's order), so rows ascend within each leaf. The chunks are fixed by
-// the point count alone (the order depends on neither them nor the threads). Nothing otherwise.
+// (x, then y, then z: Coord's order), in two steps: by bucket of leaves, then within each bucket
+// by leaf and voxel (Buckets, orderBucket). The chunks are fixed by the point count alone (the
+// order depends on neither them nor the threads). Nothing otherwise.
 template <bool Quantised>
 std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   const std::size_t n = frame.size();
@@ -565,18 +615,17 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
   const std::vector<const float*> source = pointFloatColumns(frame);
   GroupedPoints points(n, source.size());
-  // Where each chunk's rows of a leaf go: leaf by leaf, chunk by chunk.
-  std::uint32_t sum = 0;
+  // The leaves that hold points, in order (each one's first point and origin), and the buckets.
+  std::vector<std::uint32_t> ordinalOf(leaves), boxOf;
+  std::size_t sum = 0;
   for (std::size_t l = 0; l < leaves; ++l) {
-    const std::uint32_t first = sum;
-    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
-      std::uint32_t& entry = table[chunk * leaves + l];
-      const std::uint32_t count = entry;
-      entry = sum;
-      sum += count;
-    }
-    if (sum == first) continue;
-    points.starts.push_back(first);
+    std::size_t total = 0;
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) total += table[chunk * leaves + l];
+    if (total == 0) continue;
+    ordinalOf[l] = static_cast<std::uint32_t>(boxOf.size());
+    boxOf.push_back(static_cast<std::uint32_t>(l));
+    points.starts.push_back(sum);
+    sum += total;
     const std::uint64_t z = l % extent[2], y = (l / extent[2]) % extent[1],
                         x = l / (extent[2] * extent[1]);
     points.origins.push_back(box.first +
@@ -585,39 +634,63 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                                             static_cast<openvdb::Int32>(z << kLeafLog2)));
   }
   points.starts.push_back(n);
-  // Each row's place (read in row order, written to one stretch a leaf), then its values, one
-  // column at a time over a run of chunks: a column's writes go to one line a leaf at a time,
-  // which stay in cache from one chunk to the next (all the columns of a chunk at once would
-  // evict each other's lines before they fill).
+  const Buckets buckets(points.starts);
+  // Where each chunk's rows of a bucket go: bucket by bucket, chunk by chunk.
+  const std::size_t bucketCount = buckets.count();
+  std::vector<std::uint32_t> next(chunks * bucketCount);
+  for (std::size_t b = 0; b < bucketCount; ++b) {
+    auto at = static_cast<std::uint32_t>(points.starts[buckets.first[b]]);
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      next[chunk * bucketCount + b] = at;
+      for (std::uint32_t o = buckets.first[b]; o < buckets.first[b + 1]; ++o)
+        at += table[chunk * leaves + boxOf[o]];
+    }
+  }
+  // Each row's place in its bucket (rows in order within a bucket) and its key there, the place
+  // of its leaf in the bucket and its voxel, then its values, one column at a time over a run of
+  // chunks: a column's writes go to one line a bucket at a time, which stay in cache from one
+  // chunk to the next (all the columns of a chunk at once would evict each other's lines).
   par::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
                     [&](const tbb::blocked_range<std::size_t>& run) {
-                      const std::size_t runBegin = chunkRange(run.begin()).first;
-                      const std::size_t runEnd = chunkRange(run.end() - 1).second;
-                      for (std::size_t chunk = run.begin(); chunk < run.end(); ++chunk) {
-                        std::uint32_t* next = table.data() + chunk * leaves;
-                        const auto [begin, end] = chunkRange(chunk);
-                        for (std::size_t i = begin; i < end; ++i) rowAt[i] = next[rowAt[i]]++;
-                      }
-                      const std::uint32_t* const at = rowAt.get();
-                      std::uint16_t* const __restrict voxel = points.voxel.get();
+                      std::uint32_t* const at = rowAt.get();
+                      std::uint16_t* const __restrict key = points.voxel.get();
                       openvdb::Vec3f* const __restrict offset = points.offset.get();
                       PlacedRows placed;
-                      for (std::size_t first = runBegin; first < runEnd; first += kPlacedRows) {
-                        const std::size_t rows = std::min(kPlacedRows, runEnd - first);
-                        placeRows<Quantised>(positions, first, rows, placed);
-                        for (std::size_t k = 0; k < rows; ++k) {
-                          const std::uint32_t to = at[first + k];
-                          voxel[to] =
-                              static_cast<std::uint16_t>(Leaf::coordToOffset(placed.voxel(k)));
-                          offset[to] = openvdb::Vec3f(placed.offset[0][k], placed.offset[1][k],
-                                                      placed.offset[2][k]);
+                      for (std::size_t chunk = run.begin(); chunk < run.end(); ++chunk) {
+                        std::uint32_t* const chunkNext = next.data() + chunk * bucketCount;
+                        const auto [begin, end] = chunkRange(chunk);
+                        for (std::size_t first = begin; first < end; first += kPlacedRows) {
+                          const std::size_t rows = std::min(kPlacedRows, end - first);
+                          placeRows<Quantised>(positions, first, rows, placed);
+                          for (std::size_t k = 0; k < rows; ++k) {
+                            const std::uint32_t o = ordinalOf[at[first + k]];
+                            const std::uint32_t b = buckets.of[o];
+                            const std::uint32_t to = chunkNext[b]++;
+                            at[first + k] = to;
+                            key[to] = static_cast<std::uint16_t>(
+                                ((o - buckets.first[b]) << kVoxelBits) |
+                                static_cast<std::uint32_t>(Leaf::coordToOffset(placed.voxel(k))));
+                            offset[to] = openvdb::Vec3f(placed.offset[0][k], placed.offset[1][k],
+                                                        placed.offset[2][k]);
+                          }
                         }
                       }
+                      const std::size_t runBegin = chunkRange(run.begin()).first;
+                      const std::size_t runEnd = chunkRange(run.end() - 1).second;
                       scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
                       for (std::size_t j = 0; j < source.size(); ++j)
                         scatter(source[j], at, runBegin, runEnd, points.columns[j].get());
                     });
-  orderByVoxel(points);
+  // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, bucketCount),
+                    [&](const tbb::blocked_range<std::size_t>& some) {
+                      BucketScratch scratch;
+                      for (std::size_t b = some.begin(); b < some.end(); ++b) {
+                        orderBucket(points, points.starts[buckets.first[b]],
+                                    points.starts[buckets.first[b + 1]],
+                                    buckets.first[b + 1] - buckets.first[b], scratch);
+                      }
+                    });
   return points;
 }
 
@@ -720,35 +793,33 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
   using Kind = GridAttribute::Kind;
   const std::size_t begin = points.starts[l];
   const std::size_t count = points.starts[l + 1] - begin;
-  const std::uint32_t* local = points.local.get() + begin;
   const auto column = [&](std::size_t j) { return points.columns[a.column + j].get() + begin; };
   switch (a.kind) {
     case Kind::Position: {
       const openvdb::Vec3f* offset = points.offset.get() + begin;
-      for (std::size_t k = 0; k < count; ++k) set(k, offset[local[k]]);
+      for (std::size_t k = 0; k < count; ++k) set(k, offset[k]);
       return;
     }
     case Kind::Vector: {
       const float *x = column(0), *y = column(1), *z = column(2);
       for (std::size_t k = 0; k < count; ++k) {
-        const std::uint32_t i = local[k];
-        set(k, openvdb::Vec3f(x[i], y[i], z[i]));
+        set(k, openvdb::Vec3f(x[k], y[k], z[k]));
       }
       return;
     }
     case Kind::Id: {
       const std::uint64_t* id = points.id.get() + begin;
-      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int64_t>(id[local[k]]));
+      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int64_t>(id[k]));
       return;
     }
     case Kind::Int: {
       const float* x = column(0);
-      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[local[k]]));
+      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[k]));
       return;
     }
     case Kind::Float: {
       const float* x = column(0);
-      for (std::size_t k = 0; k < count; ++k) set(k, x[local[k]]);
+      for (std::size_t k = 0; k < count; ++k) set(k, x[k]);
       return;
     }
   }
