@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ios>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -337,16 +338,47 @@ struct RangeBytes {
   std::size_t ends[3] = {};
 };
 
+// Pass a+2's record of a leaf (LeafNode::writeBuffers(), with OpenVDB's writeCompressedValues()
+// for PointDataIndex32): the value mask, the 16-bit size of the blosc-compressed voxel offsets
+// (kUncompressed when blosc did not make them smaller: the offsets follow whole), the bytes.
+constexpr std::size_t kValueMaskBytes = sizeof(Leaf::NodeMaskType);
+constexpr std::uint16_t kUncompressed = std::numeric_limits<std::uint16_t>::max();
+constexpr std::size_t kVoxelOffsetBytes = Leaf::SIZE * sizeof(openvdb::PointDataIndex32);
+
 // Writes the parts of leaves [begin, end) into `range`, each by the call that
-// PointDataLeafNode::writeBuffers() makes in its pass.
+// PointDataLeafNode::writeBuffers() makes in its pass; but for pass 0, each leaf's 16-bit size of
+// its compressed voxel offsets, which writeCompressedValuesSize() finds by compressing them as
+// pass a+2 does: here it is read from pass a+2's record, made first, so each leaf's offsets are
+// compressed once. (Where pass a+2 kept them whole, OpenVDB's own call writes the size.)
 void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
                      const openvdb::io::StreamMetadata& metadata, bool toHalf, RangeBytes& range) {
   const std::vector<const Leaf*>& leaves = all.leaf;
-  range.sink = std::make_unique<MemorySink>((end - begin) * (2 * 1024 + 128) + 4096);
+  MemorySink voxels((end - begin) * (kValueMaskBytes + 2 + 1024) + 4096);
+  std::vector<std::uint16_t> sizes;
+  {
+    LeafStream stream(&voxels, metadata);
+    for (std::size_t l = begin; l < end; ++l) {
+      const std::size_t at = voxels.size();
+      static_cast<const Leaf::BaseLeaf&>(*leaves[l]).writeBuffers(stream.out(), toHalf);
+      std::uint16_t size = 0;
+      if (voxels.size() >= at + kValueMaskBytes + sizeof size)
+        std::memcpy(&size, voxels.data() + at + kValueMaskBytes, sizeof size);
+      const std::size_t bytes = size == kUncompressed ? kVoxelOffsetBytes : size;
+      if (!stream.out() || voxels.size() != at + kValueMaskBytes + sizeof size + bytes)
+        throw std::logic_error("VDB points: a leaf's voxel offsets are not laid out as foreseen");
+      sizes.push_back(size);
+    }
+  }
+  range.sink = std::make_unique<MemorySink>((end - begin) * (2 + 128) + voxels.size() + 4096);
   LeafStream stream(range.sink.get(), metadata);
   std::ostream& out = stream.out();
-  for (std::size_t l = begin; l < end; ++l)
-    openvdb::io::writeCompressedValuesSize(out, leaves[l]->buffer().data(), Leaf::SIZE);
+  for (std::size_t l = begin; l < end; ++l) {
+    const std::uint16_t size = sizes[l - begin];
+    if (size != kUncompressed)
+      out.write(reinterpret_cast<const char*>(&size), sizeof size);
+    else
+      openvdb::io::writeCompressedValuesSize(out, leaves[l]->buffer().data(), Leaf::SIZE);
+  }
   range.ends[0] = range.sink->size();
   for (std::size_t l = begin; l < end; ++l) {
     const vdbp::AttributeSet& set = leaves[l]->attributeSet();
@@ -362,8 +394,7 @@ void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
     }
   }
   range.ends[1] = range.sink->size();
-  for (std::size_t l = begin; l < end; ++l)
-    static_cast<const Leaf::BaseLeaf&>(*leaves[l]).writeBuffers(out, toHalf);
+  out.write(voxels.data(), static_cast<std::streamsize>(voxels.size()));
   range.ends[2] = range.sink->size();
   if (!out) throw std::runtime_error("cannot encode the VDB points' leaves");
 }
