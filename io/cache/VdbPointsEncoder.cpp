@@ -531,6 +531,9 @@ void encodePage(const Leaves& all, Page& page) {
   }
 }
 
+// A leaf without arrays: a default attribute set (encodePointsFile's `values`).
+bool isPlaceholderless(const Leaf& leaf) { return leaf.attributeSet().size() == 0; }
+
 // Whether the leaves can be encoded apart: every leaf with the same descriptor (so one is
 // written, and every leaf has as many passes), every array in memory and whole (the serial writer
 // would load or refuse it; here its bytes are read directly).
@@ -568,13 +571,15 @@ void describePlaceholders(Leaves& all, const openvdb::io::StreamMetadata& metada
       throw std::logic_error("VDB points: a placeholder array with a stride");
     all.storage.push_back(array.storageTypeSize());
   }
-  for (std::size_t l = 0; l < all.size(); ++l) {
-    const vdbp::AttributeSet& leafSet = all.leaf[l]->attributeSet();
-    for (std::size_t a = 0; a < leafSet.size(); ++a) {
-      const vdbp::AttributeArray& array = *leafSet.getConst(a);
-      if (!array.isUniform() || array.isTransient() || array.size() != all.points(l))
-        throw std::logic_error("VDB points: an array is not a placeholder of its leaf's points");
-    }
+  for (std::size_t a = 0; a < set.size(); ++a) {
+    const vdbp::AttributeArray& array = *set.getConst(a);
+    if (!array.isUniform() || array.isTransient() || array.size() != all.points(0) ||
+        !array.isDataLoaded())
+      throw std::logic_error("VDB points: an array is not a placeholder of its leaf's points");
+  }
+  for (std::size_t l = 1; l < all.size(); ++l) {
+    if (!isPlaceholderless(*all.leaf[l]))
+      throw std::logic_error("VDB points: a leaf past the first with arrays of its own");
   }
   for (std::size_t a = 0; a < set.size(); ++a)
     all.metadata.push_back(metadataTemplate(all, a, metadata));
@@ -594,7 +599,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
   leaves.reserve(tree.leafCount());
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
   if (leaves.empty()) return false;
-  if (sink == nullptr || !splittable(leaves)) {
+  if (sink == nullptr || (values == nullptr && !splittable(leaves))) {
     if (values == nullptr) return false;
     throw std::logic_error("VDB points: placeholder arrays that cannot be encoded in parallel");
   }
@@ -687,13 +692,18 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
   ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues* values)
       : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()), values_(values) {
     if (values_ == nullptr) return;
-    for (auto leaf = constTree().cbeginLeaf(); leaf; ++leaf) {
-      const vdbp::AttributeSet& set = leaf->attributeSet();
-      for (std::size_t a = 0; a < set.size(); ++a) {
-        const vdbp::AttributeArray& array = *set.getConst(a);
-        if (array.isUniform() && array.size() > 0)
-          expandedExtra_ += (std::size_t{array.size()} - 1) * array.storageTypeSize();
-      }
+    // Each leaf past the first lacks the first's attribute set but for its arrays' sizes; each
+    // array, expanded, holds its leaf's point count of values where a placeholder holds one.
+    auto leaf = constTree().cbeginLeaf();
+    if (!leaf) return;
+    const vdbp::AttributeSet& set = leaf->attributeSet();
+    std::size_t bytesPerPoint = 0;
+    for (std::size_t a = 0; a < set.size(); ++a)
+      bytesPerPoint += set.getConst(a)->storageTypeSize();
+    const std::size_t setBytes = set.memUsage() - vdbp::AttributeSet().memUsage();
+    for (bool first = true; leaf; ++leaf, first = false) {
+      if (!first) expandedExtra_ += setBytes;
+      if (leaf->pointCount() > 0) expandedExtra_ += (leaf->pointCount() - 1) * bytesPerPoint;
     }
   }
   void writeBuffers(std::ostream& os) const override {

@@ -78,10 +78,12 @@ LargeArray<T> allocateLargeArray(std::size_t n) {
 /// depend on the thread count. A grid this cannot split (leaves whose attributes differ, arrays
 /// not in memory) or without a leaf is written by OpenVDB alone, to the same bytes.
 /// `expectedBytes`: the room reserved for the header, metadata and topology.
-/// With `values`, every leaf's arrays are placeholders: uniform, of the leaf's point count, stride
-/// 1, in memory. The file is then the one the grid would give with each array expanded to hold
-/// the values `values` stores (its metadata, the file's memory statistics and the arrays'
-/// bytes), and the values go from `values` straight into the file's bytes. Such a grid is never
+/// With `values`, the first leaf's arrays are placeholders (uniform, of the leaf's point count,
+/// stride 1, in memory) and every other leaf has none (a default attribute set: it stands for
+/// the first leaf's set with its own point count). The file is then the one the grid would give
+/// with every leaf holding the first's attributes, each array expanded to hold the values
+/// `values` stores (its metadata, the file's memory statistics and the arrays' bytes), and the
+/// values go from `values` straight into the file's bytes. Such a grid is never
 /// handed to OpenVDB's own writer: a grid the encoder cannot split throws std::logic_error.
 FileBytes encodePointsFile(openvdb::points::PointDataGrid& grid, std::uint32_t compression,
                            const PointValues* values = nullptr,

@@ -251,6 +251,20 @@ TEST_F(ioVdbWriter, KeptBuffersGiveEachFramesOwnBytes) {
   }
 }
 
+// Leaves in several of the tree's top nodes (4096 m apart), whose order in the tree is not the
+// leaves' Coord order: the attributes' placeholders go on the tree's first leaf, and the others,
+// which hold none, still count every attribute in the file's memory statistics.
+TEST_F(ioVdbWriter, LeavesFarApartGiveOpenVdbsBytes) {
+  FrameData frame = frameOf(20000, 40.0f);
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(frame.size()); ++i) {
+    const float shift = i % 3 == 0 ? 0.0f : i % 3 == 1 ? 5000.0f : -9000.0f;
+    frame.position[0][i] -= shift;
+    frame.position[1][i] += shift;
+  }
+  for (const VdbCacheOptions& options : {kDefault, kFixed16Blosc})
+    expectSameBytesAsOpenVdb(frame, options);
+}
+
 // 2·10⁵ of 2.2·10⁵ points in one 8 m leaf, the others over an 80 m box: that leaf's P, v and id
 // arrays are larger than a page (pages of their own, closing the page before them), its float
 // arrays fill most of one, in both position encodings; without blosc, they are stored into place
