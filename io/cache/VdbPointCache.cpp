@@ -504,9 +504,8 @@ void orderBucket(GroupedPoints& points, std::size_t begin, std::size_t end, std:
   scratch.rank.resize(count);
   for (std::size_t i = 0; i < count; ++i) scratch.rank[i] = scratch.counts[key[i]]++;
   const std::uint32_t* const rank = scratch.rank.data();
-  scratch.keys.assign(key, key + count);
-  for (std::size_t i = 0; i < count; ++i)
-    key[rank[i]] = static_cast<std::uint16_t>(scratch.keys[i] & (Leaf::SIZE - 1));
+  permute(key, rank, count, scratch.keys);
+  for (std::size_t i = 0; i < count; ++i) key[i] &= Leaf::SIZE - 1;  // the voxel alone
   permute(points.offset.get() + begin, rank, count, scratch.vectors);
   permute(points.id.get() + begin, rank, count, scratch.ids);
   for (LargeArray<float>& column : points.columns)
@@ -776,23 +775,22 @@ void setVoxelEnds(const GroupedPoints& points, std::size_t l, Leaf& leaf) {
   leaf.setValueMask(mask);
 }
 
-// Leaf l with its voxel values and, unless `arrays` is false, an attribute set of its point
-// count, each array uniform (the placeholders encodePointsFile takes, or to be expanded and
-// filled). Without, the leaf keeps its default attribute set: encodePointsFile takes
+// Leaf l with its voxel values, and its default attribute set: encodePointsFile takes
 // placeholders on the tree's first leaf alone, some ten thousand arrays fewer to make and free
 // at 10⁶ points.
-std::unique_ptr<Leaf> makeEmptyLeaf(const GroupedPoints& points, std::size_t l,
-                                    const vdbp::AttributeSet::Descriptor::Ptr& descriptor,
-                                    bool arrays = true) {
-  const auto count = static_cast<openvdb::Index>(points.starts[l + 1] - points.starts[l]);
+std::unique_ptr<Leaf> makeEmptyLeaf(const GroupedPoints& points, std::size_t l) {
   auto leaf = std::make_unique<Leaf>(points.origins[l]);
-  // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
-  if (arrays) {
-    leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, count),
-                              /*allowMismatchingDescriptors=*/true);
-  }
   setVoxelEnds(points, l, *leaf);
   return leaf;
+}
+
+// Gives `leaf` an attribute set of its point count, each array uniform: the placeholders
+// encodePointsFile takes, or arrays to be expanded and filled.
+void addUniformArrays(Leaf& leaf, const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
+  // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
+  leaf.replaceAttributeSet(
+      new vdbp::AttributeSet(descriptor, static_cast<openvdb::Index>(leaf.pointCount())),
+      /*allowMismatchingDescriptors=*/true);
 }
 
 // Calls set(k, value) for each point k of leaf l in its array's order, with the value attribute
@@ -849,7 +847,8 @@ template <typename PositionArray>
 std::unique_ptr<Leaf> makeLeaf(const std::vector<GridAttribute>& attributes,
                                const GroupedPoints& points, std::size_t l,
                                const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
-  std::unique_ptr<Leaf> leaf = makeEmptyLeaf(points, l, descriptor);
+  std::unique_ptr<Leaf> leaf = makeEmptyLeaf(points, l);
+  addUniformArrays(*leaf, descriptor);
   for (std::size_t pos = 0; pos < attributes.size(); ++pos) {
     const auto fill = [&]<typename Array>(Array& array) {
       eachValue(points, l, attributes[pos], [&](std::size_t k, const auto& value) {
@@ -960,16 +959,10 @@ FileBytes encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
   const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
   std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
   const auto descriptor = gridDescriptor<PositionArray>(attributes);
-  auto tree = makeTree(points, [&](std::size_t l) {
-    return makeEmptyLeaf(points, l, descriptor, /*arrays=*/false);
-  });
+  auto tree = makeTree(points, [&](std::size_t l) { return makeEmptyLeaf(points, l); });
   // The placeholders, on the tree's first leaf (the tree's order is not the leaves' Coord order
   // where they lie far apart).
-  if (auto first = tree->beginLeaf()) {
-    first->replaceAttributeSet(
-        new vdbp::AttributeSet(descriptor, static_cast<openvdb::Index>(first->pointCount())),
-        /*allowMismatchingDescriptors=*/true);
-  }
+  if (auto first = tree->beginLeaf()) addUniformArrays(*first, descriptor);
   const vdbp::PointDataGrid::Ptr grid = makeGrid(tree, frame, meta);
   const GroupedValues<PositionArray> values(points, std::move(attributes));
   return encodePointsFile(*grid, compressionFlags(options), &values);

@@ -701,10 +701,11 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
     for (std::size_t a = 0; a < set.size(); ++a)
       bytesPerPoint += set.getConst(a)->storageTypeSize();
     const std::size_t setBytes = set.memUsage() - vdbp::AttributeSet().memUsage();
-    for (bool first = true; leaf; ++leaf, first = false) {
-      if (!first) expandedExtra_ += setBytes;
+    std::size_t leaves = 0;
+    for (; leaf; ++leaf, ++leaves) {
       if (leaf->pointCount() > 0) expandedExtra_ += (leaf->pointCount() - 1) * bytesPerPoint;
     }
+    expandedExtra_ += (leaves - 1) * setBytes;
   }
   void writeBuffers(std::ostream& os) const override {
     if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), values_, os))
