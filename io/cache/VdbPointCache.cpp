@@ -951,11 +951,12 @@ vdbp::PointDataGrid::Ptr makeGrid(const vdbp::PointDataTree::Ptr& tree, const Fr
 
 std::uint32_t compressionFlags(const VdbCacheOptions& options);
 
-// The file's bytes, but for the UUID: the grid's leaves hold placeholders, and the values go from
-// the grouped points straight into the bytes (encodePointsFile's PointValues).
-template <typename PositionArray>
-FileBytes encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
-                      const VdbCacheOptions& options, Grouping grouping) {
+// The file, but for the UUID, handed to use(file) while what it is made from lives: the grid's
+// leaves hold placeholders, and the values go from the grouped points straight into the bytes
+// (encodePointsFile's PointValues) as the file is written (EncodedPointsFile).
+template <typename PositionArray, typename Use>
+void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
+                 const VdbCacheOptions& options, Grouping grouping, const Use& use) {
   const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
   std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
   const auto descriptor = gridDescriptor<PositionArray>(attributes);
@@ -965,7 +966,8 @@ FileBytes encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
   if (auto first = tree->beginLeaf()) addUniformArrays(*first, descriptor);
   const vdbp::PointDataGrid::Ptr grid = makeGrid(tree, frame, meta);
   const GroupedValues<PositionArray> values(points, std::move(attributes));
-  return encodePointsFile(*grid, compressionFlags(options), &values);
+  EncodedPointsFile file = encodePointsFileDeferred(*grid, compressionFlags(options), &values);
+  use(file);
 }
 
 // The grid with every array filled, as OpenVDB's own writer takes it.
@@ -982,12 +984,14 @@ vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetada
                   frame, meta);
 }
 
-FileBytes encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
-                      const VdbCacheOptions& options, Grouping grouping = Grouping::Any) {
+template <typename Use>
+void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
+                 const VdbCacheOptions& options, Grouping grouping, const Use& use) {
   checkColumns(frame);
-  return options.positions == VdbCacheOptions::Positions::Fixed16
-             ? encodeFrame<QuantisedPositionArray>(frame, meta, options, grouping)
-             : encodeFrame<PositionArray>(frame, meta, options, grouping);
+  if (options.positions == VdbCacheOptions::Positions::Fixed16)
+    encodeFrame<QuantisedPositionArray>(frame, meta, options, grouping, use);
+  else
+    encodeFrame<PositionArray>(frame, meta, options, grouping, use);
 }
 
 vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetadata& meta,
@@ -1085,14 +1089,11 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
                         const std::filesystem::path& path, const VdbCacheOptions& options,
                         Durability durability) {
   openvdb::initialize();
-  FileBytes bytes = encodeFrame(frame, meta, options);
-  stampUuid(std::span<char>(bytes.data(), bytes.size()), meta, frame.frame);
-  writeFileAtomically(
-      path,
-      [&](std::ostream& out) {
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-      },
-      durability);
+  encodeFrame(frame, meta, options, Grouping::Any, [&](EncodedPointsFile& file) {
+    stampUuid(std::span<char>(file.head(), file.headSize()), meta, frame.frame);
+    writeFileAtomically(
+        path, [&](std::ostream& out) { file.write(out); }, durability);
+  });
 }
 
 namespace detail {
@@ -1104,8 +1105,10 @@ std::string vdbPointCacheBytes(const FrameData& frame, const VdbCacheMetadata& m
   const Grouping by = grouping == VdbGrouping::Sorted ? Grouping::Sorted : Grouping::Any;
   std::string bytes;
   if (encoder == VdbEncoder::Parallel) {
-    const FileBytes encoded = encodeFrame(frame, meta, options, by);
-    bytes.assign(encoded.data(), encoded.size());
+    encodeFrame(frame, meta, options, by, [&](const EncodedPointsFile& file) {
+      const FileBytes encoded = file.bytes();
+      bytes.assign(encoded.data(), encoded.size());
+    });
   } else {
     const vdbp::PointDataGrid::Ptr grid = filledGrid(frame, meta, options, by);
     bytes =

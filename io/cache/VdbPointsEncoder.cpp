@@ -7,6 +7,8 @@
 #include <openvdb/points/StreamCompression.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -124,25 +126,30 @@ using Leaf = vdbp::PointDataTree::LeafNodeType;
 
 // An output stream buffer over memory that grows, with what Archive::write() asks of a stream:
 // writes, tellp, seekp back to patch what it wrote (a grid's offsets), seekp to the end; and
-// append(), a stretch at the end handed out to be filled by other means (several threads).
-// Unbuffered: every write goes to xsputn() or overflow(), which copy it into place.
+// skip(), a stretch at the end whose bytes are made elsewhere (the gap: at most one, not held).
+// Positions are the file's, the gap's bytes counted. Unbuffered: every write goes to xsputn()
+// or overflow(), which copy it into place.
 class MemorySink final : public std::streambuf {
  public:
   explicit MemorySink(std::size_t capacity) { grow(std::max<std::size_t>(capacity, 64)); }
 
-  /// Makes room for `n` bytes at the end (the put position must be there), moves the put
-  /// position past them and returns where they start; the caller writes them.
-  char* append(std::size_t n) {
-    if (pos_ != size_) throw std::logic_error("MemorySink::append away from the end");
-    if (size_ + n > capacity_) grow(size_ + n);
-    char* at = data_.get() + size_;
+  /// Moves the put position (which must be at the end) past `n` bytes that the sink leaves out,
+  /// and returns where they start.
+  std::size_t skip(std::size_t n) {
+    if (pos_ != size_ || gapSize_ != 0) throw std::logic_error("MemorySink::skip twice or inside");
+    gapAt_ = size_;
+    gapSize_ = n;
     size_ += n;
     pos_ = size_;
-    return at;
+    return gapAt_;
   }
+  /// The bytes held: those before the gap, then those after it.
   const char* data() const { return data_.get(); }
+  std::size_t held() const { return size_ - gapSize_; }
+  /// The file's size, the gap's bytes counted.
   std::size_t size() const { return size_; }
-  FileBytes release() && { return FileBytes(std::move(data_), size_); }
+  std::size_t gapAt() const { return gapAt_; }
+  FileBytes release() && { return FileBytes(std::move(data_), held()); }
 
  protected:
   int_type overflow(int_type c) override {
@@ -172,15 +179,19 @@ class MemorySink final : public std::streambuf {
 
  private:
   void put(const char* s, std::size_t n) {
-    if (pos_ + n > capacity_) grow(std::max(pos_ + n, 2 * capacity_));
-    std::memcpy(data_.get() + pos_, s, n);
+    const std::size_t gapEnd = gapAt_ + gapSize_;
+    if (gapSize_ != 0 && pos_ < gapEnd && pos_ + n > gapAt_)
+      throw std::logic_error("MemorySink: a write into the gap");
+    const std::size_t at = gapSize_ != 0 && pos_ >= gapEnd ? pos_ - gapSize_ : pos_;
+    if (at + n > capacity_) grow(std::max(at + n, 2 * capacity_));
+    std::memcpy(data_.get() + at, s, n);
     pos_ += n;
     size_ = std::max(size_, pos_);
   }
   // Capacity `capacity`, keeping what is written.
   void grow(std::size_t capacity) {
     FileBytes::Storage bigger = FileBytes::allocate(capacity);
-    if (size_ > 0) std::memcpy(bigger.get(), data_.get(), size_);
+    if (held() > 0) std::memcpy(bigger.get(), data_.get(), held());
     data_ = std::move(bigger);
     capacity_ = capacity;
   }
@@ -189,6 +200,7 @@ class MemorySink final : public std::streambuf {
   std::size_t capacity_ = 0;
   std::size_t size_ = 0;
   std::size_t pos_ = 0;
+  std::size_t gapAt_ = 0, gapSize_ = 0;
 };
 
 // A stretch of bytes of the file, in memory owned elsewhere; or, where `data` is null, leaf
@@ -561,6 +573,45 @@ struct Part {
   std::size_t attribute = 0, begin = 0, end = 0;
 };
 
+// The leaves' buffers but the pass count, as parts in the file's order: each made already but
+// for the unpaged arrays, stored when fill() is called. Owns what the parts point into.
+class DeferredBuffers final : public EncodedPointsFile::Deferred {
+ public:
+  DeferredBuffers(Leaves all, openvdb::io::StreamMetadata::Ptr metadata,
+                  std::vector<RangeBytes> ranges, std::vector<std::vector<Page>> pages,
+                  std::vector<Part> parts)
+      : all_(std::move(all)),
+        metadata_(std::move(metadata)),
+        ranges_(std::move(ranges)),
+        pages_(std::move(pages)),
+        parts_(std::move(parts)),
+        offsets_(parts_.size() + 1, 0) {
+    for (std::size_t p = 0; p < parts_.size(); ++p) offsets_[p + 1] = offsets_[p] + parts_[p].size;
+  }
+  std::size_t parts() const override { return parts_.size(); }
+  std::size_t offset(std::size_t p) const override { return offsets_[p]; }
+  void fill(std::size_t begin, std::size_t end, char* to) const override {
+    for (std::size_t p = begin; p < end; ++p) {
+      const Part& part = parts_[p];
+      char* const at = to + (offsets_[p] - offsets_[begin]);
+      if (part.size == 0) continue;
+      if (part.data != nullptr) {
+        std::memcpy(at, part.data, part.size);
+      } else {
+        writeArrays(all_, part.begin, part.end, part.attribute, *metadata_, at, part.size);
+      }
+    }
+  }
+
+ private:
+  Leaves all_;
+  openvdb::io::StreamMetadata::Ptr metadata_;
+  std::vector<RangeBytes> ranges_;        // (pointed into by parts_)
+  std::vector<std::vector<Page>> pages_;  // (pointed into by parts_)
+  std::vector<Part> parts_;
+  std::vector<std::size_t> offsets_;
+};
+
 // The placeholders' sizes and metadata records (encodePointsFile's `values`).
 void describePlaceholders(Leaves& all, const openvdb::io::StreamMetadata& metadata) {
   for (const Leaf* leaf : all.leaf) all.count.push_back(leaf->pointCount());
@@ -585,13 +636,15 @@ void describePlaceholders(Leaves& all, const openvdb::io::StreamMetadata& metada
     all.metadata.push_back(metadataTemplate(all, a, metadata));
 }
 
-// Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel, and
-// returns true; or writes nothing and returns false when the tree is not splittable() (or has no
-// leaf: two bytes that OpenVDB writes as fast) or `os` does not write into a MemorySink. With
-// `values`, the tree's arrays are placeholders (encodePointsFile): a tree with leaves that this
-// cannot write throws.
+// Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel but
+// for the parts left to `deferred` (DeferredBuffers: `os` skips their bytes), and returns true;
+// or writes nothing and returns false when the tree is not splittable() (or has no leaf: two
+// bytes that OpenVDB writes as fast) or `os` does not write into a MemorySink. With `values`,
+// the tree's arrays are placeholders (encodePointsFile): a tree with leaves that this cannot
+// write throws.
 bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const PointValues* values,
-                            std::ostream& os) {
+                            std::ostream& os,
+                            std::unique_ptr<EncodedPointsFile::Deferred>& deferred) {
   auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
   Leaves all;
   all.values = values;
@@ -660,23 +713,10 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
 
   const auto passes = static_cast<std::uint16_t>(leaves.front()->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
-  // Each part's place, summed in advance, then every part written there at once.
-  std::vector<std::size_t> offsets(parts.size() + 1, 0);
-  for (std::size_t p = 0; p < parts.size(); ++p) offsets[p + 1] = offsets[p] + parts[p].size;
-  char* const to = sink->append(offsets.back());
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, parts.size(), 1),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t p = r.begin(); p < r.end(); ++p) {
-                        const Part& part = parts[p];
-                        if (part.size == 0) continue;
-                        if (part.data != nullptr) {
-                          std::memcpy(to + offsets[p], part.data, part.size);
-                        } else {
-                          writeArrays(all, part.begin, part.end, part.attribute, *metadata,
-                                      to + offsets[p], part.size);
-                        }
-                      }
-                    });
+  auto buffers = std::make_unique<DeferredBuffers>(std::move(all), metadata, std::move(rangeBytes),
+                                                   std::move(pages), std::move(parts));
+  sink->skip(buffers->offset(buffers->parts()));
+  deferred = std::move(buffers);
   return true;
 }
 
@@ -689,8 +729,9 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
 // (file_mem_bytes).
 class ParallelBuffersGrid final : public vdbp::PointDataGrid {
  public:
-  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues* values)
-      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()), values_(values) {
+  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues* values,
+                      std::unique_ptr<EncodedPointsFile::Deferred>* deferred)
+      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()), values_(values), deferred_(deferred) {
     if (values_ == nullptr) return;
     // Each leaf past the first lacks the first's attribute set but for its arrays' sizes; each
     // array, expanded, holds its leaf's point count of values where a placeholder holds one.
@@ -708,7 +749,7 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
     expandedExtra_ += (leaves - 1) * setBytes;
   }
   void writeBuffers(std::ostream& os) const override {
-    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), values_, os))
+    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), values_, os, *deferred_))
       vdbp::PointDataGrid::writeBuffers(os);
   }
   openvdb::Index64 memUsage() const override {
@@ -718,6 +759,7 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
   ParallelBuffersGrid(ParallelBuffersGrid& grid, openvdb::ShallowCopy)
       : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()),
         values_(grid.values_),
+        deferred_(grid.deferred_),
         expandedExtra_(grid.expandedExtra_) {}
   openvdb::GridBase::Ptr copyGrid() override {
     return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
@@ -729,6 +771,7 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
 
  private:
   const PointValues* values_ = nullptr;
+  std::unique_ptr<EncodedPointsFile::Deferred>* deferred_;  // where writeBuffers() leaves them
   openvdb::Index64 expandedExtra_ = 0;
 };
 
@@ -744,14 +787,111 @@ class PointsArchive final : public openvdb::io::Archive {
 
 }  // namespace
 
-FileBytes encodePointsFile(vdbp::PointDataGrid& grid, std::uint32_t compression,
-                           const PointValues* values, std::size_t expectedBytes) {
-  const openvdb::GridCPtrVec grids{std::make_shared<const ParallelBuffersGrid>(grid, values)};
+EncodedPointsFile::EncodedPointsFile(FileBytes known, std::size_t deferredAt,
+                                     std::unique_ptr<Deferred> deferred)
+    : known_(std::move(known)), at_(deferredAt), deferred_(std::move(deferred)) {
+  if (at_ > known_.size()) throw std::logic_error("EncodedPointsFile: deferred bytes past the end");
+}
+
+EncodedPointsFile::~EncodedPointsFile() = default;
+
+std::size_t EncodedPointsFile::size() const {
+  return known_.size() + (deferred_ ? deferred_->offset(deferred_->parts()) : 0);
+}
+
+FileBytes EncodedPointsFile::bytes() const {
+  FileBytes file(FileBytes::allocate(size()), size());
+  char* const to = file.data();
+  std::memcpy(to, known_.data(), at_);
+  std::size_t end = at_;
+  if (deferred_) {
+    const Deferred& d = *deferred_;
+    par::parallel_for(tbb::blocked_range<std::size_t>(0, d.parts(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        d.fill(r.begin(), r.end(), to + at_ + d.offset(r.begin()));
+                      });
+    end += d.offset(d.parts());
+  }
+  std::memcpy(to + end, known_.data() + at_, known_.size() - at_);
+  return file;
+}
+
+namespace {
+
+// The deferred bytes are written in chunks of consecutive parts of about this size (a part
+// larger is a chunk alone): small enough to stay in the cache from being made to being copied
+// by the kernel, large enough that a write() call's cost is nothing beside the copy.
+constexpr std::size_t kChunkBytes = std::size_t{512} << 10;
+
+void writeDeferred(const EncodedPointsFile::Deferred& d, std::ostream& out) {
+  std::vector<std::size_t> chunks{0};  // each chunk's first part, and the end
+  std::size_t largest = 0;
+  for (std::size_t p = 1; p <= d.parts(); ++p) {
+    if (p == d.parts() || d.offset(p + 1) - d.offset(chunks.back()) > kChunkBytes) {
+      largest = std::max(largest, d.offset(p) - d.offset(chunks.back()));
+      chunks.push_back(p);
+    }
+  }
+  // One buffer a chunk in flight, made by one thread while another writes the one before.
+  const std::size_t tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  const FileBytes::Storage room = FileBytes::allocate(tokens * largest);
+  std::vector<std::size_t> free(tokens);
+  for (std::size_t t = 0; t < tokens; ++t) free[t] = t;
+  std::mutex freeLock;
+  struct Chunk {
+    std::size_t index = 0, slot = 0;
+  };
+  std::size_t next = 0;
+  const auto take = [&](tbb::flow_control& control) {
+    if (next + 1 >= chunks.size()) {
+      control.stop();
+      return Chunk{};
+    }
+    const std::lock_guard lock(freeLock);
+    const Chunk chunk{next++, free.back()};
+    free.pop_back();
+    return chunk;
+  };
+  const auto make = [&](Chunk chunk) {
+    d.fill(chunks[chunk.index], chunks[chunk.index + 1], room.get() + chunk.slot * largest);
+    return chunk;
+  };
+  const auto put = [&](Chunk chunk) {
+    const std::size_t size = d.offset(chunks[chunk.index + 1]) - d.offset(chunks[chunk.index]);
+    if (out) out.write(room.get() + chunk.slot * largest, static_cast<std::streamsize>(size));
+    const std::lock_guard lock(freeLock);
+    free.push_back(chunk.slot);
+  };
+  par::parallel_pipeline(tokens,
+                         tbb::make_filter<void, Chunk>(tbb::filter_mode::serial_in_order, take) &
+                             tbb::make_filter<Chunk, Chunk>(tbb::filter_mode::parallel, make) &
+                             tbb::make_filter<Chunk, void>(tbb::filter_mode::serial_in_order, put));
+}
+
+}  // namespace
+
+void EncodedPointsFile::write(std::ostream& out) const {
+  out.write(known_.data(), static_cast<std::streamsize>(at_));
+  if (deferred_ && out) writeDeferred(*deferred_, out);
+  if (out) out.write(known_.data() + at_, static_cast<std::streamsize>(known_.size() - at_));
+}
+
+EncodedPointsFile encodePointsFileDeferred(vdbp::PointDataGrid& grid, std::uint32_t compression,
+                                           const PointValues* values, std::size_t expectedBytes) {
+  std::unique_ptr<EncodedPointsFile::Deferred> deferred;
+  const openvdb::GridCPtrVec grids{
+      std::make_shared<const ParallelBuffersGrid>(grid, values, &deferred)};
   MemorySink sink(expectedBytes);
   std::ostream os(&sink);
   PointsArchive(compression).writeSeekable(os, grids);
   if (!os) throw std::runtime_error("cannot encode the VDB points grid");
-  return std::move(sink).release();
+  const std::size_t at = deferred ? sink.gapAt() : sink.held();
+  return EncodedPointsFile(std::move(sink).release(), at, std::move(deferred));
+}
+
+FileBytes encodePointsFile(vdbp::PointDataGrid& grid, std::uint32_t compression,
+                           const PointValues* values, std::size_t expectedBytes) {
+  return encodePointsFileDeferred(grid, compression, values, expectedBytes).bytes();
 }
 
 std::string encodePointsFileSerially(const vdbp::PointDataGrid::ConstPtr& grid,

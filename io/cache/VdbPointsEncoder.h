@@ -65,6 +65,46 @@ LargeArray<T> allocateLargeArray(std::size_t n) {
   return LargeArray<T>(reinterpret_cast<T*>(FileBytes::allocate(n * sizeof(T)).release()));
 }
 
+/// A .vdb file encoded in memory but for its largest part, the leaves' buffers past their
+/// voxel offsets (the attribute arrays' values and, with blosc, pages): those are made as the
+/// file is written, a chunk at a time on every thread, while the chunk made before goes to the
+/// kernel. The file is then never whole in memory, its values go through the cache on their way
+/// to the page cache, and storing them overlaps writing them. Holds what it was made from (the
+/// grid's leaves and the caller's PointValues), which must outlive it.
+class EncodedPointsFile {
+ public:
+  /// The bytes not yet made: parts of the file one after another, filled on demand.
+  class Deferred {
+   public:
+    virtual ~Deferred() = default;
+    virtual std::size_t parts() const = 0;
+    /// Where part `p` starts from where part 0 starts; offset(parts()) is their size.
+    virtual std::size_t offset(std::size_t p) const = 0;
+    /// Writes parts [begin, end) at `to`, where part `begin` starts. Called from several
+    /// threads at once, for different parts.
+    virtual void fill(std::size_t begin, std::size_t end, char* to) const = 0;
+  };
+
+  /// `known`: the file's bytes but the deferred ones, which go at `deferredAt`.
+  EncodedPointsFile(FileBytes known, std::size_t deferredAt, std::unique_ptr<Deferred> deferred);
+  EncodedPointsFile(EncodedPointsFile&&) noexcept = default;
+  ~EncodedPointsFile();
+
+  /// The bytes before the deferred ones (the header first), for the caller to change in place.
+  char* head() { return known_.data(); }
+  std::size_t headSize() const { return at_; }
+  std::size_t size() const;
+  /// Writes the whole file to `out`, in order; stops at the first failed write (`out` tells).
+  void write(std::ostream& out) const;
+  /// The whole file in memory.
+  FileBytes bytes() const;
+
+ private:
+  FileBytes known_;
+  std::size_t at_ = 0;
+  std::unique_ptr<Deferred> deferred_;
+};
+
 /// What openvdb::io::File::write() writes for `grid` alone (its name unique, no file metadata)
 /// with `compression` (openvdb::io::COMPRESS_* flags), made in memory: the bytes of
 /// io::Archive::write(os, {grid}, seekable = true), every one of them but the header's UUID, which
@@ -88,6 +128,13 @@ LargeArray<T> allocateLargeArray(std::size_t n) {
 FileBytes encodePointsFile(openvdb::points::PointDataGrid& grid, std::uint32_t compression,
                            const PointValues* values = nullptr,
                            std::size_t expectedBytes = 1 << 20);
+
+/// The same file, its leaves' buffers made as it is written (EncodedPointsFile). `grid` and
+/// `values` must outlive it.
+EncodedPointsFile encodePointsFileDeferred(openvdb::points::PointDataGrid& grid,
+                                           std::uint32_t compression,
+                                           const PointValues* values = nullptr,
+                                           std::size_t expectedBytes = 1 << 20);
 
 /// The same bytes made by io::Archive::write() alone, on one thread, into a std::ostringstream:
 /// the way tickfx wrote its caches before encodePointsFile, kept as the tests' reference.
