@@ -233,8 +233,9 @@ struct Piece {
 // to one leaf, and a page to a run of consecutive leaves: leaf ranges and pages are encoded
 // apart, in parallel, each by the OpenVDB function the serial writer calls for it, and the file
 // is their concatenation in the order above. The arrays without blosc, most of the file, are
-// written straight into place (their sizes are known in advance); the rest is made first, then
-// copied there.
+// stored from the caller's values as the file is written (their sizes are known in advance,
+// so the grid's end offset is too); the rest is made first, then copied into the chunks
+// written (DeferredBuffers, EncodedPointsFile::write).
 
 constexpr std::size_t kRangePoints = 16384;  // a leaf range ends once it holds this many points
 constexpr std::size_t kRangeLeaves = 64;     // or this many leaves
