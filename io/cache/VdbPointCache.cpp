@@ -236,6 +236,36 @@ void placeRows(const Positions& positions, std::size_t begin, std::size_t count,
   }
 }
 
+// A box of leaves: its first and last leaf origins, and its extent in leaves on each axis.
+struct LeafBox {
+  std::array<std::int32_t, 3> first{}, last{};
+  std::array<std::uint32_t, 3> extent{};
+};
+
+// Each of the `count` placed rows' leaf index in `box` (x, then y, then z: Coord's order) in
+// leaf[k], and false where some row's leaf lies outside the box (its index is then meaningless).
+// In plain integer loops that the compiler vectorises; the box holds at most 2³² leaves, so the
+// indices of the rows inside it fit 32 bits.
+bool leafIndices(const PlacedRows& placed, std::size_t count, const LeafBox& box,
+                 std::uint32_t* __restrict leaf) {
+  constexpr unsigned kLeafLog2 = Leaf::LOG2DIM;
+  std::uint32_t outside = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    std::uint32_t index = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::int32_t origin = placed.index[c][k] & kLeafMask;
+      outside |= static_cast<std::uint32_t>(origin < box.first[c]) |
+                 static_cast<std::uint32_t>(origin > box.last[c]);
+      // (Unsigned: exact for a leaf in the box, where first <= origin <= last.)
+      index = index * box.extent[c] +
+              ((static_cast<std::uint32_t>(origin) - static_cast<std::uint32_t>(box.first[c])) >>
+               kLeafLog2);
+    }
+    leaf[k] = index;
+  }
+  return outside == 0;
+}
+
 // Each point's leaf and voxel offset within its leaf (0 to 511), in row order (sorted below).
 template <bool Quantised>
 std::vector<PointSlot> slotsInRowOrder(const FrameData& frame) {
@@ -576,15 +606,12 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     leafCount *= e;
   }
   const std::size_t leaves = leafCount;
-  const auto leafIndex = [&](const openvdb::Coord& leaf) {
-    std::uint64_t index = 0;
-    for (int c = 0; c < 3; ++c) {
-      index = index * extent[static_cast<std::size_t>(c)] +
-              (static_cast<std::uint64_t>(static_cast<std::int64_t>(leaf[c]) - box.first[c]) >>
-               kLeafLog2);
-    }
-    return static_cast<std::uint32_t>(index);
-  };
+  LeafBox leafBox;
+  for (std::size_t c = 0; c < 3; ++c) {
+    leafBox.first[c] = box.first[static_cast<int>(c)];
+    leafBox.last[c] = box.second[static_cast<int>(c)];
+    leafBox.extent[c] = static_cast<std::uint32_t>(extent[c]);
+  }
   const auto chunkRange = [&](std::size_t chunk) {
     return std::pair{chunk * n / chunks, (chunk + 1) * n / chunks};
   };
@@ -600,31 +627,25 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     for (std::size_t first = begin; first < end; first += kPlacedRows) {
       const std::size_t rows = std::min(kPlacedRows, end - first);
       placeRows<Quantised>(positions, first, rows, placed);
-      for (std::size_t k = 0; k < rows; ++k) {
-        const openvdb::Coord leaf = placed.voxel(k) & kLeafMask;
-        // (Never, as the box is made; but a wrong box must not write past the table.)
-        if (openvdb::Coord::lessThan(leaf, box.first) ||
-            openvdb::Coord::lessThan(box.second, leaf)) {
-          outsideBox[chunk] = 1;
-          return;
-        }
-        const std::uint32_t l = leafIndex(leaf);
-        rowAt[first + k] = l;
-        ++count[l];
+      std::uint32_t* const leaf = rowAt.get() + first;
+      // (Never outside, as the box is made; but a wrong box must not write past the table.)
+      if (!leafIndices(placed, rows, leafBox, leaf)) {
+        outsideBox[chunk] = 1;
+        return;
       }
+      for (std::size_t k = 0; k < rows; ++k) ++count[leaf[k]];
     }
   });
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
   const std::vector<const float*> source = pointFloatColumns(frame);
   GroupedPoints points(n, source.size());
   // The leaves that hold points, in order (each one's first point and origin), and the buckets.
-  std::vector<std::uint32_t> ordinalOf(leaves), boxOf;
+  std::vector<std::uint32_t> boxOf;  // each such leaf's index in the box
   std::size_t sum = 0;
   for (std::size_t l = 0; l < leaves; ++l) {
     std::size_t total = 0;
     for (std::size_t chunk = 0; chunk < chunks; ++chunk) total += table[chunk * leaves + l];
     if (total == 0) continue;
-    ordinalOf[l] = static_cast<std::uint32_t>(boxOf.size());
     boxOf.push_back(static_cast<std::uint32_t>(l));
     points.starts.push_back(sum);
     sum += total;
@@ -637,6 +658,13 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   }
   points.starts.push_back(n);
   const Buckets buckets(points.starts);
+  // Each box leaf's bucket and place in it (bucket << 4 | place), looked up once a row.
+  static_assert(kBucketLeaves <= 16);
+  std::vector<std::uint32_t> bucketPlace(leaves);
+  for (std::size_t o = 0; o < boxOf.size(); ++o) {
+    const std::uint32_t b = buckets.of[o];
+    bucketPlace[boxOf[o]] = b << 4 | (static_cast<std::uint32_t>(o) - buckets.first[b]);
+  }
   // Where each chunk's rows of a bucket go: bucket by bucket, chunk by chunk.
   const std::size_t bucketCount = buckets.count();
   std::vector<std::uint32_t> next(chunks * bucketCount);
@@ -665,12 +693,11 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                           const std::size_t rows = std::min(kPlacedRows, end - first);
                           placeRows<Quantised>(positions, first, rows, placed);
                           for (std::size_t k = 0; k < rows; ++k) {
-                            const std::uint32_t o = ordinalOf[at[first + k]];
-                            const std::uint32_t b = buckets.of[o];
-                            const std::uint32_t to = chunkNext[b]++;
+                            const std::uint32_t p = bucketPlace[at[first + k]];
+                            const std::uint32_t to = chunkNext[p >> 4]++;
                             at[first + k] = to;
                             key[to] = static_cast<std::uint16_t>(
-                                ((o - buckets.first[b]) << kVoxelBits) |
+                                ((p & 15) << kVoxelBits) |
                                 static_cast<std::uint32_t>(Leaf::coordToOffset(placed.voxel(k))));
                             offset[to] = openvdb::Vec3f(placed.offset[0][k], placed.offset[1][k],
                                                         placed.offset[2][k]);
