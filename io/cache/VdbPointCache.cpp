@@ -36,6 +36,7 @@
 #include "io/util/AtomicFile.h"
 #include "io/util/Fingerprint.h"
 #include "io/util/ProfiledTbb.h"
+#include "particles/Isa.h"
 
 namespace tickfx::io {
 namespace {
@@ -265,6 +266,66 @@ bool leafIndices(const PlacedRows& placed, std::size_t count, const LeafBox& box
   }
   return outside == 0;
 }
+
+// placeRows() and leafIndices() compiled for each instruction set (particles/Isa.h), whole
+// (flatten): the same bits on each, as they use integer operations and IEEE arithmetic alone.
+template <bool Quantised>
+void placeRowsBaseline(const Positions& positions, std::size_t begin, std::size_t count,
+                       PlacedRows& placed) {
+  placeRows<Quantised>(positions, begin, count, placed);
+}
+#ifdef TICKFX_AVX2_CLONES
+template <bool Quantised>
+[[gnu::target("avx2"), gnu::flatten]] void placeRowsAvx2(const Positions& positions,
+                                                         std::size_t begin, std::size_t count,
+                                                         PlacedRows& placed) {
+  placeRows<Quantised>(positions, begin, count, placed);
+}
+template <bool Quantised>
+[[gnu::target("avx2,avx512f"), gnu::flatten]] void placeRowsAvx512(const Positions& positions,
+                                                                   std::size_t begin,
+                                                                   std::size_t count,
+                                                                   PlacedRows& placed) {
+  placeRows<Quantised>(positions, begin, count, placed);
+}
+[[gnu::target("avx2"), gnu::flatten]] bool leafIndicesAvx2(const PlacedRows& placed,
+                                                           std::size_t count, const LeafBox& box,
+                                                           std::uint32_t* leaf) {
+  return leafIndices(placed, count, box, leaf);
+}
+[[gnu::target("avx2,avx512f"), gnu::flatten]] bool leafIndicesAvx512(const PlacedRows& placed,
+                                                                     std::size_t count,
+                                                                     const LeafBox& box,
+                                                                     std::uint32_t* leaf) {
+  return leafIndices(placed, count, box, leaf);
+}
+#endif
+
+// The placement and leaf index loops on one instruction set, chosen once (activeIsa()).
+template <bool Quantised>
+struct RowPlacer {
+  using Place = void (*)(const Positions&, std::size_t, std::size_t, PlacedRows&);
+  using Index = bool (*)(const PlacedRows&, std::size_t, const LeafBox&, std::uint32_t*);
+  Place place = &placeRowsBaseline<Quantised>;
+  Index index = &leafIndices;
+
+  RowPlacer() {
+#ifdef TICKFX_AVX2_CLONES
+    switch (activeIsa()) {
+      case Isa::Avx512:
+        place = &placeRowsAvx512<Quantised>;
+        index = &leafIndicesAvx512;
+        break;
+      case Isa::Avx2:
+        place = &placeRowsAvx2<Quantised>;
+        index = &leafIndicesAvx2;
+        break;
+      case Isa::Baseline:
+        break;
+    }
+#endif
+  }
+};
 
 // Each point's leaf and voxel offset within its leaf (0 to 511), in row order (sorted below).
 template <bool Quantised>
@@ -617,6 +678,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   };
   // Each row's leaf, and each chunk's count of rows a leaf.
   const Positions positions(frame);
+  const RowPlacer<Quantised> placer;
   const LargeArray<std::uint32_t> rowAt = allocateLargeArray<std::uint32_t>(n);
   std::vector<std::uint32_t> table(leaves * chunks, 0);
   std::vector<char> outsideBox(chunks, 0);
@@ -626,10 +688,10 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     PlacedRows placed;
     for (std::size_t first = begin; first < end; first += kPlacedRows) {
       const std::size_t rows = std::min(kPlacedRows, end - first);
-      placeRows<Quantised>(positions, first, rows, placed);
+      placer.place(positions, first, rows, placed);
       std::uint32_t* const leaf = rowAt.get() + first;
       // (Never outside, as the box is made; but a wrong box must not write past the table.)
-      if (!leafIndices(placed, rows, leafBox, leaf)) {
+      if (!placer.index(placed, rows, leafBox, leaf)) {
         outsideBox[chunk] = 1;
         return;
       }
@@ -691,7 +753,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                         const auto [begin, end] = chunkRange(chunk);
                         for (std::size_t first = begin; first < end; first += kPlacedRows) {
                           const std::size_t rows = std::min(kPlacedRows, end - first);
-                          placeRows<Quantised>(positions, first, rows, placed);
+                          placer.place(positions, first, rows, placed);
                           for (std::size_t k = 0; k < rows; ++k) {
                             const std::uint32_t p = bucketPlace[at[first + k]];
                             const std::uint32_t to = chunkNext[p >> 4]++;

@@ -27,6 +27,7 @@
 #include "io/cache/VdbCacheOptions.h"
 #include "io/cache/VdbPointCache.h"
 #include "io/cache/VdbPointCacheBytes.h"
+#include "particles/Isa.h"
 
 namespace tickfx::io {
 namespace {
@@ -325,6 +326,20 @@ void expectGroupingsAgree(const FrameData& frame) {
                                              VdbGrouping::Fastest);
       });
       EXPECT_EQ(fastest.size(), sorted.size());
+      EXPECT_TRUE(fastest == sorted)
+          << "the groupings differ first at byte " << firstDifference(fastest, sorted);
+    }
+    // The placement loops' clones for each instruction set this machine runs, on two threads
+    // (the sort places points with scalar code alone).
+    for (const Isa isa : {Isa::Baseline, Isa::Avx2, Isa::Avx512}) {
+      if (!isaAvailable(isa)) continue;
+      SCOPED_TRACE(isaName(isa));
+      const ForcedIsa forced(isa);
+      std::string fastest;
+      tbb::task_arena(2).execute([&] {
+        fastest = detail::vdbPointCacheBytes(frame, metadata(), options, VdbEncoder::Parallel,
+                                             VdbGrouping::Fastest);
+      });
       EXPECT_TRUE(fastest == sorted)
           << "the groupings differ first at byte " << firstDifference(fastest, sorted);
     }
