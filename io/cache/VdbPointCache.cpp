@@ -490,29 +490,42 @@ constexpr std::size_t kBucketChunk = 65536;
 constexpr std::size_t kMaxChunks = 64;
 
 // Extends [low, high] over the coordinates x[begin, end) below 2³⁰ in magnitude, and returns
-// whether some other coordinate (beyond, infinite or NaN: placed at 0) is among them. Four lanes
-// of bounds at once, folded at the end (min and max give the same bounds in any order; a zero's
-// sign may differ, and both zeros lie in the same voxel).
-bool extendBounds(const float* x, std::size_t begin, std::size_t end, float& low, float& high) {
-  using Lanes = float __attribute__((vector_size(16)));
-  using Bits = std::int32_t __attribute__((vector_size(16)));
+// whether some other coordinate (beyond, infinite or NaN: placed at 0) is among them. A
+// register's lanes of bounds at once, folded at the end (min and max give the same bounds in any
+// order; a zero's sign may differ, and both zeros lie in the same voxel).
+using Floats4 = float __attribute__((vector_size(16)));
+using Floats8 = float __attribute__((vector_size(32)));
+using Floats16 = float __attribute__((vector_size(64)));
+using Ints4 = std::int32_t __attribute__((vector_size(16)));
+using Ints8 = std::int32_t __attribute__((vector_size(32)));
+using Ints16 = std::int32_t __attribute__((vector_size(64)));
+
+template <typename Floats, typename Bits>
+bool extendBoundsBy(const float* x, std::size_t begin, std::size_t end, float& low, float& high) {
+  constexpr int Lanes = sizeof(Floats) / sizeof(float);
+  static_assert(sizeof(Bits) == sizeof(Floats));
   constexpr auto kLimit = static_cast<float>(kLargestIndex);
-  const Lanes limit = {kLimit, kLimit, kLimit, kLimit};
-  Lanes lows = {low, low, low, low}, highs = {high, high, high, high};
+  Floats limit, lows, highs;
+  for (int k = 0; k < Lanes; ++k) {
+    limit[k] = kLimit;
+    lows[k] = low;
+    highs[k] = high;
+  }
   Bits outside = {};
   std::size_t i = begin;
-  for (; i + 4 <= end; i += 4) {
-    Lanes v;
+  for (; i + Lanes <= end; i += Lanes) {
+    Floats v;
     std::memcpy(&v, x + i, sizeof v);
-    const Bits bits = std::bit_cast<Bits>(v);
-    const Bits inside = std::bit_cast<Lanes>(bits & 0x7fffffff) < limit;  // all ones; not NaN
+    const Bits bits = __builtin_bit_cast(Bits, v);
+    const Bits inside = __builtin_bit_cast(Floats, bits & 0x7fffffff) < limit;  // all ones; not NaN
     const Bits lower = inside & (v < lows), higher = inside & (v > highs);
-    lows = std::bit_cast<Lanes>((bits & lower) | (std::bit_cast<Bits>(lows) & ~lower));
-    highs = std::bit_cast<Lanes>((bits & higher) | (std::bit_cast<Bits>(highs) & ~higher));
+    lows = __builtin_bit_cast(Floats, (bits & lower) | (__builtin_bit_cast(Bits, lows) & ~lower));
+    highs =
+        __builtin_bit_cast(Floats, (bits & higher) | (__builtin_bit_cast(Bits, highs) & ~higher));
     outside |= ~inside;
   }
   bool beyond = false;
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < Lanes; ++k) {
     low = std::min(low, lows[k]);
     high = std::max(high, highs[k]);
     beyond |= outside[k] != 0;
@@ -524,6 +537,36 @@ bool extendBounds(const float* x, std::size_t begin, std::size_t end, float& low
     beyond |= !inside;
   }
   return beyond;
+}
+
+#ifdef TICKFX_AVX2_CLONES
+[[gnu::target("avx2"), gnu::flatten]] bool extendBoundsAvx2(const float* x, std::size_t begin,
+                                                            std::size_t end, float& low,
+                                                            float& high) {
+  return extendBoundsBy<Floats8, Ints8>(x, begin, end, low, high);
+}
+[[gnu::target("avx2,avx512f"), gnu::flatten]] bool extendBoundsAvx512(const float* x,
+                                                                      std::size_t begin,
+                                                                      std::size_t end, float& low,
+                                                                      float& high) {
+  return extendBoundsBy<Floats16, Ints16>(x, begin, end, low, high);
+}
+#endif
+
+// extendBoundsBy() on the widest instruction set here (particles/Isa.h).
+bool extendBounds(Isa isa, const float* x, std::size_t begin, std::size_t end, float& low,
+                  float& high) {
+#ifdef TICKFX_AVX2_CLONES
+  switch (isa) {
+    case Isa::Avx512:
+      return extendBoundsAvx512(x, begin, end, low, high);
+    case Isa::Avx2:
+      return extendBoundsAvx2(x, begin, end, low, high);
+    case Isa::Baseline:
+      break;
+  }
+#endif
+  return extendBoundsBy<Floats4, Ints4>(x, begin, end, low, high);
 }
 
 // Consecutive leaves gathered for the counting sort: at most kBucketLeaves leaves and, unless a
@@ -621,12 +664,13 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   Range init;
   init.low.fill(std::numeric_limits<float>::infinity());
   init.high.fill(-std::numeric_limits<float>::infinity());
+  const Isa isa = activeIsa();
   const Range range = par::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, kPlacementGrain), init,
       [&](const tbb::blocked_range<std::size_t>& rows, Range r) {
         for (std::size_t c = 0; c < 3; ++c) {
-          r.placedAtZero |= extendBounds(frame.position[static_cast<int>(c)].data(), rows.begin(),
-                                         rows.end(), r.low[c], r.high[c]);
+          r.placedAtZero |= extendBounds(isa, frame.position[static_cast<int>(c)].data(),
+                                         rows.begin(), rows.end(), r.low[c], r.high[c]);
         }
         return r;
       },
