@@ -3,12 +3,14 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointDataGrid.h>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -25,6 +27,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -429,6 +432,15 @@ struct GroupedPoints {
   LargeArray<std::uint64_t> id;
   // velocity x, y, z, age, life, mass, then the frame's attributes (pointFloatColumns' order)
   std::vector<LargeArray<float>> columns;
+  // Where set (bucketedPoints), `id` and `columns` are put in order bucket by bucket by the store
+  // itself, as the file is written (orderLater()): each bucket's rows of them are still in row
+  // order, rank[k] the place in its bucket of the point whose values are at row k, and
+  // later[b * (1 + columns.size()) + s] tells whether bucket b's column s (0: id, then
+  // columns[s − 1]) is in order (kOrdered), being put in order (kOrdering) or not yet.
+  LargeArray<std::uint32_t> rank;
+  std::vector<std::uint32_t> bucketFirst;  // each bucket's first leaf, and the leaf count
+  std::vector<std::uint32_t> bucketOf;     // each leaf's bucket
+  std::unique_ptr<std::atomic<std::uint8_t>[]> later;
 
   GroupedPoints(std::size_t n, std::size_t floatColumnCount)
       : voxel(allocateLargeArray<std::uint16_t>(n)),
@@ -608,7 +620,7 @@ struct Buckets {
 
 // What orderBucket() reuses from one bucket to the next.
 struct BucketScratch {
-  std::vector<std::uint32_t> counts, rank;
+  std::vector<std::uint32_t> counts;
   std::vector<std::uint16_t> keys;
   std::vector<openvdb::Vec3f> vectors;
   std::vector<std::uint64_t> ids;
@@ -625,8 +637,9 @@ void permute(T* __restrict column, const std::uint32_t* __restrict rank, std::si
 
 // Puts points [begin, end), a bucket of `leaves` leaves in row order whose voxel column holds
 // each point's key (its leaf's place in the bucket, then its voxel), in order by key, rows in
-// order among equal keys (a counting sort), every column moved alike; the voxel column then
-// holds each point's voxel.
+// order among equal keys (a counting sort): the voxel column then holds each point's voxel, and
+// the offsets are moved alike. Each point's place is kept in `rank` for the columns the store
+// puts in order later (orderLater()).
 void orderBucket(GroupedPoints& points, std::size_t begin, std::size_t end, std::size_t leaves,
                  BucketScratch& scratch) {
   const std::size_t count = end - begin;
@@ -635,15 +648,52 @@ void orderBucket(GroupedPoints& points, std::size_t begin, std::size_t end, std:
   for (std::size_t i = 0; i < count; ++i) ++scratch.counts[key[i]];
   std::uint32_t sum = 0;
   for (std::uint32_t& c : scratch.counts) sum += std::exchange(c, sum);
-  scratch.rank.resize(count);
-  for (std::size_t i = 0; i < count; ++i) scratch.rank[i] = scratch.counts[key[i]]++;
-  const std::uint32_t* const rank = scratch.rank.data();
+  std::uint32_t* const rank = points.rank.get() + begin;
+  for (std::size_t i = 0; i < count; ++i) rank[i] = scratch.counts[key[i]]++;
   permute(key, rank, count, scratch.keys);
   for (std::size_t i = 0; i < count; ++i) key[i] &= Leaf::SIZE - 1;  // the voxel alone
   permute(points.offset.get() + begin, rank, count, scratch.vectors);
-  permute(points.id.get() + begin, rank, count, scratch.ids);
-  for (LargeArray<float>& column : points.columns)
-    permute(column.get() + begin, rank, count, scratch.floats);
+}
+
+constexpr std::uint8_t kOrdering = 1, kOrdered = 2;
+
+// Puts column s (0: id, then columns[s − 1]) of bucket b in order, once: the first thread to
+// ask does it, another that asks meanwhile waits for it (it is running, and takes microseconds).
+// The store asks before reading a leaf's values (GroupedValues), so this runs beside the
+// kernel's copy of the chunk before, in time the writing threads would otherwise wait.
+void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScratch& scratch) {
+  std::atomic<std::uint8_t>& state = points.later[b * (1 + points.columns.size()) + s];
+  if (state.load(std::memory_order_acquire) == kOrdered) return;
+  std::uint8_t expected = 0;
+  if (!state.compare_exchange_strong(expected, kOrdering, std::memory_order_acquire)) {
+    while (state.load(std::memory_order_acquire) != kOrdered) std::this_thread::yield();
+    return;
+  }
+  const std::size_t begin = points.starts[points.bucketFirst[b]];
+  const std::size_t count = points.starts[points.bucketFirst[b + 1]] - begin;
+  const std::uint32_t* const rank = points.rank.get() + begin;
+  try {
+    if (s == 0)
+      permute(points.id.get() + begin, rank, count, scratch.ids);
+    else
+      permute(points.columns[s - 1].get() + begin, rank, count, scratch.floats);
+  } catch (...) {
+    state.store(0, std::memory_order_release);  // (an allocation failed: another may try)
+    throw;
+  }
+  state.store(kOrdered, std::memory_order_release);
+}
+
+// Every column in order (OpenVDB's own writer reads the grouped points whole).
+void orderAllLater(GroupedPoints& points) {
+  if (!points.later) return;
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.bucketFirst.size() - 1),
+                    [&](const tbb::blocked_range<std::size_t>& some) {
+                      BucketScratch scratch;
+                      for (std::size_t b = some.begin(); b < some.end(); ++b)
+                        for (std::size_t s = 0; s <= points.columns.size(); ++s)
+                          orderLater(points, b, s, scratch);
+                    });
 }
 
 // The fast way, when the leaves' bounding box holds few enough leaves to count them in a table
@@ -817,6 +867,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                         scatter(source[j], at, runBegin, runEnd, points.columns[j].get());
                     });
   // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
+  points.rank = allocateLargeArray<std::uint32_t>(n);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, bucketCount),
                     [&](const tbb::blocked_range<std::size_t>& some) {
                       BucketScratch scratch;
@@ -826,6 +877,10 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                                     buckets.first[b + 1] - buckets.first[b], scratch);
                       }
                     });
+  points.bucketFirst = buckets.first;
+  points.bucketOf = buckets.of;
+  const std::size_t later = bucketCount * (1 + points.columns.size());
+  points.later = std::make_unique<std::atomic<std::uint8_t>[]>(later);  // (zeroed: not yet)
   return points;
 }
 
@@ -1003,24 +1058,58 @@ std::unique_ptr<Leaf> makeLeaf(const std::vector<GridAttribute>& attributes,
 template <typename PositionArray>
 class GroupedValues final : public PointValues {
  public:
-  GroupedValues(const GroupedPoints& points, std::vector<GridAttribute> attributes)
+  GroupedValues(GroupedPoints& points, std::vector<GridAttribute> attributes)
       : points_(points), attributes_(std::move(attributes)) {}
 
   void store(std::size_t attribute, const openvdb::Coord& origin, std::size_t count,
              char* to) const override {
-    const auto& origins = points_.origins;
-    const auto leaf = std::lower_bound(origins.begin(), origins.end(), origin);
-    const auto l = static_cast<std::size_t>(leaf - origins.begin());
-    if (leaf == origins.end() || *leaf != origin ||
-        points_.starts[l + 1] - points_.starts[l] != count || attribute >= attributes_.size()) {
+    Local& local = local_.local();
+    const std::size_t l = leafAt(origin, local.next);
+    if (points_.starts[l + 1] - points_.starts[l] != count || attribute >= attributes_.size())
       throw std::logic_error("VDB points: values asked for a leaf the frame does not have");
-    }
+    local.next = l + 1;
     const GridAttribute& a = attributes_[attribute];
+    if (points_.later) orderColumns(l, a, local.scratch);
     withArrayType<PositionArray>(
         a.kind, [&]<typename Array>(std::type_identity<Array>) { storeAs<Array>(l, a, to); });
   }
 
  private:
+  // A thread's own: the leaf after the last it stored (the encoder asks for leaves in the tree's
+  // order, which is nearly always the leaves' Coord order), and orderLater()'s scratch.
+  struct Local {
+    std::size_t next = 0;
+    BucketScratch scratch;
+  };
+
+  // The index of the leaf at `origin`, tried first at `guess`.
+  std::size_t leafAt(const openvdb::Coord& origin, std::size_t guess) const {
+    const auto& origins = points_.origins;
+    if (guess < origins.size() && origins[guess] == origin) return guess;
+    const auto leaf = std::lower_bound(origins.begin(), origins.end(), origin);
+    if (leaf == origins.end() || *leaf != origin)
+      throw std::logic_error("VDB points: values asked for a leaf the frame does not have");
+    return static_cast<std::size_t>(leaf - origins.begin());
+  }
+
+  // The columns attribute `a` reads, in order in leaf l's bucket.
+  void orderColumns(std::size_t l, const GridAttribute& a, BucketScratch& scratch) const {
+    using Kind = GridAttribute::Kind;
+    const std::size_t b = points_.bucketOf[l];
+    switch (a.kind) {
+      case Kind::Position:
+        return;  // (the offsets are ordered with the voxels)
+      case Kind::Id:
+        return orderLater(points_, b, 0, scratch);
+      case Kind::Vector:
+        for (std::size_t j = 0; j < 3; ++j) orderLater(points_, b, 1 + a.column + j, scratch);
+        return;
+      case Kind::Float:
+      case Kind::Int:
+        return orderLater(points_, b, 1 + a.column, scratch);
+    }
+  }
+
   template <typename Array>
   void storeAs(std::size_t l, const GridAttribute& a, char* to) const {
     using Storage = typename Array::StorageType;
@@ -1035,8 +1124,9 @@ class GroupedValues final : public PointValues {
     });
   }
 
-  const GroupedPoints& points_;
+  GroupedPoints& points_;
   std::vector<GridAttribute> attributes_;
+  mutable tbb::enumerable_thread_specific<Local> local_;
 };
 
 // Which way the points are grouped: only tests ask for the general way.
@@ -1090,7 +1180,7 @@ std::uint32_t compressionFlags(const VdbCacheOptions& options);
 template <typename PositionArray, typename Use>
 void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
                  const VdbCacheOptions& options, Grouping grouping, const Use& use) {
-  const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
+  GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
   std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
   const auto descriptor = gridDescriptor<PositionArray>(attributes);
   auto tree = makeTree(points, [&](std::size_t l) { return makeEmptyLeaf(points, l); });
@@ -1107,7 +1197,8 @@ void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
 template <typename PositionArray>
 vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetadata& meta,
                                     Grouping grouping) {
-  const GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
+  GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
+  orderAllLater(points);
   const std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
   const auto descriptor = gridDescriptor<PositionArray>(attributes);
   return makeGrid(makeTree(points,
