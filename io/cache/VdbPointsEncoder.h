@@ -65,12 +65,13 @@ LargeArray<T> allocateLargeArray(std::size_t n) {
   return LargeArray<T>(reinterpret_cast<T*>(FileBytes::allocate(n * sizeof(T)).release()));
 }
 
-/// A .vdb file encoded in memory but for its largest part, the leaves' buffers past their
-/// voxel offsets (the attribute arrays' values and, with blosc, pages): those are made as the
-/// file is written, a chunk at a time on every thread, while the chunk made before goes to the
-/// kernel. The file is then never whole in memory, its values go through the cache on their way
-/// to the page cache, and storing them overlaps writing them. Holds what it was made from (the
-/// grid's leaves and the caller's PointValues), which must outlive it.
+/// A .vdb file encoded in memory but for its largest part, the attribute arrays' values without
+/// blosc: those are stored as the file is written, a chunk at a time on every thread, while the
+/// chunk made before goes to the kernel; the rest of the leaves' buffers (voxel offsets, the
+/// arrays' records, blosc's pages), made beforehand, are copied into the same chunks. The file
+/// is then never whole in memory, its values go through the cache on their way to the page
+/// cache, and storing them overlaps writing them. Holds what it was made from (the grid's leaves
+/// and the caller's PointValues), which must outlive it.
 class EncodedPointsFile {
  public:
   /// The bytes not yet made: parts of the file one after another, filled on demand.
