@@ -566,8 +566,8 @@ bool extendBoundsBy(const float* x, std::size_t begin, std::size_t end, float& l
 #endif
 
 // extendBoundsBy() on the widest instruction set here (particles/Isa.h).
-bool extendBounds(Isa isa, const float* x, std::size_t begin, std::size_t end, float& low,
-                  float& high) {
+bool extendBounds([[maybe_unused]] Isa isa, const float* x, std::size_t begin, std::size_t end,
+                  float& low, float& high) {
 #ifdef TICKFX_AVX2_CLONES
   switch (isa) {
     case Isa::Avx512:
