@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -637,32 +638,25 @@ void describePlaceholders(Leaves& all, const openvdb::io::StreamMetadata& metada
     all.metadata.push_back(metadataTemplate(all, a, metadata));
 }
 
-// Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel but
-// for the parts left to `deferred` (DeferredBuffers: `os` skips their bytes), and returns true;
-// or writes nothing and returns false when the tree is not splittable() (or has no leaf: two
-// bytes that OpenVDB writes as fast) or `os` does not write into a MemorySink. With `values`,
-// the tree's arrays are placeholders (encodePointsFile): a tree with leaves that this cannot
-// write throws.
-bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const PointValues* values,
-                            std::ostream& os,
-                            std::unique_ptr<EncodedPointsFile::Deferred>& deferred) {
-  auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
+// What Grid<PointDataTree>::writeBuffers() writes for `tree` after the pass count, encoded in
+// parallel with the stream metadata `metadata` but for the parts left to fill() (DeferredBuffers);
+// or null when the tree is not splittable() or has no leaf (two bytes that OpenVDB writes as
+// fast). With `values`, the tree's arrays are placeholders (encodePointsFile): a tree with leaves
+// that this cannot write throws.
+std::unique_ptr<DeferredBuffers> encodeBuffers(const vdbp::PointDataTree& tree, bool toHalf,
+                                               const PointValues* values,
+                                               const openvdb::io::StreamMetadata::Ptr& metadata) {
   Leaves all;
   all.values = values;
   std::vector<const Leaf*>& leaves = all.leaf;
   leaves.reserve(tree.leafCount());
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
-  if (leaves.empty()) return false;
-  if (sink == nullptr || (values == nullptr && !splittable(leaves))) {
-    if (values == nullptr) return false;
-    throw std::logic_error("VDB points: placeholder arrays that cannot be encoded in parallel");
-  }
-  const openvdb::io::StreamMetadata::Ptr metadata = openvdb::io::getStreamMetadataPtr(os);
-  if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
+  if (leaves.empty()) return nullptr;
+  if (values == nullptr && !splittable(leaves)) return nullptr;
   if (values != nullptr) describePlaceholders(all, *metadata);
 
   const std::size_t attributes = leaves.front()->attributeSet().size();
-  const bool paged = (openvdb::io::getDataCompression(os) & openvdb::io::COMPRESS_BLOSC) != 0;
+  const bool paged = (metadata->compression() & openvdb::io::COMPRESS_BLOSC) != 0;
   const std::vector<std::size_t> starts = leafRanges(leaves);
   const std::size_t ranges = starts.size() - 1;
   std::vector<RangeBytes> rangeBytes(ranges);
@@ -711,11 +705,85 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
       }
     }
   }
+  return std::make_unique<DeferredBuffers>(std::move(all), metadata, std::move(rangeBytes),
+                                           std::move(pages), std::move(parts));
+}
 
-  const auto passes = static_cast<std::uint16_t>(leaves.front()->buffers());
+// encodeBuffers() begun ahead, on another thread, while this one goes on: Archive::write() has
+// set the stream's metadata for the grid by the time it makes the grid's statistics
+// (ParallelBuffersGrid::copyGrid()), and then writes the header and topology on this thread
+// alone, which the leaves' buffers need not wait for. What is made is used only if the metadata
+// is the same when the buffers are written.
+class BuffersAhead {
+ public:
+  explicit BuffersAhead(std::ios_base& os) : os_(os) {}
+  ~BuffersAhead() {
+    try {
+      group_.wait();
+    } catch (...) {  // (the write failed before it took the buffers: it throws already)
+    }
+  }
+  BuffersAhead(const BuffersAhead&) = delete;
+  BuffersAhead& operator=(const BuffersAhead&) = delete;
+
+  // Begins encodeBuffers() with the stream's metadata as it is now; once only.
+  void start(const vdbp::PointDataTree& tree, bool toHalf, const PointValues* values) {
+    const openvdb::io::StreamMetadata::Ptr now = openvdb::io::getStreamMetadataPtr(os_);
+    if (started_ || !now) return;
+    started_ = true;
+    metadata_ = std::make_shared<openvdb::io::StreamMetadata>(*now);
+    // The topology's writer (RootNode::writeTopology()) points the stream at the tree's
+    // background value, which the leaves' compression reads.
+    metadata_->setBackgroundPtr(&tree.background());
+    madeFor_ = metadata_->str();
+    group_.run([this, &tree, toHalf, values] {
+      buffers_ = encodeBuffers(tree, toHalf, values, metadata_);
+    });
+  }
+  // What start() made, once made (an exception it threw is thrown here), when it was made with
+  // stream metadata like `metadata`; null otherwise, or when it was not started.
+  std::unique_ptr<DeferredBuffers> take(const openvdb::io::StreamMetadata& metadata) {
+    if (!started_) return nullptr;
+    {
+      const profile::ParallelScope parallel;
+      group_.wait();
+    }
+    started_ = false;
+    if (metadata.str() != madeFor_ || metadata.backgroundPtr() != metadata_->backgroundPtr())
+      return nullptr;
+    return std::move(buffers_);
+  }
+
+ private:
+  std::ios_base& os_;  // (getStreamMetadataPtr() takes it non-const)
+  tbb::task_group group_;
+  bool started_ = false;
+  openvdb::io::StreamMetadata::Ptr metadata_;
+  std::string madeFor_;
+  std::unique_ptr<DeferredBuffers> buffers_;
+};
+
+// Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel but
+// for the parts left to `deferred` (DeferredBuffers: `os` skips their bytes), and returns true;
+// or writes nothing and returns false when encodeBuffers() makes nothing or `os` does not write
+// into a MemorySink. The buffers are those `ahead` made, where it made them for this stream.
+bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const PointValues* values,
+                            std::ostream& os, BuffersAhead* ahead,
+                            std::unique_ptr<EncodedPointsFile::Deferred>& deferred) {
+  auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
+  const openvdb::io::StreamMetadata::Ptr metadata = openvdb::io::getStreamMetadataPtr(os);
+  std::unique_ptr<DeferredBuffers> buffers =
+      ahead != nullptr && metadata ? ahead->take(*metadata) : nullptr;
+  if (!tree.cbeginLeaf()) return false;
+  if (sink == nullptr) {
+    if (values == nullptr) return false;
+    throw std::logic_error("VDB points: placeholder arrays that cannot be encoded in parallel");
+  }
+  if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
+  if (!buffers) buffers = encodeBuffers(tree, toHalf, values, metadata);
+  if (!buffers) return false;  // (never with placeholders: they are checked, and there are leaves)
+  const auto passes = static_cast<std::uint16_t>(tree.cbeginLeaf()->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
-  auto buffers = std::make_unique<DeferredBuffers>(std::move(all), metadata, std::move(rangeBytes),
-                                                   std::move(pages), std::move(parts));
   sink->skip(buffers->offset(buffers->parts()));
   deferred = std::move(buffers);
   return true;
@@ -727,12 +795,15 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
 // into the grid's descriptor itself.
 // With placeholder arrays (`values`), memUsage() is what the grid would use with its arrays
 // expanded, and so is that of the shallow copy Archive::write() makes to record it in the file
-// (file_mem_bytes).
+// (file_mem_bytes). That copy (copyGrid() const, the one Archive::write() calls) starts `ahead`.
 class ParallelBuffersGrid final : public vdbp::PointDataGrid {
  public:
-  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues* values,
+  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues* values, BuffersAhead* ahead,
                       std::unique_ptr<EncodedPointsFile::Deferred>* deferred)
-      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()), values_(values), deferred_(deferred) {
+      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()),
+        values_(values),
+        ahead_(ahead),
+        deferred_(deferred) {
     if (values_ == nullptr) return;
     // Each leaf past the first lacks the first's attribute set but for its arrays' sizes; each
     // array, expanded, holds its leaf's point count of values where a placeholder holds one.
@@ -750,7 +821,7 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
     expandedExtra_ += (leaves - 1) * setBytes;
   }
   void writeBuffers(std::ostream& os) const override {
-    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), values_, os, *deferred_))
+    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), values_, os, ahead_, *deferred_))
       vdbp::PointDataGrid::writeBuffers(os);
   }
   openvdb::Index64 memUsage() const override {
@@ -760,18 +831,21 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
   ParallelBuffersGrid(ParallelBuffersGrid& grid, openvdb::ShallowCopy)
       : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()),
         values_(grid.values_),
+        ahead_(grid.ahead_),
         deferred_(grid.deferred_),
         expandedExtra_(grid.expandedExtra_) {}
   openvdb::GridBase::Ptr copyGrid() override {
     return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
   }
   openvdb::GridBase::ConstPtr copyGrid() const override {
+    if (ahead_ != nullptr) ahead_->start(constTree(), saveFloatAsHalf(), values_);
     return std::make_shared<ParallelBuffersGrid>(const_cast<ParallelBuffersGrid&>(*this),
                                                  openvdb::ShallowCopy());
   }
 
  private:
   const PointValues* values_ = nullptr;
+  BuffersAhead* ahead_ = nullptr;
   std::unique_ptr<EncodedPointsFile::Deferred>* deferred_;  // where writeBuffers() leaves them
   openvdb::Index64 expandedExtra_ = 0;
 };
@@ -880,10 +954,11 @@ void EncodedPointsFile::write(std::ostream& out) const {
 EncodedPointsFile encodePointsFileDeferred(vdbp::PointDataGrid& grid, std::uint32_t compression,
                                            const PointValues* values, std::size_t expectedBytes) {
   std::unique_ptr<EncodedPointsFile::Deferred> deferred;
-  const openvdb::GridCPtrVec grids{
-      std::make_shared<const ParallelBuffersGrid>(grid, values, &deferred)};
   MemorySink sink(expectedBytes);
   std::ostream os(&sink);
+  BuffersAhead ahead(os);
+  const openvdb::GridCPtrVec grids{
+      std::make_shared<const ParallelBuffersGrid>(grid, values, &ahead, &deferred)};
   PointsArchive(compression).writeSeekable(os, grids);
   if (!os) throw std::runtime_error("cannot encode the VDB points grid");
   const std::size_t at = deferred ? sink.gapAt() : sink.held();

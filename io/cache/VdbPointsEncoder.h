@@ -115,7 +115,8 @@ class EncodedPointsFile {
 /// OpenVDB writes the header, the grid's descriptor (and the offsets it patches in), its
 /// metadata, transform and topology, as ever; the leaves' buffers, nearly all of the file, are
 /// made by OpenVDB's own leaf and attribute writers on every thread (TBB), leaf range by leaf
-/// range and, with blosc, page by page, into place at offsets summed in advance. The bytes do not
+/// range and, with blosc, page by page, into place at offsets summed in advance; they are begun
+/// on other threads while this one writes the header and topology. The bytes do not
 /// depend on the thread count. A grid this cannot split (leaves whose attributes differ, arrays
 /// not in memory) or without a leaf is written by OpenVDB alone, to the same bytes.
 /// `expectedBytes`: the room reserved for the header, metadata and topology.
