@@ -575,6 +575,36 @@ struct Part {
   std::size_t attribute = 0, begin = 0, end = 0;
 };
 
+// Bytes [from, to) of the `size` bytes of writeArrays(…, begin, end, a, …), at `out`: each leaf's
+// array that lies whole in the range written into place, one cut by it through a copy.
+void writeArraysSlice(const Leaves& all, std::size_t begin, std::size_t end, std::size_t a,
+                      const openvdb::io::StreamMetadata& metadata, std::size_t size,
+                      std::size_t from, std::size_t to, char* out) {
+  if (from == 0 && to == size) return writeArrays(all, begin, end, a, metadata, out, size);
+  std::vector<char> copy;
+  if (all.values == nullptr) {  // (OpenVDB writes the arrays: the whole part, then the slice)
+    copy.resize(size);
+    writeArrays(all, begin, end, a, metadata, copy.data(), size);
+    std::memcpy(out, copy.data() + from, to - from);
+    return;
+  }
+  std::size_t at = 0;  // where leaf l's array starts
+  for (std::size_t l = begin; l < end && at < to; ++l) {
+    const std::size_t bytes = 1 + all.arrayBytes(l, a), next = at + bytes;
+    if (next > from) {
+      if (at >= from && next <= to) {
+        writeArrays(all, l, l + 1, a, metadata, out + (at - from), bytes);
+      } else {
+        copy.resize(bytes);
+        writeArrays(all, l, l + 1, a, metadata, copy.data(), bytes);
+        const std::size_t first = std::max(at, from), last = std::min(next, to);
+        std::memcpy(out + (first - from), copy.data() + (first - at), last - first);
+      }
+    }
+    at = next;
+  }
+}
+
 // The leaves' buffers but the pass count, as parts in the file's order: each made already but
 // for the unpaged arrays, stored when fill() is called. Owns what the parts point into.
 class DeferredBuffers final : public EncodedPointsFile::Deferred {
@@ -590,17 +620,22 @@ class DeferredBuffers final : public EncodedPointsFile::Deferred {
         offsets_(parts_.size() + 1, 0) {
     for (std::size_t p = 0; p < parts_.size(); ++p) offsets_[p + 1] = offsets_[p] + parts_[p].size;
   }
-  std::size_t parts() const override { return parts_.size(); }
-  std::size_t offset(std::size_t p) const override { return offsets_[p]; }
-  void fill(std::size_t begin, std::size_t end, char* to) const override {
-    for (std::size_t p = begin; p < end; ++p) {
+  std::size_t size() const override { return offsets_.back(); }
+  void fill(std::size_t from, std::size_t to, char* out) const override {
+    // The parts that [from, to) overlaps, the first found by a binary search.
+    auto p = static_cast<std::size_t>(std::upper_bound(offsets_.begin(), offsets_.end(), from) -
+                                      offsets_.begin());
+    for (p = p == 0 ? 0 : p - 1; p < parts_.size() && offsets_[p] < to; ++p) {
       const Part& part = parts_[p];
-      char* const at = to + (offsets_[p] - offsets_[begin]);
-      if (part.size == 0) continue;
+      const std::size_t first = std::max(from, offsets_[p]), last = std::min(to, offsets_[p + 1]);
+      if (first >= last) continue;
+      char* const at = out + (first - from);
+      const std::size_t inFrom = first - offsets_[p], inTo = last - offsets_[p];
       if (part.data != nullptr) {
-        std::memcpy(at, part.data, part.size);
+        std::memcpy(at, part.data + inFrom, inTo - inFrom);
       } else {
-        writeArrays(all_, part.begin, part.end, part.attribute, *metadata_, at, part.size);
+        writeArraysSlice(all_, part.begin, part.end, part.attribute, *metadata_, part.size, inFrom,
+                         inTo, at);
       }
     }
   }
@@ -784,7 +819,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
   if (!buffers) return false;  // (never with placeholders: they are checked, and there are leaves)
   const auto passes = static_cast<std::uint16_t>(tree.cbeginLeaf()->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
-  sink->skip(buffers->offset(buffers->parts()));
+  sink->skip(buffers->size());
   deferred = std::move(buffers);
   return true;
 }
@@ -871,45 +906,51 @@ EncodedPointsFile::EncodedPointsFile(FileBytes known, std::size_t deferredAt,
 EncodedPointsFile::~EncodedPointsFile() = default;
 
 std::size_t EncodedPointsFile::size() const {
-  return known_.size() + (deferred_ ? deferred_->offset(deferred_->parts()) : 0);
-}
-
-FileBytes EncodedPointsFile::bytes() const {
-  FileBytes file(FileBytes::allocate(size()), size());
-  char* const to = file.data();
-  std::memcpy(to, known_.data(), at_);
-  std::size_t end = at_;
-  if (deferred_) {
-    const Deferred& d = *deferred_;
-    par::parallel_for(tbb::blocked_range<std::size_t>(0, d.parts(), 1),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        d.fill(r.begin(), r.end(), to + at_ + d.offset(r.begin()));
-                      });
-    end += d.offset(d.parts());
-  }
-  std::memcpy(to + end, known_.data() + at_, known_.size() - at_);
-  return file;
+  return known_.size() + (deferred_ ? deferred_->size() : 0);
 }
 
 namespace {
 
-// The deferred bytes are written in chunks of consecutive parts of about this size (a part
-// larger is a chunk alone): small enough to stay in the cache from being made to being copied
-// by the kernel, large enough that a write() call's cost is nothing beside the copy.
+// The file is made and written in chunks of this many bytes (the last shorter): small enough to
+// stay in the cache from being made to being copied by the kernel, large enough that a write()
+// call's cost is nothing beside the copy, and a multiple of the page cache's large folios.
 constexpr std::size_t kChunkBytes = std::size_t{512} << 10;
 
-void writeDeferred(const EncodedPointsFile::Deferred& d, std::ostream& out) {
-  std::vector<std::size_t> chunks{0};  // each chunk's first part, and the end
-  std::size_t largest = 0;
-  for (std::size_t p = 1; p <= d.parts(); ++p) {
-    if (p == d.parts() || d.offset(p + 1) - d.offset(chunks.back()) > kChunkBytes) {
-      largest = std::max(largest, d.offset(p) - d.offset(chunks.back()));
-      chunks.push_back(p);
-    }
-  }
+}  // namespace
+
+void EncodedPointsFile::fill(std::size_t from, std::size_t to, char* out) const {
+  const std::size_t deferred = deferred_ ? deferred_->size() : 0, end = at_ + deferred;
+  // The known bytes before the deferred ones, the deferred ones, the known ones after.
+  const auto copy = [&](std::size_t first, std::size_t last, const auto& put) {
+    first = std::max(first, from);
+    last = std::min(last, to);
+    if (first < last) put(first, last, out + (first - from));
+  };
+  copy(0, at_,
+       [&](std::size_t a, std::size_t b, char* o) { std::memcpy(o, known_.data() + a, b - a); });
+  copy(at_, end,
+       [&](std::size_t a, std::size_t b, char* o) { deferred_->fill(a - at_, b - at_, o); });
+  copy(end, end + (known_.size() - at_), [&](std::size_t a, std::size_t b, char* o) {
+    std::memcpy(o, known_.data() + (a - deferred), b - a);
+  });
+}
+
+FileBytes EncodedPointsFile::bytes() const {
+  FileBytes file(FileBytes::allocate(size()), size());
+  const std::size_t chunks = (size() + kChunkBytes - 1) / kChunkBytes;
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      const std::size_t from = r.begin() * kChunkBytes;
+                      fill(from, std::min(size(), r.end() * kChunkBytes), file.data() + from);
+                    });
+  return file;
+}
+
+void EncodedPointsFile::write(std::ostream& out) const {
+  const std::size_t size = this->size(), chunks = (size + kChunkBytes - 1) / kChunkBytes;
   // One buffer a chunk in flight, made by one thread while another writes the one before.
   const std::size_t tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-  const FileBytes::Storage room = FileBytes::allocate(tokens * largest);
+  const FileBytes::Storage room = FileBytes::allocate(tokens * kChunkBytes);
   std::vector<std::size_t> free(tokens);
   for (std::size_t t = 0; t < tokens; ++t) free[t] = t;
   std::mutex freeLock;
@@ -918,7 +959,7 @@ void writeDeferred(const EncodedPointsFile::Deferred& d, std::ostream& out) {
   };
   std::size_t next = 0;
   const auto take = [&](tbb::flow_control& control) {
-    if (next + 1 >= chunks.size()) {
+    if (next >= chunks) {
       control.stop();
       return Chunk{};
     }
@@ -927,13 +968,18 @@ void writeDeferred(const EncodedPointsFile::Deferred& d, std::ostream& out) {
     free.pop_back();
     return chunk;
   };
+  const auto bounds = [&](const Chunk& chunk) {
+    return std::pair{chunk.index * kChunkBytes, std::min(size, (chunk.index + 1) * kChunkBytes)};
+  };
   const auto make = [&](Chunk chunk) {
-    d.fill(chunks[chunk.index], chunks[chunk.index + 1], room.get() + chunk.slot * largest);
+    const auto [from, to] = bounds(chunk);
+    fill(from, to, room.get() + chunk.slot * kChunkBytes);
     return chunk;
   };
   const auto put = [&](Chunk chunk) {
-    const std::size_t size = d.offset(chunks[chunk.index + 1]) - d.offset(chunks[chunk.index]);
-    if (out) out.write(room.get() + chunk.slot * largest, static_cast<std::streamsize>(size));
+    const auto [from, to] = bounds(chunk);
+    if (out)
+      out.write(room.get() + chunk.slot * kChunkBytes, static_cast<std::streamsize>(to - from));
     const std::lock_guard lock(freeLock);
     free.push_back(chunk.slot);
   };
@@ -941,14 +987,6 @@ void writeDeferred(const EncodedPointsFile::Deferred& d, std::ostream& out) {
                          tbb::make_filter<void, Chunk>(tbb::filter_mode::serial_in_order, take) &
                              tbb::make_filter<Chunk, Chunk>(tbb::filter_mode::parallel, make) &
                              tbb::make_filter<Chunk, void>(tbb::filter_mode::serial_in_order, put));
-}
-
-}  // namespace
-
-void EncodedPointsFile::write(std::ostream& out) const {
-  out.write(known_.data(), static_cast<std::streamsize>(at_));
-  if (deferred_ && out) writeDeferred(*deferred_, out);
-  if (out) out.write(known_.data() + at_, static_cast<std::streamsize>(known_.size() - at_));
 }
 
 EncodedPointsFile encodePointsFileDeferred(vdbp::PointDataGrid& grid, std::uint32_t compression,
