@@ -304,32 +304,6 @@ template <bool Quantised>
 }
 #endif
 
-// The placement and leaf index loops on one instruction set, chosen once (activeIsa()).
-template <bool Quantised>
-struct RowPlacer {
-  using Place = void (*)(const Positions&, std::size_t, std::size_t, PlacedRows&);
-  using Index = bool (*)(const PlacedRows&, std::size_t, const LeafBox&, std::uint32_t*);
-  Place place = &placeRowsBaseline<Quantised>;
-  Index index = &leafIndices;
-
-  RowPlacer() {
-#ifdef TICKFX_AVX2_CLONES
-    switch (activeIsa()) {
-      case Isa::Avx512:
-        place = &placeRowsAvx512<Quantised>;
-        index = &leafIndicesAvx512;
-        break;
-      case Isa::Avx2:
-        place = &placeRowsAvx2<Quantised>;
-        index = &leafIndicesAvx2;
-        break;
-      case Isa::Baseline:
-        break;
-    }
-#endif
-  }
-};
-
 // Each point's leaf and voxel offset within its leaf (0 to 511), in row order (sorted below).
 template <bool Quantised>
 std::vector<PointSlot> slotsInRowOrder(const FrameData& frame) {
@@ -419,6 +393,44 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
   return true;
 }
 
+// Consecutive leaves gathered for the counting sort: at most kBucketLeaves leaves and, unless a
+// leaf alone holds more, kBucketPoints points or a kBucketShare-th of the frame's, whichever is
+// more. Rows are first scattered by bucket (some 140 streams at 10⁶ and 10⁷ points over a 100 m
+// box, where a scatter by leaf wrote 2200 and missed the cache on nearly every value), each
+// bucket's rows in row order; then each bucket, small enough for the cache, is put in order by
+// leaf and voxel.
+constexpr std::size_t kBucketPoints = 8192;
+constexpr std::size_t kBucketShare = 128;
+constexpr std::uint32_t kBucketLeaves = 16;
+constexpr unsigned kVoxelBits = 3 * Leaf::LOG2DIM;  // a voxel's index in its leaf
+static_assert(std::size_t{1} << kVoxelBits == Leaf::SIZE);
+static_assert((kBucketLeaves << kVoxelBits) - 1 <= std::numeric_limits<std::uint16_t>::max(),
+              "a point's key in its bucket (leaf, voxel) fits the voxel column's 16 bits");
+
+// The buckets of leaves whose points start at `starts` (and end at its last entry): first[b] is
+// bucket b's first leaf (first[count()] the number of leaves), of[l] the bucket of leaf l.
+struct Buckets {
+  std::vector<std::uint32_t> first, of;
+
+  Buckets() = default;
+  explicit Buckets(const std::vector<std::size_t>& starts) : of(starts.size() - 1) {
+    const std::size_t most = std::max(kBucketPoints, starts.back() / kBucketShare);
+    std::size_t points = 0;
+    for (std::uint32_t l = 0; l < of.size(); ++l) {
+      const std::size_t count = starts[l + 1] - starts[l];
+      if (first.empty() || l - first.back() >= kBucketLeaves ||
+          (points > 0 && points + count > most)) {
+        first.push_back(l);
+        points = 0;
+      }
+      of[l] = static_cast<std::uint32_t>(first.size() - 1);
+      points += count;
+    }
+    first.push_back(static_cast<std::uint32_t>(of.size()));
+  }
+  std::size_t count() const { return first.size() - 1; }
+};
+
 // The points in the order the leaves' arrays hold them: the leaves in Coord order (ascending, as
 // Coord's operator< orders them), a leaf's points by voxel, and in row order within a voxel. Each
 // point's values are copied here in that order, so that a leaf's array is one stretch of each
@@ -435,11 +447,10 @@ struct GroupedPoints {
   // Where set (bucketedPoints), `id` and `columns` are put in order bucket by bucket by the store
   // itself, as the file is written (orderLater()): each bucket's rows of them are still in row
   // order, rank[k] the place in its bucket of the point whose values are at row k, and
-  // later[b * (1 + columns.size()) + s] tells whether bucket b's column s (0: id, then
-  // columns[s − 1]) is in order (kOrdered), being put in order (kOrdering) or not yet.
+  // later[b * laterColumns() + s] tells whether bucket b's column s (0: id, then columns[s − 1])
+  // is in order (kOrdered), being put in order (kOrdering) or not yet.
   LargeArray<std::uint32_t> rank;
-  std::vector<std::uint32_t> bucketFirst;  // each bucket's first leaf, and the leaf count
-  std::vector<std::uint32_t> bucketOf;     // each leaf's bucket
+  Buckets buckets;
   std::unique_ptr<std::atomic<std::uint8_t>[]> later;
 
   GroupedPoints(std::size_t n, std::size_t floatColumnCount)
@@ -449,6 +460,8 @@ struct GroupedPoints {
     for (std::size_t j = 0; j < floatColumnCount; ++j)
       columns.push_back(allocateLargeArray<float>(n));
   }
+  // The columns `later` tells of for each bucket: the ids, then the float columns.
+  std::size_t laterColumns() const { return 1 + columns.size(); }
 };
 
 constexpr std::size_t kStandardFloatColumns = 6;  // velocity x, y, z, age, life, mass
@@ -565,57 +578,35 @@ bool extendBoundsBy(const float* x, std::size_t begin, std::size_t end, float& l
 }
 #endif
 
-// extendBoundsBy() on the widest instruction set here (particles/Isa.h).
-bool extendBounds([[maybe_unused]] Isa isa, const float* x, std::size_t begin, std::size_t end,
-                  float& low, float& high) {
+// The bounds', placement and leaf index loops above on one instruction set, the widest here,
+// chosen once (activeIsa()).
+template <bool Quantised>
+struct RowKernels {
+  using Bounds = bool (*)(const float*, std::size_t, std::size_t, float&, float&);
+  using Place = void (*)(const Positions&, std::size_t, std::size_t, PlacedRows&);
+  using Index = bool (*)(const PlacedRows&, std::size_t, const LeafBox&, std::uint32_t*);
+  Bounds bounds = &extendBoundsBy<Floats4, Ints4>;
+  Place place = &placeRowsBaseline<Quantised>;
+  Index index = &leafIndices;
+
+  RowKernels() {
 #ifdef TICKFX_AVX2_CLONES
-  switch (isa) {
-    case Isa::Avx512:
-      return extendBoundsAvx512(x, begin, end, low, high);
-    case Isa::Avx2:
-      return extendBoundsAvx2(x, begin, end, low, high);
-    case Isa::Baseline:
-      break;
-  }
-#endif
-  return extendBoundsBy<Floats4, Ints4>(x, begin, end, low, high);
-}
-
-// Consecutive leaves gathered for the counting sort: at most kBucketLeaves leaves and, unless a
-// leaf alone holds more, kBucketPoints points or a kBucketShare-th of the frame's, whichever is
-// more. Rows are first scattered by bucket (some 140 streams at 10⁶ and 10⁷ points over a 100 m
-// box, where a scatter by leaf wrote 2200 and missed the cache on nearly every value), each
-// bucket's rows in row order; then each bucket, small enough for the cache, is put in order by
-// leaf and voxel.
-constexpr std::size_t kBucketPoints = 8192;
-constexpr std::size_t kBucketShare = 128;
-constexpr std::uint32_t kBucketLeaves = 16;
-constexpr unsigned kVoxelBits = 3 * Leaf::LOG2DIM;  // a voxel's index in its leaf
-static_assert(std::size_t{1} << kVoxelBits == Leaf::SIZE);
-static_assert((kBucketLeaves << kVoxelBits) - 1 <= std::numeric_limits<std::uint16_t>::max(),
-              "a point's key in its bucket (leaf, voxel) fits the voxel column's 16 bits");
-
-// The buckets of leaves whose points start at `starts` (and end at its last entry): first[b] is
-// bucket b's first leaf (first[count()] the number of leaves), of[l] the bucket of leaf l.
-struct Buckets {
-  std::vector<std::uint32_t> first, of;
-
-  explicit Buckets(const std::vector<std::size_t>& starts) : of(starts.size() - 1) {
-    const std::size_t most = std::max(kBucketPoints, starts.back() / kBucketShare);
-    std::size_t points = 0;
-    for (std::uint32_t l = 0; l < of.size(); ++l) {
-      const std::size_t count = starts[l + 1] - starts[l];
-      if (first.empty() || l - first.back() >= kBucketLeaves ||
-          (points > 0 && points + count > most)) {
-        first.push_back(l);
-        points = 0;
-      }
-      of[l] = static_cast<std::uint32_t>(first.size() - 1);
-      points += count;
+    switch (activeIsa()) {
+      case Isa::Avx512:
+        bounds = &extendBoundsAvx512;
+        place = &placeRowsAvx512<Quantised>;
+        index = &leafIndicesAvx512;
+        break;
+      case Isa::Avx2:
+        bounds = &extendBoundsAvx2;
+        place = &placeRowsAvx2<Quantised>;
+        index = &leafIndicesAvx2;
+        break;
+      case Isa::Baseline:
+        break;
     }
-    first.push_back(static_cast<std::uint32_t>(of.size()));
+#endif
   }
-  std::size_t count() const { return first.size() - 1; }
 };
 
 // What orderBucket() reuses from one bucket to the next.
@@ -662,15 +653,15 @@ constexpr std::uint8_t kOrdering = 1, kOrdered = 2;
 // The store asks before reading a leaf's values (GroupedValues), so this runs beside the
 // kernel's copy of the chunk before, in time the writing threads would otherwise wait.
 void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScratch& scratch) {
-  std::atomic<std::uint8_t>& state = points.later[b * (1 + points.columns.size()) + s];
+  std::atomic<std::uint8_t>& state = points.later[b * points.laterColumns() + s];
   if (state.load(std::memory_order_acquire) == kOrdered) return;
   std::uint8_t expected = 0;
   if (!state.compare_exchange_strong(expected, kOrdering, std::memory_order_acquire)) {
     while (state.load(std::memory_order_acquire) != kOrdered) std::this_thread::yield();
     return;
   }
-  const std::size_t begin = points.starts[points.bucketFirst[b]];
-  const std::size_t count = points.starts[points.bucketFirst[b + 1]] - begin;
+  const std::size_t begin = points.starts[points.buckets.first[b]];
+  const std::size_t count = points.starts[points.buckets.first[b + 1]] - begin;
   const std::uint32_t* const rank = points.rank.get() + begin;
   try {
     if (s == 0)
@@ -687,11 +678,11 @@ void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScrat
 // Every column in order (OpenVDB's own writer reads the grouped points whole).
 void orderAllLater(GroupedPoints& points) {
   if (!points.later) return;
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.bucketFirst.size() - 1),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.buckets.count()),
                     [&](const tbb::blocked_range<std::size_t>& some) {
                       BucketScratch scratch;
                       for (std::size_t b = some.begin(); b < some.end(); ++b)
-                        for (std::size_t s = 0; s <= points.columns.size(); ++s)
+                        for (std::size_t s = 0; s < points.laterColumns(); ++s)
                           orderLater(points, b, s, scratch);
                     });
 }
@@ -714,13 +705,13 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   Range init;
   init.low.fill(std::numeric_limits<float>::infinity());
   init.high.fill(-std::numeric_limits<float>::infinity());
-  const Isa isa = activeIsa();
+  const RowKernels<Quantised> kernels;
   const Range range = par::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, kPlacementGrain), init,
       [&](const tbb::blocked_range<std::size_t>& rows, Range r) {
         for (std::size_t c = 0; c < 3; ++c) {
-          r.placedAtZero |= extendBounds(isa, frame.position[static_cast<int>(c)].data(),
-                                         rows.begin(), rows.end(), r.low[c], r.high[c]);
+          r.placedAtZero |= kernels.bounds(frame.position[static_cast<int>(c)].data(), rows.begin(),
+                                           rows.end(), r.low[c], r.high[c]);
         }
         return r;
       },
@@ -772,7 +763,6 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   };
   // Each row's leaf, and each chunk's count of rows a leaf.
   const Positions positions(frame);
-  const RowPlacer<Quantised> placer;
   const LargeArray<std::uint32_t> rowAt = allocateLargeArray<std::uint32_t>(n);
   std::vector<std::uint32_t> table(leaves * chunks, 0);
   std::vector<char> outsideBox(chunks, 0);
@@ -782,10 +772,10 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     PlacedRows placed;
     for (std::size_t first = begin; first < end; first += kPlacedRows) {
       const std::size_t rows = std::min(kPlacedRows, end - first);
-      placer.place(positions, first, rows, placed);
+      kernels.place(positions, first, rows, placed);
       std::uint32_t* const leaf = rowAt.get() + first;
       // (Never outside, as the box is made; but a wrong box must not write past the table.)
-      if (!placer.index(placed, rows, leafBox, leaf)) {
+      if (!kernels.index(placed, rows, leafBox, leaf)) {
         outsideBox[chunk] = 1;
         return;
       }
@@ -813,7 +803,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                                             static_cast<openvdb::Int32>(z << kLeafLog2)));
   }
   points.starts.push_back(n);
-  const Buckets buckets(points.starts);
+  Buckets buckets(points.starts);
   // Each box leaf's bucket and place in it (bucket << 4 | place), looked up once a row.
   static_assert(kBucketLeaves <= 16);
   std::vector<std::uint32_t> bucketPlace(leaves);
@@ -847,7 +837,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                         const auto [begin, end] = chunkRange(chunk);
                         for (std::size_t first = begin; first < end; first += kPlacedRows) {
                           const std::size_t rows = std::min(kPlacedRows, end - first);
-                          placer.place(positions, first, rows, placed);
+                          kernels.place(positions, first, rows, placed);
                           for (std::size_t k = 0; k < rows; ++k) {
                             const std::uint32_t p = bucketPlace[at[first + k]];
                             const std::uint32_t to = chunkNext[p >> 4]++;
@@ -877,9 +867,8 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                                     buckets.first[b + 1] - buckets.first[b], scratch);
                       }
                     });
-  points.bucketFirst = buckets.first;
-  points.bucketOf = buckets.of;
-  const std::size_t later = bucketCount * (1 + points.columns.size());
+  points.buckets = std::move(buckets);
+  const std::size_t later = bucketCount * points.laterColumns();
   points.later = std::make_unique<std::atomic<std::uint8_t>[]>(later);  // (zeroed: not yet)
   return points;
 }
@@ -892,6 +881,12 @@ struct GridAttribute {
   std::string name;
   Kind kind = Kind::Float;
   std::size_t column = 0;
+
+  // How many of GroupedPoints::columns it reads, from `column` on (the offsets and the ids are
+  // columns apart).
+  std::size_t floatColumns() const {
+    return kind == Kind::Vector ? 3 : kind == Kind::Float || kind == Kind::Int ? 1 : 0;
+  }
 };
 
 // The grid's attributes of a frame with these attribute columns.
@@ -1092,22 +1087,13 @@ class GroupedValues final : public PointValues {
     return static_cast<std::size_t>(leaf - origins.begin());
   }
 
-  // The columns attribute `a` reads, in order in leaf l's bucket.
+  // The columns attribute `a` reads, in order in leaf l's bucket (the offsets are ordered with
+  // the voxels).
   void orderColumns(std::size_t l, const GridAttribute& a, BucketScratch& scratch) const {
-    using Kind = GridAttribute::Kind;
-    const std::size_t b = points_.bucketOf[l];
-    switch (a.kind) {
-      case Kind::Position:
-        return;  // (the offsets are ordered with the voxels)
-      case Kind::Id:
-        return orderLater(points_, b, 0, scratch);
-      case Kind::Vector:
-        for (std::size_t j = 0; j < 3; ++j) orderLater(points_, b, 1 + a.column + j, scratch);
-        return;
-      case Kind::Float:
-      case Kind::Int:
-        return orderLater(points_, b, 1 + a.column, scratch);
-    }
+    const std::size_t b = points_.buckets.of[l];
+    if (a.kind == GridAttribute::Kind::Id) orderLater(points_, b, 0, scratch);
+    for (std::size_t j = 0; j < a.floatColumns(); ++j)
+      orderLater(points_, b, 1 + a.column + j, scratch);
   }
 
   template <typename Array>
