@@ -272,11 +272,6 @@ bool leafIndices(const PlacedRows& placed, std::size_t count, const LeafBox& box
 
 // placeRows() and leafIndices() compiled for each instruction set (particles/Isa.h), whole
 // (flatten): the same bits on each, as they use integer operations and IEEE arithmetic alone.
-template <bool Quantised>
-void placeRowsBaseline(const Positions& positions, std::size_t begin, std::size_t count,
-                       PlacedRows& placed) {
-  placeRows<Quantised>(positions, begin, count, placed);
-}
 #ifdef TICKFX_AVX2_CLONES
 template <bool Quantised>
 [[gnu::target("avx2"), gnu::flatten]] void placeRowsAvx2(const Positions& positions,
@@ -462,6 +457,10 @@ struct GroupedPoints {
   }
   // The columns `later` tells of for each bucket: the ids, then the float columns.
   std::size_t laterColumns() const { return 1 + columns.size(); }
+  // The points of bucket b: [first, second).
+  std::pair<std::size_t, std::size_t> bucketPoints(std::size_t b) const {
+    return {starts[buckets.first[b]], starts[buckets.first[b + 1]]};
+  }
 };
 
 constexpr std::size_t kStandardFloatColumns = 6;  // velocity x, y, z, age, life, mass
@@ -586,7 +585,7 @@ struct RowKernels {
   using Place = void (*)(const Positions&, std::size_t, std::size_t, PlacedRows&);
   using Index = bool (*)(const PlacedRows&, std::size_t, const LeafBox&, std::uint32_t*);
   Bounds bounds = &extendBoundsBy<Floats4, Ints4>;
-  Place place = &placeRowsBaseline<Quantised>;
+  Place place = &placeRows<Quantised>;
   Index index = &leafIndices;
 
   RowKernels() {
@@ -626,14 +625,15 @@ void permute(T* __restrict column, const std::uint32_t* __restrict rank, std::si
   for (std::size_t i = 0; i < count; ++i) column[rank[i]] = copy[i];
 }
 
-// Puts points [begin, end), a bucket of `leaves` leaves in row order whose voxel column holds
+// Puts bucket b's points, in row order and with a voxel column that holds
 // each point's key (its leaf's place in the bucket, then its voxel), in order by key, rows in
 // order among equal keys (a counting sort): the voxel column then holds each point's voxel, and
 // the offsets are moved alike. Each point's place is kept in `rank` for the columns the store
 // puts in order later (orderLater()).
-void orderBucket(GroupedPoints& points, std::size_t begin, std::size_t end, std::size_t leaves,
-                 BucketScratch& scratch) {
+void orderBucket(GroupedPoints& points, std::size_t b, BucketScratch& scratch) {
+  const auto [begin, end] = points.bucketPoints(b);
   const std::size_t count = end - begin;
+  const std::size_t leaves = points.buckets.first[b + 1] - points.buckets.first[b];
   std::uint16_t* const key = points.voxel.get() + begin;
   scratch.counts.assign(leaves << kVoxelBits, 0);
   for (std::size_t i = 0; i < count; ++i) ++scratch.counts[key[i]];
@@ -660,8 +660,8 @@ void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScrat
     while (state.load(std::memory_order_acquire) != kOrdered) std::this_thread::yield();
     return;
   }
-  const std::size_t begin = points.starts[points.buckets.first[b]];
-  const std::size_t count = points.starts[points.buckets.first[b + 1]] - begin;
+  const auto [begin, end] = points.bucketPoints(b);
+  const std::size_t count = end - begin;
   const std::uint32_t* const rank = points.rank.get() + begin;
   try {
     if (s == 0)
@@ -858,16 +858,13 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                     });
   // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
   points.rank = allocateLargeArray<std::uint32_t>(n);
+  points.buckets = std::move(buckets);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, bucketCount),
                     [&](const tbb::blocked_range<std::size_t>& some) {
                       BucketScratch scratch;
-                      for (std::size_t b = some.begin(); b < some.end(); ++b) {
-                        orderBucket(points, points.starts[buckets.first[b]],
-                                    points.starts[buckets.first[b + 1]],
-                                    buckets.first[b + 1] - buckets.first[b], scratch);
-                      }
+                      for (std::size_t b = some.begin(); b < some.end(); ++b)
+                        orderBucket(points, b, scratch);
                     });
-  points.buckets = std::move(buckets);
   const std::size_t later = bucketCount * points.laterColumns();
   points.later = std::make_unique<std::atomic<std::uint8_t>[]>(later);  // (zeroed: not yet)
   return points;

@@ -582,15 +582,9 @@ void writeArraysSlice(const Leaves& all, std::size_t begin, std::size_t end, std
                       std::size_t from, std::size_t to, char* out) {
   if (from == 0 && to == size) return writeArrays(all, begin, end, a, metadata, out, size);
   std::vector<char> copy;
-  if (all.values == nullptr) {  // (OpenVDB writes the arrays: the whole part, then the slice)
-    copy.resize(size);
-    writeArrays(all, begin, end, a, metadata, copy.data(), size);
-    std::memcpy(out, copy.data() + from, to - from);
-    return;
-  }
   std::size_t at = 0;  // where leaf l's array starts
   for (std::size_t l = begin; l < end && at < to; ++l) {
-    const std::size_t bytes = 1 + all.arrayBytes(l, a), next = at + bytes;
+    const std::size_t bytes = unpagedBytes(all, l, a), next = at + bytes;
     if (next > from) {
       if (at >= from && next <= to) {
         writeArrays(all, l, l + 1, a, metadata, out + (at - from), bytes);
@@ -916,6 +910,12 @@ namespace {
 // call's cost is nothing beside the copy, and a multiple of the page cache's large folios.
 constexpr std::size_t kChunkBytes = std::size_t{512} << 10;
 
+// Chunk `c` of a file of `size` bytes: [first, second).
+std::pair<std::size_t, std::size_t> chunkBytes(std::size_t c, std::size_t size) {
+  return {c * kChunkBytes, std::min(size, (c + 1) * kChunkBytes)};
+}
+std::size_t chunkCount(std::size_t size) { return (size + kChunkBytes - 1) / kChunkBytes; }
+
 }  // namespace
 
 void EncodedPointsFile::fill(std::size_t from, std::size_t to, char* out) const {
@@ -937,17 +937,18 @@ void EncodedPointsFile::fill(std::size_t from, std::size_t to, char* out) const 
 
 FileBytes EncodedPointsFile::bytes() const {
   FileBytes file(FileBytes::allocate(size()), size());
-  const std::size_t chunks = (size() + kChunkBytes - 1) / kChunkBytes;
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, chunkCount(size()), 1),
                     [&](const tbb::blocked_range<std::size_t>& r) {
-                      const std::size_t from = r.begin() * kChunkBytes;
-                      fill(from, std::min(size(), r.end() * kChunkBytes), file.data() + from);
+                      for (std::size_t c = r.begin(); c < r.end(); ++c) {
+                        const auto [from, to] = chunkBytes(c, size());
+                        fill(from, to, file.data() + from);
+                      }
                     });
   return file;
 }
 
 void EncodedPointsFile::write(std::ostream& out) const {
-  const std::size_t size = this->size(), chunks = (size + kChunkBytes - 1) / kChunkBytes;
+  const std::size_t size = this->size(), chunks = chunkCount(size);
   // One buffer a chunk in flight, made by one thread while another writes the one before.
   const std::size_t tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   const FileBytes::Storage room = FileBytes::allocate(tokens * kChunkBytes);
@@ -968,16 +969,13 @@ void EncodedPointsFile::write(std::ostream& out) const {
     free.pop_back();
     return chunk;
   };
-  const auto bounds = [&](const Chunk& chunk) {
-    return std::pair{chunk.index * kChunkBytes, std::min(size, (chunk.index + 1) * kChunkBytes)};
-  };
   const auto make = [&](Chunk chunk) {
-    const auto [from, to] = bounds(chunk);
+    const auto [from, to] = chunkBytes(chunk.index, size);
     fill(from, to, room.get() + chunk.slot * kChunkBytes);
     return chunk;
   };
   const auto put = [&](Chunk chunk) {
-    const auto [from, to] = bounds(chunk);
+    const auto [from, to] = chunkBytes(chunk.index, size);
     if (out)
       out.write(room.get() + chunk.slot * kChunkBytes, static_cast<std::streamsize>(to - from));
     const std::lock_guard lock(freeLock);
