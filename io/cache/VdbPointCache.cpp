@@ -1172,7 +1172,7 @@ void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
   if (auto first = tree->beginLeaf()) addUniformArrays(*first, descriptor);
   const vdbp::PointDataGrid::Ptr grid = makeGrid(tree, frame, meta);
   const GroupedValues<PositionArray> values(points, std::move(attributes));
-  EncodedPointsFile file = encodePointsFileDeferred(*grid, compressionFlags(options), &values);
+  EncodedPointsFile file = encodePointsFile(*grid, compressionFlags(options), values);
   use(file);
 }
 

@@ -204,10 +204,9 @@ class MemorySink final : public std::streambuf {
   std::size_t gapAt_ = 0, gapSize_ = 0;
 };
 
-// A stretch of bytes of the file, in memory owned elsewhere; or, where `data` is null, leaf
-// `leaf`'s array of the attribute at hand, its values to be stored by the caller's PointValues.
+// Leaf `leaf`'s array of the attribute at hand, `size` bytes, its values to be stored by the
+// caller's PointValues.
 struct Piece {
-  const char* data = nullptr;
   std::size_t size = 0;
   std::size_t leaf = 0;
 };
@@ -241,12 +240,12 @@ struct Piece {
 constexpr std::size_t kRangePoints = 16384;  // a leaf range ends once it holds this many points
 constexpr std::size_t kRangeLeaves = 64;     // or this many leaves
 
-// The leaves in the tree's order, and where their arrays are placeholders (encodePointsFile's
-// `values`) what stands in for the arrays: each leaf's point count, each attribute's bytes a
-// value, and each attribute's metadata record as OpenVDB writes it for leaf 0's array expanded.
+// The leaves in the tree's order, and what stands in for their arrays, placeholders
+// (encodePointsFile's `values`): each leaf's point count, each attribute's bytes a value, and
+// each attribute's metadata record as OpenVDB writes it for leaf 0's array expanded.
 struct Leaves {
   std::vector<const Leaf*> leaf;
-  const PointValues* values = nullptr;
+  const PointValues* values = nullptr;  // (never null)
   std::vector<std::size_t> count;
   std::vector<std::size_t> storage;
   std::vector<std::string> metadata;
@@ -401,11 +400,7 @@ void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
       out.write(reinterpret_cast<const char*>(&shared), sizeof shared);
       set.writeDescriptor(out, /*outputTransient=*/false);
     }
-    if (all.values == nullptr) {
-      set.writeMetadata(out, /*outputTransient=*/false, /*paged=*/true);
-    } else {
-      for (std::size_t a = 0; a < all.metadata.size(); ++a) writeArrayMetadata(all, l, a, out);
-    }
+    for (std::size_t a = 0; a < all.metadata.size(); ++a) writeArrayMetadata(all, l, a, out);
   }
   range.ends[1] = range.sink->size();
   out.write(voxels.data(), static_cast<std::streamsize>(voxels.size()));
@@ -413,48 +408,26 @@ void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
   if (!out) throw std::runtime_error("cannot encode the VDB points' leaves");
 }
 
-// What AttributeArray::writeBuffers() writes for `array` without blosc (points/AttributeArray.h):
-// nothing for a transient array, the one value of a uniform one, else a flag byte (0: not
-// compressed) and the values.
-// A placeholder stands for an array expanded, never transient.
+// What AttributeArray::writeBuffers() writes without blosc (points/AttributeArray.h) for leaf
+// l's array of attribute a expanded (a placeholder stands for an array neither uniform nor
+// transient): a flag byte (0: not compressed) and the values.
 std::size_t unpagedBytes(const Leaves& all, std::size_t l, std::size_t a) {
-  if (all.values != nullptr) return 1 + all.arrayBytes(l, a);
-  const vdbp::AttributeArray& array = *all.leaf[l]->attributeSet().getConst(a);
-  if (array.isTransient()) return 0;
-  if (array.isUniform()) return array.storageTypeSize();
-  return 1 + std::size_t{array.dataSize()} * array.storageTypeSize();
+  return 1 + all.arrayBytes(l, a);
 }
 
-// A stream buffer over a stretch of memory of a fixed size: a write past its end fails.
-class SpanSink final : public std::streambuf {
- public:
-  SpanSink(char* data, std::size_t size) { setp(data, data + size); }
-  bool full() const { return pptr() == epptr(); }
-};
-
-// Writes attribute `a` of leaves [begin, end) without blosc, each array by its writeBuffers()
-// (PointDataLeafNode::writeBuffers() in pass a+3+k: writePagedBuffers() falls back to it), into
-// the `size` bytes at `to`, which unpagedBytes() said they take.
-// With placeholders, each array's flag and values are written here, the values by the caller.
-void writeArrays(const Leaves& all, std::size_t begin, std::size_t end, std::size_t a,
-                 const openvdb::io::StreamMetadata& metadata, char* to, std::size_t size) {
-  if (all.values != nullptr) {
-    char* const stop = to + size;
-    for (std::size_t l = begin; l < end; ++l) {
-      *to++ = 0;  // not compressed
-      all.store(l, a, to);
-      to += all.arrayBytes(l, a);
-    }
-    if (to != stop)
-      throw std::logic_error("VDB points: an attribute array took other than the bytes foreseen");
-    return;
+// Writes attribute `a` of leaves [begin, end) without blosc, as each array's writeBuffers()
+// would (PointDataLeafNode::writeBuffers() in pass a+3+k: writePagedBuffers() falls back to it),
+// into the `size` bytes at `to`, which unpagedBytes() said they take: each array's flag, then
+// its values, stored by the caller's PointValues.
+void writeArrays(const Leaves& all, std::size_t begin, std::size_t end, std::size_t a, char* to,
+                 std::size_t size) {
+  char* const stop = to + size;
+  for (std::size_t l = begin; l < end; ++l) {
+    *to++ = 0;  // not compressed
+    all.store(l, a, to);
+    to += all.arrayBytes(l, a);
   }
-  const std::vector<const Leaf*>& leaves = all.leaf;
-  SpanSink sink(to, size);
-  LeafStream stream(&sink, metadata);
-  for (std::size_t l = begin; l < end; ++l)
-    leaves[l]->attributeSet().getConst(a)->writeBuffers(stream.out(), /*outputTransient=*/false);
-  if (!stream.out() || !sink.full())
+  if (to != stop)
     throw std::logic_error("VDB points: an attribute array took other than the bytes foreseen");
 }
 
@@ -471,7 +444,6 @@ struct Page {
 
 // Attribute `a`'s pages, as PagedOutputStream::write() cuts them: an array that would take the
 // page past compression::PageSize closes it first; an array larger than a page is a page alone.
-// Transient arrays are not written (writePagedBuffers()).
 void cutPages(const Leaves& all, std::size_t a, std::vector<Page>& pages) {
   const auto pageSize = static_cast<std::size_t>(openvdb::compression::PageSize);
   Page page;
@@ -482,15 +454,7 @@ void cutPages(const Leaves& all, std::size_t a, std::vector<Page>& pages) {
     page.attribute = a;
   };
   for (std::size_t l = 0; l < all.size(); ++l) {
-    Piece piece{nullptr, 0, l};
-    if (all.values != nullptr) {
-      piece.size = all.arrayBytes(l, a);
-    } else {
-      const vdbp::AttributeArray& array = *all.leaf[l]->attributeSet().getConst(a);
-      if (array.isTransient()) continue;
-      piece.data = array.constDataAsByteArray();
-      piece.size = std::size_t{array.isUniform() ? 1 : array.dataSize()} * array.storageTypeSize();
-    }
+    const Piece piece{all.arrayBytes(l, a), l};
     const std::size_t bytes = piece.size;
     if (bytes == 0) continue;
     if (bytes > pageSize) {
@@ -511,7 +475,7 @@ void cutPages(const Leaves& all, std::size_t a, std::vector<Page>& pages) {
 // its size record from the result: (compressed, uncompressed) as two ints when blosc made it
 // smaller, else −uncompressed (PagedOutputStream::compressAndWrite() in size-only mode, which
 // compresses the same bytes the same way only to count them).
-// Placeholders' values are stored one after another first, then written at once: the page cuts
+// The arrays' values are stored one after another first, then written at once: the page cuts
 // and compresses them as it would the same bytes written array by array.
 void encodePage(const Leaves& all, Page& page) {
   const std::size_t a = page.attribute;
@@ -519,18 +483,13 @@ void encodePage(const Leaves& all, Page& page) {
   std::ostream out(page.values.get());
   openvdb::compression::PagedOutputStream stream(out);
   stream.setSizeOnly(false);
-  if (all.values != nullptr) {
-    const std::unique_ptr<char[]> bytes = std::make_unique_for_overwrite<char[]>(page.bytes);
-    std::size_t at = 0;
-    for (const Piece& array : page.arrays) {
-      all.store(array.leaf, a, bytes.get() + at);
-      at += array.size;
-    }
-    stream.write(bytes.get(), static_cast<std::streamsize>(page.bytes));
-  }
+  const std::unique_ptr<char[]> bytes = std::make_unique_for_overwrite<char[]>(page.bytes);
+  std::size_t at = 0;
   for (const Piece& array : page.arrays) {
-    if (array.data != nullptr) stream.write(array.data, static_cast<std::streamsize>(array.size));
+    all.store(array.leaf, a, bytes.get() + at);
+    at += array.size;
   }
+  stream.write(bytes.get(), static_cast<std::streamsize>(page.bytes));
   stream.flush();
   if (!out) throw std::runtime_error("cannot encode the VDB points' pages");
   const std::size_t written = page.values->size();
@@ -548,25 +507,6 @@ void encodePage(const Leaves& all, Page& page) {
 // A leaf without arrays: a default attribute set (encodePointsFile's `values`).
 bool isPlaceholderless(const Leaf& leaf) { return leaf.attributeSet().size() == 0; }
 
-// Whether the leaves can be encoded apart: every leaf with the same descriptor (so one is
-// written, and every leaf has as many passes), every array in memory and whole (the serial writer
-// would load or refuse it; here its bytes are read directly).
-bool splittable(const std::vector<const Leaf*>& leaves) {
-  const vdbp::AttributeSet::Descriptor& descriptor = leaves.front()->attributeSet().descriptor();
-  for (const Leaf* leaf : leaves) {
-    const vdbp::AttributeSet& set = leaf->attributeSet();
-    if (&set.descriptor() != &descriptor && set.descriptor() != descriptor) return false;
-    if (set.size() != descriptor.size()) return false;
-    for (std::size_t a = 0; a < set.size(); ++a) {
-      const vdbp::AttributeArray* array = set.getConst(a);
-      if (array == nullptr || !array->isDataLoaded() ||
-          (array->flags() & vdbp::AttributeArray::PARTIALREAD))
-        return false;
-    }
-  }
-  return true;
-}
-
 // A stretch of the file: bytes made already (`data`), or when `data` is null the unpaged arrays
 // of attribute `attribute` of leaves [begin, end), `size` bytes, to be written into place.
 struct Part {
@@ -578,19 +518,18 @@ struct Part {
 // Bytes [from, to) of the `size` bytes of writeArrays(…, begin, end, a, …), at `out`: each leaf's
 // array that lies whole in the range written into place, one cut by it through a copy.
 void writeArraysSlice(const Leaves& all, std::size_t begin, std::size_t end, std::size_t a,
-                      const openvdb::io::StreamMetadata& metadata, std::size_t size,
-                      std::size_t from, std::size_t to, char* out) {
-  if (from == 0 && to == size) return writeArrays(all, begin, end, a, metadata, out, size);
+                      std::size_t size, std::size_t from, std::size_t to, char* out) {
+  if (from == 0 && to == size) return writeArrays(all, begin, end, a, out, size);
   std::vector<char> copy;
   std::size_t at = 0;  // where leaf l's array starts
   for (std::size_t l = begin; l < end && at < to; ++l) {
     const std::size_t bytes = unpagedBytes(all, l, a), next = at + bytes;
     if (next > from) {
       if (at >= from && next <= to) {
-        writeArrays(all, l, l + 1, a, metadata, out + (at - from), bytes);
+        writeArrays(all, l, l + 1, a, out + (at - from), bytes);
       } else {
         copy.resize(bytes);
-        writeArrays(all, l, l + 1, a, metadata, copy.data(), bytes);
+        writeArrays(all, l, l + 1, a, copy.data(), bytes);
         const std::size_t first = std::max(at, from), last = std::min(next, to);
         std::memcpy(out + (first - from), copy.data() + (first - at), last - first);
       }
@@ -603,11 +542,9 @@ void writeArraysSlice(const Leaves& all, std::size_t begin, std::size_t end, std
 // for the unpaged arrays, stored when fill() is called. Owns what the parts point into.
 class DeferredBuffers final : public EncodedPointsFile::Deferred {
  public:
-  DeferredBuffers(Leaves all, openvdb::io::StreamMetadata::Ptr metadata,
-                  std::vector<RangeBytes> ranges, std::vector<std::vector<Page>> pages,
+  DeferredBuffers(Leaves all, std::vector<RangeBytes> ranges, std::vector<std::vector<Page>> pages,
                   std::vector<Part> parts)
       : all_(std::move(all)),
-        metadata_(std::move(metadata)),
         ranges_(std::move(ranges)),
         pages_(std::move(pages)),
         parts_(std::move(parts)),
@@ -628,15 +565,13 @@ class DeferredBuffers final : public EncodedPointsFile::Deferred {
       if (part.data != nullptr) {
         std::memcpy(at, part.data + inFrom, inTo - inFrom);
       } else {
-        writeArraysSlice(all_, part.begin, part.end, part.attribute, *metadata_, part.size, inFrom,
-                         inTo, at);
+        writeArraysSlice(all_, part.begin, part.end, part.attribute, part.size, inFrom, inTo, at);
       }
     }
   }
 
  private:
   Leaves all_;
-  openvdb::io::StreamMetadata::Ptr metadata_;
   std::vector<RangeBytes> ranges_;        // (pointed into by parts_)
   std::vector<std::vector<Page>> pages_;  // (pointed into by parts_)
   std::vector<Part> parts_;
@@ -669,20 +604,18 @@ void describePlaceholders(Leaves& all, const openvdb::io::StreamMetadata& metada
 
 // What Grid<PointDataTree>::writeBuffers() writes for `tree` after the pass count, encoded in
 // parallel with the stream metadata `metadata` but for the parts left to fill() (DeferredBuffers);
-// or null when the tree is not splittable() or has no leaf (two bytes that OpenVDB writes as
-// fast). With `values`, the tree's arrays are placeholders (encodePointsFile): a tree with leaves
-// that this cannot write throws.
+// or null when the tree has no leaf (two bytes that OpenVDB writes as fast). The tree's arrays
+// are placeholders of `values` (encodePointsFile): a tree with other arrays throws.
 std::unique_ptr<DeferredBuffers> encodeBuffers(const vdbp::PointDataTree& tree, bool toHalf,
-                                               const PointValues* values,
+                                               const PointValues& values,
                                                const openvdb::io::StreamMetadata::Ptr& metadata) {
   Leaves all;
-  all.values = values;
+  all.values = &values;
   std::vector<const Leaf*>& leaves = all.leaf;
   leaves.reserve(tree.leafCount());
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
   if (leaves.empty()) return nullptr;
-  if (values == nullptr && !splittable(leaves)) return nullptr;
-  if (values != nullptr) describePlaceholders(all, *metadata);
+  describePlaceholders(all, *metadata);
 
   const std::size_t attributes = leaves.front()->attributeSet().size();
   const bool paged = (metadata->compression() & openvdb::io::COMPRESS_BLOSC) != 0;
@@ -734,8 +667,8 @@ std::unique_ptr<DeferredBuffers> encodeBuffers(const vdbp::PointDataTree& tree, 
       }
     }
   }
-  return std::make_unique<DeferredBuffers>(std::move(all), metadata, std::move(rangeBytes),
-                                           std::move(pages), std::move(parts));
+  return std::make_unique<DeferredBuffers>(std::move(all), std::move(rangeBytes), std::move(pages),
+                                           std::move(parts));
 }
 
 // encodeBuffers() begun ahead, on another thread, while this one goes on: Archive::write() has
@@ -756,7 +689,7 @@ class BuffersAhead {
   BuffersAhead& operator=(const BuffersAhead&) = delete;
 
   // Begins encodeBuffers() with the stream's metadata as it is now; once only.
-  void start(const vdbp::PointDataTree& tree, bool toHalf, const PointValues* values) {
+  void start(const vdbp::PointDataTree& tree, bool toHalf, const PointValues& values) {
     const openvdb::io::StreamMetadata::Ptr now = openvdb::io::getStreamMetadataPtr(os_);
     if (started_ || !now) return;
     started_ = true;
@@ -765,7 +698,7 @@ class BuffersAhead {
     // background value, which the leaves' compression reads.
     metadata_->setBackgroundPtr(&tree.background());
     madeFor_ = metadata_->str();
-    group_.run([this, &tree, toHalf, values] {
+    group_.run([this, &tree, toHalf, &values] {
       buffers_ = encodeBuffers(tree, toHalf, values, metadata_);
     });
   }
@@ -794,9 +727,9 @@ class BuffersAhead {
 
 // Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel but
 // for the parts left to `deferred` (DeferredBuffers: `os` skips their bytes), and returns true;
-// or writes nothing and returns false when encodeBuffers() makes nothing or `os` does not write
-// into a MemorySink. The buffers are those `ahead` made, where it made them for this stream.
-bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const PointValues* values,
+// or writes nothing and returns false when the tree has no leaf. The buffers are those `ahead`
+// made, where it made them for this stream.
+bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const PointValues& values,
                             std::ostream& os, BuffersAhead* ahead,
                             std::unique_ptr<EncodedPointsFile::Deferred>& deferred) {
   auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
@@ -804,13 +737,11 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
   std::unique_ptr<DeferredBuffers> buffers =
       ahead != nullptr && metadata ? ahead->take(*metadata) : nullptr;
   if (!tree.cbeginLeaf()) return false;
-  if (sink == nullptr) {
-    if (values == nullptr) return false;
+  if (sink == nullptr)
     throw std::logic_error("VDB points: placeholder arrays that cannot be encoded in parallel");
-  }
   if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
   if (!buffers) buffers = encodeBuffers(tree, toHalf, values, metadata);
-  if (!buffers) return false;  // (never with placeholders: they are checked, and there are leaves)
+  if (!buffers) return false;  // (never: there are leaves)
   const auto passes = static_cast<std::uint16_t>(tree.cbeginLeaf()->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
   sink->skip(buffers->size());
@@ -822,18 +753,17 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
 // its leaves' buffers written by writeBuffersInParallel(). Archive::write() calls the virtual
 // GridBase::writeBuffers() between the topology and the grid's end offset, which it then patches
 // into the grid's descriptor itself.
-// With placeholder arrays (`values`), memUsage() is what the grid would use with its arrays
+// Its arrays being placeholders (`values`), memUsage() is what the grid would use with its arrays
 // expanded, and so is that of the shallow copy Archive::write() makes to record it in the file
 // (file_mem_bytes). That copy (copyGrid() const, the one Archive::write() calls) starts `ahead`.
 class ParallelBuffersGrid final : public vdbp::PointDataGrid {
  public:
-  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues* values, BuffersAhead* ahead,
+  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues& values, BuffersAhead* ahead,
                       std::unique_ptr<EncodedPointsFile::Deferred>* deferred)
       : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()),
-        values_(values),
+        values_(&values),
         ahead_(ahead),
         deferred_(deferred) {
-    if (values_ == nullptr) return;
     // Each leaf past the first lacks the first's attribute set but for its arrays' sizes; each
     // array, expanded, holds its leaf's point count of values where a placeholder holds one.
     auto leaf = constTree().cbeginLeaf();
@@ -850,7 +780,7 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
     expandedExtra_ += (leaves - 1) * setBytes;
   }
   void writeBuffers(std::ostream& os) const override {
-    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), values_, os, ahead_, *deferred_))
+    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), *values_, os, ahead_, *deferred_))
       vdbp::PointDataGrid::writeBuffers(os);
   }
   openvdb::Index64 memUsage() const override {
@@ -867,13 +797,13 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
     return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
   }
   openvdb::GridBase::ConstPtr copyGrid() const override {
-    if (ahead_ != nullptr) ahead_->start(constTree(), saveFloatAsHalf(), values_);
+    if (ahead_ != nullptr) ahead_->start(constTree(), saveFloatAsHalf(), *values_);
     return std::make_shared<ParallelBuffersGrid>(const_cast<ParallelBuffersGrid&>(*this),
                                                  openvdb::ShallowCopy());
   }
 
  private:
-  const PointValues* values_ = nullptr;
+  const PointValues* values_ = nullptr;  // (never null)
   BuffersAhead* ahead_ = nullptr;
   std::unique_ptr<EncodedPointsFile::Deferred>* deferred_;  // where writeBuffers() leaves them
   openvdb::Index64 expandedExtra_ = 0;
@@ -987,8 +917,8 @@ void EncodedPointsFile::write(std::ostream& out) const {
                              tbb::make_filter<Chunk, void>(tbb::filter_mode::serial_in_order, put));
 }
 
-EncodedPointsFile encodePointsFileDeferred(vdbp::PointDataGrid& grid, std::uint32_t compression,
-                                           const PointValues* values, std::size_t expectedBytes) {
+EncodedPointsFile encodePointsFile(vdbp::PointDataGrid& grid, std::uint32_t compression,
+                                   const PointValues& values, std::size_t expectedBytes) {
   std::unique_ptr<EncodedPointsFile::Deferred> deferred;
   MemorySink sink(expectedBytes);
   std::ostream os(&sink);
@@ -999,11 +929,6 @@ EncodedPointsFile encodePointsFileDeferred(vdbp::PointDataGrid& grid, std::uint3
   if (!os) throw std::runtime_error("cannot encode the VDB points grid");
   const std::size_t at = deferred ? sink.gapAt() : sink.held();
   return EncodedPointsFile(std::move(sink).release(), at, std::move(deferred));
-}
-
-FileBytes encodePointsFile(vdbp::PointDataGrid& grid, std::uint32_t compression,
-                           const PointValues* values, std::size_t expectedBytes) {
-  return encodePointsFileDeferred(grid, compression, values, expectedBytes).bytes();
 }
 
 std::string encodePointsFileSerially(const vdbp::PointDataGrid::ConstPtr& grid,

@@ -111,36 +111,28 @@ class EncodedPointsFile {
 };
 
 /// What openvdb::io::File::write() writes for `grid` alone (its name unique, no file metadata)
-/// with `compression` (openvdb::io::COMPRESS_* flags), made in memory: the bytes of
+/// with `compression` (openvdb::io::COMPRESS_* flags), to be made as it is written: the bytes of
 /// io::Archive::write(os, {grid}, seekable = true), every one of them but the header's UUID, which
 /// OpenVDB draws at random each time. (File writes through its own std::ofstream and ignores its
 /// failures, so a full disk left a truncated .vdb under the frame's name and the run went on:
 /// writeVdbPointCache writes these bytes with writeFileAtomically instead.)
 /// OpenVDB writes the header, the grid's descriptor (and the offsets it patches in), its
-/// metadata, transform and topology, as ever; the leaves' buffers, nearly all of the file, are
-/// made by OpenVDB's own leaf and attribute writers on every thread (TBB), leaf range by leaf
-/// range and, with blosc, page by page, into place at offsets summed in advance; they are begun
-/// on other threads while this one writes the header and topology. The bytes do not
-/// depend on the thread count. A grid this cannot split (leaves whose attributes differ, arrays
-/// not in memory) or without a leaf is written by OpenVDB alone, to the same bytes.
-/// `expectedBytes`: the room reserved for the header, metadata and topology.
-/// With `values`, the first leaf's arrays are placeholders (uniform, of the leaf's point count,
-/// stride 1, in memory) and every other leaf has none (a default attribute set: it stands for
-/// the first leaf's set with its own point count). The file is then the one the grid would give
-/// with every leaf holding the first's attributes, each array expanded to hold the values
-/// `values` stores (its metadata, the file's memory statistics and the arrays' bytes), and the
-/// values go from `values` straight into the file's bytes. Such a grid is never
-/// handed to OpenVDB's own writer: a grid the encoder cannot split throws std::logic_error.
-FileBytes encodePointsFile(openvdb::points::PointDataGrid& grid, std::uint32_t compression,
-                           const PointValues* values = nullptr,
-                           std::size_t expectedBytes = 1 << 20);
-
-/// The same file, its leaves' buffers made as it is written (EncodedPointsFile). `grid` and
-/// `values` must outlive it.
-EncodedPointsFile encodePointsFileDeferred(openvdb::points::PointDataGrid& grid,
-                                           std::uint32_t compression,
-                                           const PointValues* values = nullptr,
-                                           std::size_t expectedBytes = 1 << 20);
+/// metadata, transform and topology, as ever, into memory; the rest of the leaves' buffers (voxel
+/// offsets, the arrays' records, blosc's pages) are made by OpenVDB's own leaf and attribute
+/// writers on every thread (TBB), leaf range by leaf range and page by page, begun on other
+/// threads while this one writes the header and topology; the arrays' values without blosc,
+/// nearly all of the file, are stored as the file is written (EncodedPointsFile). The bytes do
+/// not depend on the thread count. A grid without a leaf is written by OpenVDB alone, to the same
+/// bytes.
+/// The grid's arrays are placeholders of `values`: the first leaf's arrays uniform, of the leaf's
+/// point count, stride 1, in memory, and every other leaf without arrays (a default attribute
+/// set: it stands for the first leaf's set with its own point count). The file is the one the
+/// grid would give with every leaf holding the first's attributes, each array expanded to hold
+/// the values `values` stores (its metadata, the file's memory statistics and the arrays' bytes).
+/// A grid with other arrays throws std::logic_error. `expectedBytes`: the room reserved for the
+/// header, metadata and topology. `grid` and `values` must outlive the result.
+EncodedPointsFile encodePointsFile(openvdb::points::PointDataGrid& grid, std::uint32_t compression,
+                                   const PointValues& values, std::size_t expectedBytes = 1 << 20);
 
 /// The same bytes made by io::Archive::write() alone, on one thread, into a std::ostringstream:
 /// the way tickfx wrote its caches before encodePointsFile, kept as the tests' reference.
