@@ -21,6 +21,7 @@
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/PlyCache.h"
+#include "io/util/AtomicFile.h"
 #include "io/util/UninitialisedVector.h"
 #include "particles/ParticleSystem.h"
 
@@ -197,6 +198,39 @@ TEST_F(Caches, AFailedWriteLeavesTheOldFileAndNoTemporary) {
   for (const auto& entry : fs::directory_iterator(dir_)) {
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
   }
+}
+
+// writeFileAtomically's stream takes blocks as large as its buffer (64 KiB) past the buffer, at
+// offsets on 64 KiB boundaries: a block's first bytes top the buffer up, its last ones stay in it.
+// Whatever the sizes, the flushes between them and the offsets they leave, the file holds every
+// byte in the order written.
+TEST_F(Caches, WritesOfAnySizeReachTheFileInTheirOrder) {
+  std::string expected;
+  std::uint32_t state = 12345;
+  const auto bytes = [&](std::size_t n) {
+    std::string b(n, '\0');
+    for (char& c : b) c = static_cast<char>((state = state * 1664525u + 1013904223u) >> 24);
+    return b;
+  };
+  const fs::path path = dir_ / "pieces.bin";
+  writeFileAtomically(path, [&](std::ostream& out) {
+    // (size, flush after): a header, blocks of a PLY body, a block exactly the buffer's size,
+    // one of a multiple of it, and blocks after flushes that leave the file off a boundary.
+    const std::pair<std::size_t, bool> pieces[] = {
+        {300, false},    {1441792, false}, {1441792, false}, {70000, false}, {5, false},
+        {65536, false},  {17, true},       {65536, false},   {196625, true}, {65535, false},
+        {131072, false}, {100, true},      {200000, false},  {1, false},     {65537, false}};
+    for (const auto& [size, flush] : pieces) {
+      const std::string piece = bytes(size);
+      out.write(piece.data(), static_cast<std::streamsize>(piece.size()));
+      if (flush) out.flush();
+      expected += piece;
+    }
+  });
+  std::ifstream in(path, std::ios::binary);
+  const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(written.size(), expected.size());
+  EXPECT_TRUE(written == expected);
 }
 
 // The bytes of this process's pages in memory (Linux: /proc/self/statm).
