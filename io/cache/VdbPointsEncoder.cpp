@@ -740,8 +740,7 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
   if (sink == nullptr)
     throw std::logic_error("VDB points: placeholder arrays that cannot be encoded in parallel");
   if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
-  if (!buffers) buffers = encodeBuffers(tree, toHalf, values, metadata);
-  if (!buffers) return false;  // (never: there are leaves)
+  if (!buffers) buffers = encodeBuffers(tree, toHalf, values, metadata);  // (not null: leaves)
   const auto passes = static_cast<std::uint16_t>(tree.cbeginLeaf()->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
   sink->skip(buffers->size());
