@@ -25,6 +25,7 @@ set(TICKFX_CORE_PUBLIC_HEADERS
   particles/SettingProblem.h
   particles/Shard.h
   particles/Spring.h
+  particles/StartsSpan.h
   particles/StateHash.h
   particles/Structure.h
   particles/TaskExecutor.h

@@ -107,6 +107,11 @@ class Collider {
   /// columns with no call a row: most particles are nowhere near most colliders.
   virtual void screen(const float* const a[3], const float* const b[3], std::size_t n,
                       std::uint8_t* flags) const = 0;
+  /// A bound of screen() along one axis (0 x, 1 y, 2 z), valid until the next beginTick(): where
+  /// it returns true, screen() flags no path whose two ends' coordinates on `axis` are both below
+  /// `lo` or both above `hi`, whatever their others. A block's step then stores only that axis's
+  /// start for the rows it rules out (ColliderSet::startsSpan()). False: no bound this tick.
+  virtual bool screenSpan(int /*axis*/, float& /*lo*/, float& /*hi*/) const { return false; }
   /// ColliderSet's contact loop over a block's flagged rows, this collider the set's only one;
   /// returns the contacts made. The default calls firstContact() a contact; a shape collider
   /// runs the same loop with its test inlined (the same bits).

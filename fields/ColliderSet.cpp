@@ -1,5 +1,7 @@
 #include "fields/ColliderSet.h"
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 #include "fields/ContactRows.h"
@@ -63,6 +65,37 @@ void ColliderSet::collide(ParticlePool& pool, std::int64_t tick, std::int64_t st
   endTick();
 }
 
+namespace {
+
+static_assert(kParallelBlockRows == 64 * StartsSpan::kGroupRows,
+              "a block's groups of rows are the 64 bits of a StepRows::written mask");
+
+// ColliderSet::startsSpan() of `colliders`: the union of their spans on the first axis (y, x, z)
+// where each has one.
+StartsSpan spanOf(const std::vector<std::unique_ptr<Collider>>& colliders) {
+  for (const int axis : {1, 0, 2}) {
+    StartsSpan span{-1, std::numeric_limits<float>::infinity(),
+                    -std::numeric_limits<float>::infinity()};
+    bool bounded = true;
+    for (const auto& c : colliders) {
+      float lo = 0.0f, hi = 0.0f;
+      if (!c->screenSpan(axis, lo, hi) || !(lo <= hi)) {
+        bounded = false;
+        break;
+      }
+      span.lo = std::min(span.lo, lo);
+      span.hi = std::max(span.hi, hi);
+    }
+    if (bounded) {
+      span.axis = axis;
+      return span;
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz,
                             bool history) {
   contacts_ = 0;
@@ -86,6 +119,7 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
     blockContacts_.resize(std::max(blockContacts_.size(), t.blocks));
     for (std::size_t k = 0; k < t.blocks; ++k) blockContacts_[k].clear();
   }
+  t.span = spanOf(colliders_);
   // The hit columns, where the pool has them.
   t.hits.fill(nullptr);
   if (pool.findAttribute(kHitColumns[0]) != ParticlePool::npos) {
@@ -95,12 +129,14 @@ void ColliderSet::beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t 
 }
 
 void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t end,
-                              const std::array<const float*, 3>& given) {
+                              const std::array<const float*, 3>& given, std::uint64_t written) {
   if (colliders_.empty() || begin >= end) return;
   TICKFX_ASSERT(begin % kParallelBlockRows == 0 && end - begin <= kParallelBlockRows,
                 "collideRows() takes whole blocks of kParallelBlockRows rows");
   TICKFX_ASSERT((given[0] != nullptr && !tick_.history) || pool.keepsPrevious(),
                 "paths start at the pool's previous positions, which it does not keep");
+  // A block far from every collider (its contact count and paths are cleared by beginTick()).
+  if (written == 0) return;
   const TickState& t = tick_;
   const std::size_t block = begin / kParallelBlockRows;
   Vec3Column& pos = pool.position();
@@ -129,8 +165,21 @@ void ColliderSet::collideRows(ParticlePool& pool, std::size_t begin, std::size_t
   // Which rows may touch a collider: a screen over the block's columns first.
   thread_local std::vector<std::uint8_t> flags;
   flags.assign(job.count, 0);
-  const float* const ends[3] = {pos.x.data() + begin, pos.y.data() + begin, pos.z.data() + begin};
-  for (const auto& c : colliders_) c->screen(job.starts.data(), ends, job.count, flags.data());
+  // The groups of rows the step wrote every start of, in runs: the others reach no screen.
+  constexpr std::size_t g = StartsSpan::kGroupRows;
+  for (std::size_t k = 0; k * g < job.count;) {
+    if ((written >> k & 1) == 0) {
+      ++k;
+      continue;
+    }
+    const std::size_t first = k;
+    while (k * g < job.count && (written >> k & 1) != 0) ++k;
+    const std::size_t from = first * g, n = std::min(job.count, k * g) - from;
+    const float* const a[3] = {job.starts[0] + from, job.starts[1] + from, job.starts[2] + from};
+    const float* const b[3] = {pos.x.data() + begin + from, pos.y.data() + begin + from,
+                               pos.z.data() + begin + from};
+    for (const auto& c : colliders_) c->screen(a, b, n, flags.data() + from);
+  }
   job.flagged = flags.data();
   // A lone collider runs the loop its own way (a shape's test inlined); several, through their
   // virtual calls.

@@ -12,6 +12,7 @@
 #include "fields/Collider.h"
 #include "particles/ParticleEvent.h"
 #include "particles/ParticlePool.h"
+#include "particles/StartsSpan.h"
 
 namespace tickfx {
 
@@ -90,10 +91,18 @@ class ColliderSet {
   /// The paths start at `starts` where given (x, y, z: row r's at index r − begin; the step's
   /// StepRows::starts, so that a tick no frame interpolates across leaves the pool's column
   /// alone), else at the pool's previousPosition(), which must then be kept.
+  /// With `written` (a block's StepRows::written after its step, bit k for rows begin + 128k on),
+  /// only the groups of rows whose bit is set are screened: the step wrote the others' starts on
+  /// the span's axis alone, and startsSpan() rules out every path among them.
   void beginTick(ParticlePool& pool, std::int64_t tick, std::int64_t stepRateHz, bool history);
   void collideRows(ParticlePool& pool, std::size_t begin, std::size_t end,
-                   const std::array<const float*, 3>& starts = {});
+                   const std::array<const float*, 3>& starts = {},
+                   std::uint64_t written = ~std::uint64_t{0});
   void endTick();
+  /// The span of this tick (after beginTick()) outside which no collider's screen flags a path
+  /// (Collider::screenSpan()): on y where every collider bounds its screen there, else x, else
+  /// z; none where some collider bounds it on no axis (a moving one, a container).
+  const StartsSpan& startsSpan() const { return tick_.span; }
 
   /// From the next tick on, records every contact (ContactRecord) for collision events, and counts
   /// each particle's contacts in the pool column `countColumn` (a float attribute the caller
@@ -128,6 +137,7 @@ class ColliderSet {
     std::size_t blocks = 0;
     std::array<float*, kHitColumns.size()> hits{};  // the pool's hit columns, or null
     float* counts = nullptr;                        // the contact count column, or null
+    StartsSpan span;
   };
 
   std::vector<std::unique_ptr<Collider>> colliders_;

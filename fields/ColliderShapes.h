@@ -11,6 +11,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+
+#include "particles/Isa.h"
 
 namespace tickfx::collide {
 
@@ -73,8 +76,8 @@ inline bool boxesMeet(const V3& a, const V3& b, const V3& lo, const V3& hi) {
 // vectorise (measured: scalar). A rowFlag without branches vectorises; columns it ignores are not
 // read.
 template <class RowFlag>
-inline void screenRows(const float* const a[3], const float* const b[3], std::size_t n,
-                       std::uint8_t* flags, const RowFlag& rowFlag) {
+inline void screenRowsAs(const float* const a[3], const float* const b[3], std::size_t n,
+                         std::uint8_t* flags, const RowFlag& rowFlag) {
   const float* __restrict ax = a[0];
   const float* __restrict ay = a[1];
   const float* __restrict az = a[2];
@@ -84,6 +87,43 @@ inline void screenRows(const float* const a[3], const float* const b[3], std::si
   std::uint8_t* __restrict f = flags;
   for (std::size_t i = 0; i < n; ++i)
     f[i] = static_cast<std::uint8_t>(f[i] | rowFlag(ax[i], ay[i], az[i], bx[i], by[i], bz[i]));
+}
+
+#ifdef TICKFX_AVX2_CLONES
+// screenRowsAs() vectorised for AVX2 and AVX-512 (the update loops' paths, particles/Isa.h), the
+// row flag inlined (flatten). Comparisons of values computed by the same IEEE operations at any
+// width: the same flags on every path (test_colliders holds them to the baseline's).
+template <class RowFlag>
+[[gnu::noinline, gnu::target("avx2"), gnu::flatten]] void screenRowsAvx2(const float* const a[3],
+                                                                         const float* const b[3],
+                                                                         std::size_t n,
+                                                                         std::uint8_t* flags,
+                                                                         const RowFlag& rowFlag) {
+  screenRowsAs(a, b, n, flags, rowFlag);
+}
+template <class RowFlag>
+[[gnu::noinline, gnu::target("avx2,avx512f"), gnu::flatten]] void screenRowsAvx512(
+    const float* const a[3], const float* const b[3], std::size_t n, std::uint8_t* flags,
+    const RowFlag& rowFlag) {
+  screenRowsAs(a, b, n, flags, rowFlag);
+}
+#endif
+
+// screenRowsAs() on the path activeIsa() names.
+template <class RowFlag>
+inline void screenRows(const float* const a[3], const float* const b[3], std::size_t n,
+                       std::uint8_t* flags, const RowFlag& rowFlag) {
+#ifdef TICKFX_AVX2_CLONES
+  switch (activeIsa()) {
+    case Isa::Avx512:
+      return screenRowsAvx512(a, b, n, flags, rowFlag);
+    case Isa::Avx2:
+      return screenRowsAvx2(a, b, n, flags, rowFlag);
+    case Isa::Baseline:
+      break;
+  }
+#endif
+  screenRowsAs(a, b, n, flags, rowFlag);
 }
 
 // flags[i] = 1 for rows [0, n) whose path a → b has a box meeting [lo, hi]: boxesMeet over
@@ -120,10 +160,7 @@ struct PlaneShape {
     // An axis-aligned normal (a ground plane's): phi is ±(x_axis − p_axis) − r, the other terms
     // being 0 · (finite) = ±0, so one column decides. (Where a coordinate is not finite phi is
     // NaN and flags nothing; this may flag such a row, which the exact test then refuses.)
-    const int axis = ny == 0.0f && nz == 0.0f   ? 0
-                     : nx == 0.0f && nz == 0.0f ? 1
-                     : nx == 0.0f && ny == 0.0f ? 2
-                                                : -1;
+    const int axis = axisOf();
     if (axis >= 0) {
       const float sign = normal[axis], p = point[axis];
       const float* const aa[3] = {a[axis], a[axis], a[axis]};
@@ -139,6 +176,26 @@ struct PlaneShape {
       const float db = nx * (bx - px) + ny * (by - py) + nz * (bz - pz) - r;
       return static_cast<int>(da < 0.0f) | static_cast<int>(db < 0.0f);
     });
+  }
+  // Collider::screenSpan() of screenColumns(): only an axis-aligned normal's screen reads one
+  // axis alone. With sign +1 it flags a path only where (c − p) − r < 0 at an end, which needs
+  // c < p + r exactly (float subtraction rounds monotonically and keeps the sign of the exact
+  // difference); with −1 only where c > p − r. p ± r is rounded once, and the slack is far more.
+  bool screenSpan(int axis, float& lo, float& hi) const {
+    if (axisOf() != axis || std::fabs(normal[axis]) != 1.0f) return false;
+    const float p = point[axis], r = offset, slack = screenSlack(std::fabs(p) + std::fabs(r));
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    lo = normal[axis] > 0.0f ? -kInf : (p - r) - slack;
+    hi = normal[axis] > 0.0f ? (p + r) + slack : kInf;
+    return true;
+  }
+  // The axis of an axis-aligned normal, else −1.
+  int axisOf() const {
+    const float nx = normal.x(), ny = normal.y(), nz = normal.z();
+    return ny == 0.0f && nz == 0.0f   ? 0
+           : nx == 0.0f && nz == 0.0f ? 1
+           : nx == 0.0f && ny == 0.0f ? 2
+                                      : -1;
   }
   bool entry(const V3& a, const V3& b, float tolerance, Entry& e) const {
     const float pa = phi(a), pb = phi(b);

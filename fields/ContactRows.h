@@ -153,19 +153,29 @@ struct VirtualColliders {
   V3 respond(const Collider& hit, const Contact& c, const V3& v) const { return hit.respond(c, v); }
 };
 
+// Rows of flags contactRows() tests at once.
+inline constexpr std::size_t kScanRows = 64;
+
+// Whether none of flags[0, kScanRows) is set: their words or'ed, no branch a row.
+inline bool noneFlagged(const std::uint8_t* flags) {
+  std::uint64_t any = 0;
+  for (std::size_t w = 0; w < kScanRows; w += sizeof any) {
+    std::uint64_t word = 0;
+    std::memcpy(&word, flags + w, sizeof word);
+    any |= word;
+  }
+  return any == 0;
+}
+
 // contactRow() for every flagged row of the block, in row order; returns the contacts made.
 template <class Colliders>
 std::uint64_t contactRows(const RowsJob& job, const Colliders& colliders) {
   std::uint64_t contacts = 0;
   for (std::size_t k = 0; k < job.count; ++k) {
-    // Most rows are screened out: skipped eight at a time.
-    if ((k & 7) == 0 && k + 8 <= job.count) {
-      std::uint64_t eight = 0;
-      std::memcpy(&eight, job.flagged + k, sizeof eight);
-      if (eight == 0) {
-        k += 7;
-        continue;
-      }
+    // Most rows are screened out: skipped 64 at a time.
+    if (k % kScanRows == 0 && k + kScanRows <= job.count && noneFlagged(job.flagged + k)) {
+      k += kScanRows - 1;
+      continue;
     }
     if (job.flagged[k] != 0) contacts += static_cast<std::uint64_t>(contactRow(job, k, colliders));
   }

@@ -88,6 +88,26 @@ class ShapeCollider final : public Collider {
     }
   }
 
+  // The bound of the screen above along `axis`: the still shape's own, where it screens its own
+  // way (screenColumns), else its screening box's.
+  bool screenSpan(int axis, float& lo, float& hi) const override {
+    if (tick_.moving) return false;
+    if constexpr (requires { shape_.screenColumns(nullptr, nullptr, 0, nullptr); }) {
+      if constexpr (requires { shape_.screenSpan(axis, lo, hi); }) {
+        return shape_.screenSpan(axis, lo, hi);
+      } else {
+        return false;
+      }
+    } else if constexpr (requires(V3 & v) { shape_.screenBox(v, v); }) {
+      V3 below, above;
+      if (!shape_.screenBox(below, above)) return false;
+      lo = below[axis];
+      hi = above[axis];
+      return true;
+    }
+    return false;
+  }
+
  private:
   // firstContact(), inline for contactRows().
   [[gnu::always_inline]] bool contactOf(const V3& a, float fromFraction, const V3& b,

@@ -19,6 +19,7 @@
 #include "integrators/StagePasses.h"
 #include "particles/Isa.h"
 #include "particles/NonfiniteState.h"
+#include "particles/StartsSpan.h"
 
 namespace tickfx {
 
@@ -244,18 +245,60 @@ bool loopAt(const Loop& loop, const Kernel& kernel, Eigen::Index offset, Eigen::
 template <class Lane>
 inline constexpr Eigen::Index kComponentBlockRows = std::is_same_v<Lane, Lanes16> ? 512 : 128;
 
+/// No StartsSpan: every start is written (where kCopies).
+struct NoSpanRows {};
+
+/// A tile's rows under a StepRows::span: the span's axis's starts (as the loop has just written
+/// them) and ends from the tile's row 0, and the mask whose groups of rows it clears.
+struct SpanRows {
+  StartsSpan span;
+  const float* starts = nullptr;
+  const float* ends = nullptr;
+  std::uint64_t* written = nullptr;
+  std::size_t firstRow = 0;  // the tile's row 0 less StepRows::writtenFrom: whole groups
+
+  /// Whether a path of the tile's rows [offset, offset + count) may reach the span; where none
+  /// does, clears their groups' bits (the loop then writes no other axis's starts for them).
+  [[gnu::always_inline]] bool reached(Eigen::Index offset, Eigen::Index count) const {
+    const float* __restrict a = starts + offset;
+    const float* __restrict b = ends + offset;
+    int any = 0;
+    for (Eigen::Index i = 0; i < count; ++i) any |= span.reaches(a[i], b[i]);
+    if (any != 0) return true;
+    constexpr std::size_t g = StartsSpan::kGroupRows;
+    const std::size_t from = firstRow + static_cast<std::size_t>(offset);
+    for (std::size_t k = from / g; k < (from + static_cast<std::size_t>(count) + g - 1) / g; ++k)
+      *written &= ~(std::uint64_t{1} << k);
+    return false;
+  }
+};
+
 /// `updateComponent(c, offset, count, loop)` for the three components c, block by block
 /// (kComponentBlockRows<Lane>) over n rows; whether some call returned true. A row's components are
-/// independent, so the order changes no bit.
-template <class Lane, bool kCheck, bool kCopies, class UpdateComponent>
+/// independent, so the order changes no bit. Under a span (SpanRows, unchecked with copies), a
+/// block's span axis goes first, and the other two write no starts where the span rules out
+/// every row of the block.
+template <class Lane, bool kCheck, bool kCopies, class UpdateComponent, class Span>
 [[gnu::always_inline]] inline bool updateBlocksAs(Eigen::Index n,
-                                                  const UpdateComponent& updateComponent) {
+                                                  const UpdateComponent& updateComponent,
+                                                  const Span& span) {
   bool suspect = false;
   constexpr Eigen::Index kRows = kComponentBlockRows<Lane>;
   for (Eigen::Index offset = 0; offset < n; offset += kRows) {
     const Eigen::Index count = std::min(kRows, n - offset);
-    for (int c = 0; c < 3; ++c) {
-      suspect |= updateComponent(c, offset, count, RowLoop<Lane, kCheck, kCopies>{});
+    if constexpr (std::is_same_v<Span, SpanRows> && kCopies && !kCheck) {
+      const int axis = span.span.axis;
+      suspect |= updateComponent(axis, offset, count, RowLoop<Lane, false, true>{});
+      const bool reached = span.reached(offset, count);
+      for (int c = 0; c < 3; ++c) {
+        if (c == axis) continue;
+        suspect |= reached ? updateComponent(c, offset, count, RowLoop<Lane, false, true>{})
+                           : updateComponent(c, offset, count, RowLoop<Lane, false, false>{});
+      }
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        suspect |= updateComponent(c, offset, count, RowLoop<Lane, kCheck, kCopies>{});
+      }
     }
   }
   return suspect;
@@ -264,47 +307,47 @@ template <class Lane, bool kCheck, bool kCopies, class UpdateComponent>
 /// updateBlocksAs() four rows a register (SSE2, NEON). Not inlined, so that the checked and
 /// unchecked loops are compiled and placed alike and a measured difference between them is the
 /// check's (docs/performance.md).
-template <bool kCheck, bool kCopies, class UpdateComponent>
-[[gnu::noinline]] bool updateBlocksBaseline(Eigen::Index n,
-                                            const UpdateComponent& updateComponent) {
-  return updateBlocksAs<Lanes4, kCheck, kCopies>(n, updateComponent);
+template <bool kCheck, bool kCopies, class UpdateComponent, class Span>
+[[gnu::noinline]] bool updateBlocksBaseline(Eigen::Index n, const UpdateComponent& updateComponent,
+                                            const Span& span) {
+  return updateBlocksAs<Lanes4, kCheck, kCopies>(n, updateComponent, span);
 }
 
 #ifdef TICKFX_AVX2_CLONES
 /// updateBlocksAs() compiled for AVX2, eight rows a register: the kernels and everything they
 /// call are inlined here (flatten). The same operations on the same values as the baseline
 /// loops, so the same bits (test_passes runs every scheme on both paths).
-template <bool kCheck, bool kCopies, class UpdateComponent>
+template <bool kCheck, bool kCopies, class UpdateComponent, class Span>
 [[gnu::noinline, gnu::target("avx2"), gnu::flatten]] bool updateBlocksAvx2(
-    Eigen::Index n, const UpdateComponent& updateComponent) {
-  return updateBlocksAs<Lanes8, kCheck, kCopies>(n, updateComponent);
+    Eigen::Index n, const UpdateComponent& updateComponent, const Span& span) {
+  return updateBlocksAs<Lanes8, kCheck, kCopies>(n, updateComponent, span);
 }
 
 /// updateBlocksAs() compiled for AVX-512 (F), sixteen rows a register, flattened as the AVX2
 /// clone is: the same operations on the same values, so the same bits (test_passes and
 /// test_subnormals run every path).
-template <bool kCheck, bool kCopies, class UpdateComponent>
+template <bool kCheck, bool kCopies, class UpdateComponent, class Span>
 [[gnu::noinline, gnu::target("avx2,avx512f"), gnu::flatten]] bool updateBlocksAvx512(
-    Eigen::Index n, const UpdateComponent& updateComponent) {
-  return updateBlocksAs<Lanes16, kCheck, kCopies>(n, updateComponent);
+    Eigen::Index n, const UpdateComponent& updateComponent, const Span& span) {
+  return updateBlocksAs<Lanes16, kCheck, kCopies>(n, updateComponent, span);
 }
 #endif
 
 /// updateBlocksAs() on the path activeIsa() names, checked (summing what the kernels return)
 /// when `check` is set.
-template <bool kCheck, bool kCopies, class UpdateComponent>
-bool updateBlocks(Eigen::Index n, const UpdateComponent& updateComponent) {
+template <bool kCheck, bool kCopies, class UpdateComponent, class Span = NoSpanRows>
+bool updateBlocks(Eigen::Index n, const UpdateComponent& updateComponent, const Span& span = {}) {
 #ifdef TICKFX_AVX2_CLONES
   switch (activeIsa()) {
     case Isa::Avx512:
-      return updateBlocksAvx512<kCheck, kCopies>(n, updateComponent);
+      return updateBlocksAvx512<kCheck, kCopies>(n, updateComponent, span);
     case Isa::Avx2:
-      return updateBlocksAvx2<kCheck, kCopies>(n, updateComponent);
+      return updateBlocksAvx2<kCheck, kCopies>(n, updateComponent, span);
     case Isa::Baseline:
       break;
   }
 #endif
-  return updateBlocksBaseline<kCheck, kCopies>(n, updateComponent);
+  return updateBlocksBaseline<kCheck, kCopies>(n, updateComponent, span);
 }
 
 /// `updateComponent(c, offset, count, loop)` (`loop`, a RowLoop, over rows [offset, offset +
@@ -312,14 +355,24 @@ bool updateBlocks(Eigen::Index n, const UpdateComponent& updateComponent) {
 /// the three components, in blocks of rows on the path activeIsa() names, then, when one may
 /// be, the exact scan that flags the rows. Checked (the loops sum what the kernels return) when
 /// `check` is set. Without `copies` (unchecked only), the kernels' copies of the previous
-/// position are not written: the caller's previous rows are a sink (previousRowsOf()).
-template <class UpdateComponent>
+/// position are not written: the caller's previous rows are a sink (previousRowsOf()). With
+/// `span` (unchecked, with copies), the starts its span rules out are written on its axis alone.
+template <class UpdateComponent, class Span = NoSpanRows>
 void updateComponents(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
-                      const UpdateComponent& updateComponent, bool copies = true) {
+                      const UpdateComponent& updateComponent, bool copies = true,
+                      const Span* span = nullptr) {
   const Eigen::Index n = rows.count();
-  const bool suspect = check != nullptr ? updateBlocks<true, true>(n, updateComponent)
-                       : copies         ? updateBlocks<false, true>(n, updateComponent)
-                                        : updateBlocks<false, false>(n, updateComponent);
+  bool suspect = false;
+  if (check != nullptr) {
+    suspect = updateBlocks<true, true>(n, updateComponent);
+  } else if (!copies) {
+    suspect = updateBlocks<false, false>(n, updateComponent);
+  } else if constexpr (!std::is_same_v<Span, NoSpanRows>) {
+    suspect = span != nullptr ? updateBlocks<false, true>(n, updateComponent, *span)
+                              : updateBlocks<false, true>(n, updateComponent);
+  } else {
+    suspect = updateBlocks<false, true>(n, updateComponent);
+  }
   if (suspect) check->scan(pool, rows.begin, rows.end);
 }
 

@@ -3,9 +3,11 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 
 #include "particles/ParticlePool.h"
 #include "particles/RowViews.h"
+#include "particles/StartsSpan.h"
 
 namespace tickfx {
 
@@ -27,10 +29,17 @@ struct StepRows {
   /// them right after its step: ColliderSet::collideRows()). Null: nowhere. A scheme that reads
   /// the previous position as state writes the pool's column all the same.
   std::array<float*, 3> starts{};
+  /// With starts: the span outside which a row's path meets no collider. A step may then write
+  /// only the span's axis of the starts of a group of StartsSpan::kGroupRows rows (from
+  /// writtenFrom on) of which no path reaches the span, and clears the group's bit in *written;
+  /// a group whose bit stays set has every start written. Without a span, every bit stays set.
+  StartsSpan span{};
+  std::uint64_t* written = nullptr;
+  std::size_t writtenFrom = 0;
 
   /// The rows of `part`, a part of these rows, on the calling thread, their starts moved with them.
   StepRows partOf(RowRange part) const {
-    StepRows p{part, fresh, true, keepPrevious, starts};
+    StepRows p{part, fresh, true, keepPrevious, starts, span, written, writtenFrom};
     if (starts[0] != nullptr) {
       for (float*& s : p.starts) s += part.begin - rows.begin;
     }

@@ -101,7 +101,7 @@ auto withFormAccelerations(const TickForms& forms, int c, const Body& body) {
 template <class KernelFor, class ColumnsOf>
 void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
                           const TickForms& forms, const KernelFor& kernelFor,
-                          const ColumnsOf& columnsOf, bool copies) {
+                          const ColumnsOf& columnsOf, bool copies, const SpanRows* span = nullptr) {
   updateComponents(
       check, pool, rows,
       [&](int c, Eigen::Index offset, Eigen::Index count, const auto& loop) {
@@ -109,7 +109,7 @@ void updateTileUnderForms(NonfiniteCheck* check, ParticlePool& pool, RowRange ro
           return loopAt(loop, kernelFor(accelerations), offset, count, columnsOf(c));
         });
       },
-      copies);
+      copies, span);
 }
 
 /// The one pass of a scheme over every tile of `rows`: `beforeTile(tile)` first (the rows spawned
@@ -128,24 +128,32 @@ void runOnePass(ParticlePool& pool, StageScratch& scratch, const StepRows& rows,
   // Fused tiles whose only other inputs are the forms: by exceptions when those are finite.
   const TileCheck tiles = tileCheck(check, pool, rows, forms.finite());
   const bool copies = writesPreviousRows(pool, rows);
-  runPasses(rows, true, scratch, {[&](const Tile& tile) {
-              beforeTile(tile);
-              const RowRange r = tile.rows();
-              Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = previousRowsOf(pool, rows, r);
-              std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
-              updateTileUnderForms(
-                  tiles.sums, pool, r, forms, kernelFor,
-                  [&](int c) {
-                    return std::apply(
-                        [&](auto&... e) {
-                          return std::tuple(pr[c].data(), vr[c].data(), old[c].data(),
-                                            e[c].data()...);
-                        },
-                        more);
+  // A block's collisions need only the starts of the rows its span does not rule out.
+  const bool spanned =
+      rows.span.any() && rows.written != nullptr && copies && !writesPreviousColumn(pool, rows);
+  runPasses(
+      rows, true, scratch, {[&](const Tile& tile) {
+        beforeTile(tile);
+        const RowRange r = tile.rows();
+        Vec3Rows pr = rowsOf(p, r), vr = rowsOf(v, r), old = previousRowsOf(pool, rows, r);
+        std::array<Vec3Rows, sizeof...(Extra)> more{rowsOf(extra, r)...};
+        SpanRows span;
+        if (spanned) {
+          const int a = rows.span.axis;
+          span = {rows.span, old[a].data(), pr[a].data(), rows.written, r.begin - rows.writtenFrom};
+        }
+        updateTileUnderForms(
+            tiles.sums, pool, r, forms, kernelFor,
+            [&](int c) {
+              return std::apply(
+                  [&](auto&... e) {
+                    return std::tuple(pr[c].data(), vr[c].data(), old[c].data(), e[c].data()...);
                   },
-                  copies);
-            }},
-            tiles.afterEachTile);
+                  more);
+            },
+            copies, spanned ? &span : nullptr);
+      }},
+      tiles.afterEachTile);
 }
 
 /// runOnePass() of a scheme whose row update reads and writes the position, the velocity and

@@ -490,13 +490,20 @@ void ParticleSystem::stepAndCollideBlocks(const StepTime& time, NonfiniteCheck* 
   parallelForTasks((n + kParallelBlockRows - 1) / kParallelBlockRows, [&](std::size_t i) {
     const std::size_t begin = i * kParallelBlockRows, end = std::min(n, begin + kParallelBlockRows);
     StepRows rows{RowRange{begin, end}, std::clamp(stepped, begin, end), true, keepPrevious};
+    // Groups of rows whose starts the step wrote on every axis: all, unless it skips those that
+    // the colliders' span rules out.
+    std::uint64_t written = ~std::uint64_t{0};
     if (buffered) {
       thread_local std::vector<float> buffer;
       buffer.resize(3 * kParallelBlockRows);
       for (std::size_t c = 0; c < 3; ++c) rows.starts[c] = buffer.data() + c * kParallelBlockRows;
+      rows.span = colliders_->startsSpan();
+      rows.written = &written;
+      rows.writtenFrom = begin;
     }
     integrator_->stepRows(pool_, *forces_, time, rows, check);
-    colliders_->collideRows(pool_, begin, end, {rows.starts[0], rows.starts[1], rows.starts[2]});
+    colliders_->collideRows(pool_, begin, end, {rows.starts[0], rows.starts[1], rows.starts[2]},
+                            written);
   });
   colliders_->endTick();
 }

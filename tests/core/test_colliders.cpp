@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -15,9 +16,11 @@
 #include <vector>
 
 #include "CoreTestSupport.h"
+#include "ForcedIsa.h"
 #include "Sanitized.h"
 #include "fields/Collider.h"
 #include "fields/ColliderSet.h"
+#include "particles/Isa.h"
 #include "particles/StateHash.h"
 
 namespace tickfx {
@@ -629,6 +632,31 @@ struct Collided {
   std::vector<CollisionPath> paths;
 };
 
+// `ticks` ticks of `system`: the state hash, the contacts over them and the last tick's paths.
+Collided ticked(ParticleSystem& system, int ticks) {
+  Collided out;
+  for (int tick = 0; tick < ticks; ++tick) {
+    system.step();
+    out.contacts += system.colliders()->contacts();
+  }
+  out.hash = stateHash(system.pool());
+  out.paths = system.colliders()->paths();
+  return out;
+}
+
+// The same state, contacts and paths, every path's every field.
+void expectSameRun(const Collided& run, const Collided& reference, const std::string& label) {
+  EXPECT_EQ(run.hash, reference.hash) << label;
+  EXPECT_EQ(run.contacts, reference.contacts) << label;
+  ASSERT_EQ(run.paths.size(), reference.paths.size()) << label;
+  for (std::size_t k = 0; k < reference.paths.size(); ++k) {
+    const CollisionPath &p = run.paths[k], &q = reference.paths[k];
+    ASSERT_TRUE(p.id == q.id && p.contacts == q.contacts && p.start == q.start &&
+                p.fraction == q.fraction && p.point == q.point)
+        << label << ", path " << k;
+  }
+}
+
 Collided collidedWith(const std::vector<ColliderSettings>& colliders, int threads) {
   auto system = systemWith("semi_implicit_euler", 60, gravityOnly(), colliders, threads);
   std::mt19937 rng(5);
@@ -642,14 +670,7 @@ Collided collidedWith(const std::vector<ColliderSettings>& colliders, int thread
                             : Eigen::Vector3f(unit(rng), -5.0f + unit(rng), unit(rng));
     system->editPool().spawn(init, 0);
   }
-  Collided out;
-  for (int tick = 0; tick < 30; ++tick) {
-    system->step();
-    out.contacts += system->colliders()->contacts();
-  }
-  out.hash = stateHash(system->pool());
-  out.paths = system->colliders()->paths();
-  return out;
+  return ticked(*system, 30);
 }
 
 TEST(CollisionLoop, ACollidersInlinedLoopGivesTheBitsOfTheVirtualOne) {
@@ -677,20 +698,153 @@ TEST(CollisionLoop, ACollidersInlinedLoopGivesTheBitsOfTheVirtualOne) {
           << static_cast<int>(response);
       for (const int threads : {1, 2}) {
         const Collided beside = collidedWith({shape, unreached}, threads);
-        const std::string label = std::string(colliderTypeName(shape.type)) + ", response " +
-                                  std::to_string(static_cast<int>(response)) + ", " +
-                                  std::to_string(threads) + " thread(s)";
-        EXPECT_EQ(beside.hash, alone.hash) << label;
-        EXPECT_EQ(beside.contacts, alone.contacts) << label;
-        ASSERT_EQ(beside.paths.size(), alone.paths.size()) << label;
-        for (std::size_t k = 0; k < alone.paths.size(); ++k) {
-          const CollisionPath &p = alone.paths[k], &q = beside.paths[k];
-          ASSERT_TRUE(p.id == q.id && p.contacts == q.contacts && p.start == q.start &&
-                      p.fraction == q.fraction && p.point == q.point)
-              << label << ", path " << k;
+        expectSameRun(beside, alone,
+                      std::string(colliderTypeName(shape.type)) + ", response " +
+                          std::to_string(static_cast<int>(response)) + ", " +
+                          std::to_string(threads) + " thread(s)");
+      }
+    }
+  }
+}
+
+// A block's step writes only one axis's starts for the groups of rows whose paths stay outside
+// the colliders' span on that axis (ColliderSet::startsSpan()): the same bits, contacts and paths
+// as the pool's column, for every scheme, every instruction set's loop and 1, 2 and 3 threads.
+// The rows come in bands of 1000 along an axis, so that whole groups are far from every collider
+// while others fall into the span within a tick; the sets bound the span on y (a ground plane
+// beside a ball and a box), on x only (a wall: no bound on y), and not at all (a moving plane).
+Collided spannedRun(const std::string& integrator, const std::vector<ColliderSettings>& colliders,
+                    int bandAxis, int threads, bool keepPrevious) {
+  auto system = systemWith(integrator, 60, gravityOnly(), colliders, threads);
+  system->setKeepPreviousPositions(keepPrevious);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  for (int i = 0; i < 24000; ++i) {
+    Eigen::Vector3f p(4.0f * unit(rng), 2.0f + unit(rng), 4.0f * unit(rng));
+    // Band k of 1000 rows about 0.3 k m from the ground (or the wall at x = −3).
+    p[bandAxis] =
+        0.3f * static_cast<float>(i / 1000) + 0.1f * unit(rng) - (bandAxis == 0 ? 3.0f : 0.0f);
+    ParticleInit init;
+    init.position = p;
+    init.velocity = Eigen::Vector3f(unit(rng), -3.0f + 3.0f * unit(rng), unit(rng));
+    init.velocity[bandAxis] = -3.0f + 3.0f * unit(rng);
+    system->editPool().spawn(init, 0);
+  }
+  return ticked(*system, 30);
+}
+
+TEST(CollisionStarts, RowsOutsideTheSpanGiveTheBitsOfThePoolsColumn) {
+  ColliderSettings ball;
+  ball.type = ColliderType::Sphere;
+  ball.radius = 0.5;
+  ball.center = Eigen::Vector3d(1.0, 1.0, 0.0);
+  ColliderSettings box;
+  box.type = ColliderType::Box;
+  box.center = Eigen::Vector3d(-1.0, 1.5, 0.0);
+  box.size = Eigen::Vector3d(1.0, 0.5, 1.0);
+  box.rotation = Eigen::Vector3d(0.0, 30.0, 0.0);
+  box.response = ColliderResponse::Kill;
+  ColliderSettings wall = groundPlane(ColliderResponse::Bounce, 0.5, 0.0);
+  wall.normal = Eigen::Vector3d(1.0, 0.0, 0.0);
+  wall.point = Eigen::Vector3d(-3.0, 0.0, 0.0);
+  ColliderSettings rising = groundPlane(ColliderResponse::Slide, 0.0, 0.1);
+  rising.motion.velocity = Eigen::Vector3d(0.0, 0.5, 0.0);
+  const struct {
+    const char* name;
+    std::vector<ColliderSettings> colliders;
+    int bandAxis;
+  } sets[] = {
+      {"ground, ball and box", {groundPlane(ColliderResponse::Bounce, 0.5, 0.2), ball, box}, 1},
+      {"wall", {wall}, 0},
+      {"rising ground", {rising}, 1}};
+  for (const auto& set : sets) {
+    for (const std::string& integrator : integratorNames()) {
+      const Collided reference = spannedRun(integrator, set.colliders, set.bandAxis, 1, true);
+      const std::string label = std::string(set.name) + ", " + integrator;
+      EXPECT_GT(reference.contacts, 1000u) << label;
+      for (const Isa isa : test::isasHere()) {
+        const ForcedIsa forced(isa);
+        for (const int threads : {1, 2, 3}) {
+          expectSameRun(
+              spannedRun(integrator, set.colliders, set.bandAxis, threads, false), reference,
+              label + ", " + isaName(isa) + ", " + std::to_string(threads) + " thread(s)");
         }
       }
     }
+  }
+}
+
+// The screen of a block's paths (Collider::screen) runs on each instruction set's loop: every path
+// gets the same flag on every path the processor has, and no path with a contact is screened
+// out. The paths: near each shape's surface on both sides, crossing it, far away, on its exact
+// axis values, and with infinite and NaN coordinates.
+TEST(CollisionScreen, EveryInstructionSetFlagsTheSameRowsAndKeepsEveryContact) {
+  ColliderSettings ground = groundPlane(ColliderResponse::Bounce, 0.5, 0.0);
+  ground.point = Eigen::Vector3d(0.0, 0.25, 0.0);
+  ground.particleRadius = 0.05;
+  ColliderSettings oblique = ground;
+  oblique.normal = Eigen::Vector3d(0.3, 1.0, -0.2);
+  ColliderSettings ball;
+  ball.type = ColliderType::Sphere;
+  ball.center = Eigen::Vector3d(0.5, 0.5, -0.5);
+  ColliderSettings box;
+  box.type = ColliderType::Box;
+  box.center = Eigen::Vector3d(-0.5, 0.5, 0.5);
+  box.size = Eigen::Vector3d(1.5, 1.0, 2.0);
+  ColliderSettings turned = box;
+  turned.size = Eigen::Vector3d(3.5, 3.5, 3.5);
+  turned.rotation = Eigen::Vector3d(10.0, 20.0, 30.0);
+  turned.side = ColliderSide::Inside;
+  constexpr std::size_t kRows = 4099;  // not a multiple of any vector's width
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> near(-2.0f, 2.0f);
+  std::array<std::vector<float>, 3> a, b;
+  const float specials[] = {0.25f,
+                            0.3f,
+                            -0.0f,
+                            std::numeric_limits<float>::infinity(),
+                            -std::numeric_limits<float>::infinity(),
+                            std::numeric_limits<float>::quiet_NaN(),
+                            1e30f};
+  for (std::size_t c = 0; c < 3; ++c) {
+    for (std::size_t i = 0; i < kRows; ++i) {
+      a[c].push_back(near(rng));
+      // Short steps mostly, a long one a row in eight.
+      b[c].push_back(a[c].back() + near(rng) * (i % 8 == 0 ? 1.0f : 0.05f));
+    }
+    for (std::size_t k = 0; k < std::size(specials); ++k) a[c][17 * k + c] = specials[k];
+  }
+  const float* const starts[3] = {a[0].data(), a[1].data(), a[2].data()};
+  const float* const ends[3] = {b[0].data(), b[1].data(), b[2].data()};
+  for (const ColliderSettings& settings : {ground, oblique, ball, box, turned}) {
+    const auto collider = makeCollider(settings);
+    collider->beginTick(0, 60);
+    const std::string label(colliderTypeName(settings.type));
+    std::vector<std::uint8_t> reference;
+    for (const Isa isa : test::isasHere()) {
+      const ForcedIsa forced(isa);
+      std::vector<std::uint8_t> flags(kRows, 0);
+      collider->screen(starts, ends, kRows, flags.data());
+      if (isa == Isa::Baseline) {
+        reference = flags;
+        continue;
+      }
+      const auto differ = std::mismatch(flags.begin(), flags.end(), reference.begin()).first;
+      EXPECT_TRUE(differ == flags.end())
+          << label << " on " << isaName(isa) << ": row " << (differ - flags.begin());
+    }
+    std::size_t flagged = 0;
+    for (std::size_t i = 0; i < kRows; ++i) {
+      flagged += reference[i];
+      const Eigen::Vector3f from(a[0][i], a[1][i], a[2][i]), to(b[0][i], b[1][i], b[2][i]);
+      Contact contact;
+      if (reference[i] == 0) {
+        EXPECT_FALSE(collider->firstContact(from, 0.0f, to, contact)) << label << ", row " << i;
+      }
+    }
+    // Some rows either way: a screen that flags all or none is no test of the loops.
+    EXPECT_GT(flagged, kRows / 20) << label;
+    EXPECT_LT(flagged, kRows - kRows / 20) << label;
   }
 }
 
