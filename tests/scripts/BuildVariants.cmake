@@ -1,6 +1,6 @@
 # cmake -P script behind the determinism.compilers test.
 #
-# Builds only the tickfx CLI, as unity builds, in two more variants (clang++ and g++ at -O3
+# Builds only the tickfx CLI, as unity builds, in more variants (by default g++ at -O3
 # -march=native, as a host that builds tickfx for its own CPU would), runs every sample of
 # GOLDEN_FILE and every golden effect of GOLDEN_EFFECTS_FILE through each of them and through the
 # main build's MAIN_TICKFX, and fails with a table unless every state hash is the golden one.
@@ -8,8 +8,8 @@
 # Inputs: SOURCE_DIR, WORK_DIR (variants are built in WORK_DIR/<name>), GENERATOR, MAIN_TICKFX,
 # MAIN_NAME (a label for the main build), GOLDEN_FILE (samples/<file> <hash> lines),
 # GOLDEN_EFFECTS_FILE (<file> <hash> lines for the effects beside it, tests/data/golden/).
-# Optional: VARIANTS, the variants to build (default "clang-native;gcc-native"; gcc-debug, below,
-# on request).
+# Optional: VARIANTS, the variants to build (default "gcc-native"; clang-native and gcc-debug,
+# below, on request).
 cmake_minimum_required(VERSION 3.22)
 
 foreach(var SOURCE_DIR WORK_DIR GENERATOR MAIN_TICKFX MAIN_NAME GOLDEN_FILE GOLDEN_EFFECTS_FILE)
@@ -33,11 +33,13 @@ endforeach()
 
 # What each variant checks, beside the main build (g++ -O3, the baseline x86-64 with the wide
 # kernels chosen at run time):
-# - clang-native: the other compiler's optimisers at -O3, vectorising everything for this CPU's
-#   widest units (AVX2, AVX-512). clang++ at -O1 is checked too, by scripts/test's ASan and TSan
-#   builds, which run the same golden hashes.
 # - gcc-native: g++'s vectorisers for the widest units everywhere (GCC 12's SLP vectoriser is the
 #   known offender; the main build has it on SSE2 only, outside its dispatched kernels).
+# - clang-native (on request: -DVARIANTS=clang-native): the other compiler's optimisers at -O3,
+#   vectorising everything for this CPU's widest units (AVX2, AVX-512). It left CI on 2026-12-03
+#   to keep scripts/test within its 30 minutes (about 150 s of a clean clone on 2 cores): clang++
+#   is still checked against the same golden hashes by the ASan/UBSan and TSan builds, and clang
+#   has no known fault that folds a rounding away; g++ 12 has one, hence the variant kept.
 # - gcc-debug (on request: -DVARIANTS=gcc-debug): g++ at -O0, no optimiser at all. It left CI to
 #   keep scripts/test within its 30 minutes (104 s of a clean clone's build on 2 cores): every
 #   optimised build agreeing with the stored hashes leaves the unoptimised one little to find. No
@@ -45,7 +47,7 @@ endforeach()
 #   no instruction.
 # A clang++ -O3 variant for the baseline x86-64 (SSE2) was dropped earlier for the same budget.
 if(NOT DEFINED VARIANTS)
-  set(VARIANTS clang-native gcc-native)
+  set(VARIANTS gcc-native)
 endif()
 set(gcc-debug_compiler ${GXX})
 set(gcc-debug_type Debug)
