@@ -65,10 +65,10 @@ class ShapeCollider final : public Collider {
     // expressions, so the same bits.
     if (!tick_.moving) {
       // Still: a loop over the columns the compiler vectorises, where the shape has one.
-      if constexpr (requires { shape_.screenColumns(a, b, n, flags); }) {
+      if constexpr (kStillScreen == StillScreen::kColumns) {
         shape_.screenColumns(a, b, n, flags);
         return;
-      } else if constexpr (requires(V3 & v) { shape_.screenBox(v, v); }) {
+      } else if constexpr (kStillScreen == StillScreen::kBox) {
         V3 lo, hi;
         if (shape_.screenBox(lo, hi)) {
           screenBoxColumns(a, b, n, lo, hi, flags);
@@ -92,13 +92,13 @@ class ShapeCollider final : public Collider {
   // way (screenColumns), else its screening box's.
   bool screenSpan(int axis, float& lo, float& hi) const override {
     if (tick_.moving) return false;
-    if constexpr (requires { shape_.screenColumns(nullptr, nullptr, 0, nullptr); }) {
+    if constexpr (kStillScreen == StillScreen::kColumns) {
       if constexpr (requires { shape_.screenSpan(axis, lo, hi); }) {
         return shape_.screenSpan(axis, lo, hi);
       } else {
         return false;
       }
-    } else if constexpr (requires(V3 & v) { shape_.screenBox(v, v); }) {
+    } else if constexpr (kStillScreen == StillScreen::kBox) {
       V3 below, above;
       if (!shape_.screenBox(below, above)) return false;
       lo = below[axis];
@@ -109,6 +109,19 @@ class ShapeCollider final : public Collider {
   }
 
  private:
+  // How screen() screens a still shape's paths, which screenSpan() must bound: the shape's own
+  // loop over the columns, its screening box's, or mayTouch() row by row.
+  enum class StillScreen { kColumns, kBox, kRows };
+  static constexpr StillScreen kStillScreen = [] {
+    if constexpr (requires(const Shape& s) { s.screenColumns(nullptr, nullptr, 0, nullptr); }) {
+      return StillScreen::kColumns;
+    } else if constexpr (requires(const Shape& s, V3& v) { s.screenBox(v, v); }) {
+      return StillScreen::kBox;
+    } else {
+      return StillScreen::kRows;
+    }
+  }();
+
   // firstContact(), inline for contactRows().
   [[gnu::always_inline]] bool contactOf(const V3& a, float fromFraction, const V3& b,
                                         Contact& out) const {

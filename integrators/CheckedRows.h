@@ -367,9 +367,8 @@ void updateComponents(NonfiniteCheck* check, ParticlePool& pool, RowRange rows,
     suspect = updateBlocks<true, true>(n, updateComponent);
   } else if (!copies) {
     suspect = updateBlocks<false, false>(n, updateComponent);
-  } else if constexpr (!std::is_same_v<Span, NoSpanRows>) {
-    suspect = span != nullptr ? updateBlocks<false, true>(n, updateComponent, *span)
-                              : updateBlocks<false, true>(n, updateComponent);
+  } else if (span != nullptr) {
+    suspect = updateBlocks<false, true>(n, updateComponent, *span);
   } else {
     suspect = updateBlocks<false, true>(n, updateComponent);
   }

@@ -21,6 +21,7 @@
 #include "fields/Collider.h"
 #include "fields/ColliderSet.h"
 #include "particles/Isa.h"
+#include "particles/StartsSpan.h"
 #include "particles/StateHash.h"
 
 namespace tickfx {
@@ -733,7 +734,15 @@ Collided spannedRun(const std::string& integrator, const std::vector<ColliderSet
   return ticked(*system, 30);
 }
 
-TEST(CollisionStarts, RowsOutsideTheSpanGiveTheBitsOfThePoolsColumn) {
+// The collider sets of the span tests: a span on y (a ground plane beside a ball and a turned
+// box that kills), on x only (a wall), and none (a rising ground).
+struct SpanSet {
+  const char* name;
+  std::vector<ColliderSettings> colliders;
+  int bandAxis;
+};
+
+std::vector<SpanSet> spanSets() {
   ColliderSettings ball;
   ball.type = ColliderType::Sphere;
   ball.radius = 0.5;
@@ -749,14 +758,39 @@ TEST(CollisionStarts, RowsOutsideTheSpanGiveTheBitsOfThePoolsColumn) {
   wall.point = Eigen::Vector3d(-3.0, 0.0, 0.0);
   ColliderSettings rising = groundPlane(ColliderResponse::Slide, 0.0, 0.1);
   rising.motion.velocity = Eigen::Vector3d(0.0, 0.5, 0.0);
+  return {{"ground, ball and box", {groundPlane(ColliderResponse::Bounce, 0.5, 0.2), ball, box}, 1},
+          {"wall", {wall}, 0},
+          {"rising ground", {rising}, 1}};
+}
+
+// Each still collider bounds its screen on an axis (Collider::screenSpan()), and the set takes
+// the union on y, else x: the plane's half-line and the shapes' screening boxes, each with the
+// screen's slack (under a thousandth here), and no span where a collider moves.
+TEST(CollisionStarts, StillCollidersBoundTheirScreenOnOneAxis) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
   const struct {
-    const char* name;
-    std::vector<ColliderSettings> colliders;
-    int bandAxis;
-  } sets[] = {
-      {"ground, ball and box", {groundPlane(ColliderResponse::Bounce, 0.5, 0.2), ball, box}, 1},
-      {"wall", {wall}, 0},
-      {"rising ground", {rising}, 1}};
+    int axis;
+    float lo, hi;  // the span without the slack
+  } expected[] = {{1, -kInf, 1.75f}, {0, -kInf, -3.0f}, {-1, 0.0f, 0.0f}};
+  const std::vector<SpanSet> sets = spanSets();
+  for (std::size_t k = 0; k < sets.size(); ++k) {
+    auto system = systemWith("semi_implicit_euler", 60, gravityOnly(), sets[k].colliders);
+    system->editPool().spawn(ParticleInit{}, 0);
+    system->step();
+    const StartsSpan& span = system->colliders()->startsSpan();
+    const auto& e = expected[k];
+    ASSERT_EQ(span.axis, e.axis) << sets[k].name;
+    if (e.axis < 0) continue;
+    // The slack widens the span outwards, never inwards.
+    EXPECT_LE(span.lo, e.lo) << sets[k].name;
+    EXPECT_GE(span.lo, e.lo == -kInf ? -kInf : e.lo - 1e-3f) << sets[k].name;
+    EXPECT_GE(span.hi, e.hi) << sets[k].name;
+    EXPECT_LE(span.hi, e.hi == kInf ? kInf : e.hi + 1e-3f) << sets[k].name;
+  }
+}
+
+TEST(CollisionStarts, RowsOutsideTheSpanGiveTheBitsOfThePoolsColumn) {
+  const std::vector<SpanSet> sets = spanSets();
   for (const auto& set : sets) {
     // Under the sanitizers, a scheme of one pass and one of stages.
     const std::vector<std::string> schemes =
