@@ -1,0 +1,747 @@
+#include "io/cache/VdbPointGrouping.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "io/util/ProfiledTbb.h"
+#include "particles/Isa.h"
+
+namespace tickfx::io {
+namespace {
+
+namespace vdbp = openvdb::points;
+using Leaf = vdbp::PointDataTree::LeafNodeType;
+
+// Points whose coordinates are within this bound sit in their nearest voxel; beyond it (or not
+// finite) in voxel 0 of that axis. Far inside the 32-bit voxel indices, with room for a tree's
+// nodes around them.
+constexpr double kLargestIndex = 1073741824.0;  // 2³⁰
+
+// One coordinate x as OpenVDB stores it: voxel index n and offset o with float(n + o) == x
+// bitwise (the voxel size is 1), |o| <= 0.5 in the voxel nearest to x. When that is not exact
+// (x beyond the bound, inf, nan; −0.0, whose sign no sum with n = 0 keeps) the coordinate goes
+// whole into voxel 0.
+// Coord::round's rule, floor(x + 0.5), for a finite |x| < 2³⁰, and x's offset from that voxel,
+// in float alone (a float → double → float round trip is what g++ 12's vectoriser may fold
+// away): x − floor(x) is exact, and so is x − n for the nearest integer n.
+// The choice of n or n + 1 is made on the bits, not by a branch (on random positions it is a
+// coin toss the processor would guess wrong half the time) nor by adding 0 (−0.0 + 0 is +0.0).
+// floor(x) for |x| < 2³¹, sign of zero included, without a call or a branch: x86-64's baseline
+// has no rounding instruction, so std::floor calls the C library. The truncation is exact (an |x|
+// past 2²³ is whole already), its sign is put back for −0.0 and (−1, 0), and 1 is taken off a
+// negative x's truncation when it is above x (subtracting +0 keeps the sign of −0.0).
+[[gnu::always_inline]] inline float floorOf(float x) {
+  const float truncated = std::copysign(static_cast<float>(static_cast<std::int32_t>(x)), x);
+  const std::uint32_t above = 0u - static_cast<std::uint32_t>(truncated > x);
+  return truncated - std::bit_cast<float>(std::bit_cast<std::uint32_t>(1.0f) & above);
+}
+
+[[gnu::always_inline]] inline std::pair<openvdb::Int32, float> nearestVoxel(float x) {
+  const float down = floorOf(x);
+  const std::uint32_t up = 0u - static_cast<std::uint32_t>(x - down >= 0.5f);
+  const float n = std::bit_cast<float>((std::bit_cast<std::uint32_t>(down + 1.0f) & up) |
+                                       (std::bit_cast<std::uint32_t>(down) & ~up));
+  return {static_cast<openvdb::Int32>(n), x - n};
+}
+
+[[gnu::always_inline]] inline std::pair<openvdb::Int32, float> place(float x) {
+  if (std::isfinite(x) && std::abs(x) < static_cast<float>(kLargestIndex)) {
+    const auto [n, offset] = nearestVoxel(x);
+    const float back = static_cast<float>(n) + offset;
+    if (std::bit_cast<std::uint32_t>(back) == std::bit_cast<std::uint32_t>(x)) return {n, offset};
+  }
+  return {0, x};
+}
+
+constexpr std::size_t kPlacementGrain = 16384;
+
+// Where a point goes: its leaf, its voxel in the leaf, and its row (which orders the points of a
+// voxel, so the order is total and a parallel sort gives one answer).
+struct PointSlot {
+  openvdb::Coord leaf;
+  openvdb::Index32 voxel = 0;
+  std::size_t row = 0;
+  bool operator<(const PointSlot& o) const {
+    if (leaf != o.leaf) return leaf < o.leaf;
+    if (voxel != o.voxel) return voxel < o.voxel;
+    return row < o.row;
+  }
+};
+
+// A 16-bit fixed-point coordinate needs only its voxel and an offset within ±0.5, not the exact
+// bits: the codec quantises the offset anyway (and turns a NaN into undefined behaviour).
+[[gnu::always_inline]] inline std::pair<openvdb::Int32, float> placeQuantised(float x) {
+  if (std::isnan(x)) return {0, 0.0f};
+  if (!(std::abs(x) < static_cast<float>(kLargestIndex))) return {0, x > 0 ? 0.5f : -0.5f};
+  return nearestVoxel(x);
+}
+
+// The frame's position columns, held apart from the frame: a loop that stores between two reads
+// would otherwise read the columns' addresses from the frame again after every store.
+struct Positions {
+  std::array<const float*, 3> axis;
+  explicit Positions(const FrameData& frame)
+      : axis{frame.position.x.data(), frame.position.y.data(), frame.position.z.data()} {}
+
+  // The voxel of row r (and its offset in that voxel, when asked), placed as the positions'
+  // codec places it. Inlined into the placement loops, where a call would cost more.
+  template <bool Quantised>
+  [[gnu::always_inline]] openvdb::Coord voxel(std::size_t r,
+                                              openvdb::Vec3f* offset = nullptr) const {
+    openvdb::Coord voxel;
+    for (int c = 0; c < 3; ++c) {
+      const float x = axis[static_cast<std::size_t>(c)][r];
+      const auto [index, o] = Quantised ? placeQuantised(x) : place(x);
+      voxel[c] = index;
+      if (offset != nullptr) (*offset)[c] = o;
+    }
+    return voxel;
+  }
+};
+
+constexpr auto kLeafMask = ~static_cast<openvdb::Int32>(Leaf::DIM - 1);
+
+// Rows placed kPlacedRows at a time by placeRows(): each axis's voxel indices and offsets.
+constexpr std::size_t kPlacedRows = 512;
+struct PlacedRows {
+  std::array<std::array<std::int32_t, kPlacedRows>, 3> index;
+  std::array<std::array<float, kPlacedRows>, 3> offset;
+
+  openvdb::Coord voxel(std::size_t k) const { return {index[0][k], index[1][k], index[2][k]}; }
+};
+
+// Places rows [begin, begin + count) (count <= kPlacedRows) as Positions::voxel() places them,
+// the same bits, in loops without branches or calls that the compiler vectorises: the
+// coordinates outside the bound (or NaN) are placed as if they were 0, then their results
+// replaced (the same rule as place(), placeQuantised() and nearestVoxel() above).
+template <bool Quantised>
+void placeRows(const Positions& positions, std::size_t begin, std::size_t count,
+               PlacedRows& placed) {
+  constexpr float kBound = static_cast<float>(kLargestIndex);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const float* __restrict x = positions.axis[c] + begin;
+    std::int32_t* __restrict index = placed.index[c].data();
+    float* __restrict offset = placed.offset[c].data();
+    for (std::size_t k = 0; k < count; ++k) {
+      // Selections by masks, not ternaries: the compiler turns a ternary into a branch, which
+      // random positions mispredict half the time, and does not vectorise it.
+      const auto mask = [](bool b) { return 0u - static_cast<std::uint32_t>(b); };
+      const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+      const auto real = [](std::uint32_t u) { return std::bit_cast<float>(u); };
+      const float v = x[k];
+      const std::uint32_t inside = mask(std::abs(v) < kBound);  // false for NaN
+      const float safe = real(bits(v) & inside);
+      const float down = floorOf(safe);
+      const std::uint32_t up = mask(safe - down >= 0.5f);
+      const float n = real((bits(down + 1.0f) & up) | (bits(down) & ~up));  // −0.0 stays −0.0
+      const auto i = static_cast<std::int32_t>(n);
+      const float o = safe - n;
+      std::uint32_t keep = inside;  // the rows placed by nearestVoxel()
+      std::uint32_t otherwise = bits(v);
+      if constexpr (Quantised) {
+        otherwise = ((bits(v) & 0x80000000u) | bits(0.5f)) & ~mask(v != v);  // ±0.5, NaN 0
+      } else {
+        keep &= mask(bits(static_cast<float>(i) + o) == bits(v));
+      }
+      index[k] = static_cast<std::int32_t>(static_cast<std::uint32_t>(i) & keep);
+      offset[k] = real((bits(o) & keep) | (otherwise & ~keep));
+    }
+  }
+}
+
+// A box of leaves: its first and last leaf origins, and its extent in leaves on each axis.
+struct LeafBox {
+  std::array<std::int32_t, 3> first{}, last{};
+  std::array<std::uint32_t, 3> extent{};
+};
+
+// Each of the `count` placed rows' leaf index in `box` (x, then y, then z: Coord's order) in
+// leaf[k], and false where some row's leaf lies outside the box (its index is then meaningless).
+// In plain integer loops that the compiler vectorises; the box holds at most 2³² leaves, so the
+// indices of the rows inside it fit 32 bits.
+bool leafIndices(const PlacedRows& placed, std::size_t count, const LeafBox& box,
+                 std::uint32_t* __restrict leaf) {
+  constexpr unsigned kLeafLog2 = Leaf::LOG2DIM;
+  std::uint32_t outside = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    std::uint32_t index = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::int32_t origin = placed.index[c][k] & kLeafMask;
+      outside |= static_cast<std::uint32_t>(origin < box.first[c]) |
+                 static_cast<std::uint32_t>(origin > box.last[c]);
+      // (Unsigned: exact for a leaf in the box, where first <= origin <= last.)
+      index = index * box.extent[c] +
+              ((static_cast<std::uint32_t>(origin) - static_cast<std::uint32_t>(box.first[c])) >>
+               kLeafLog2);
+    }
+    leaf[k] = index;
+  }
+  return outside == 0;
+}
+
+// placeRows() and leafIndices() compiled for each instruction set (particles/Isa.h), whole
+// (flatten): the same bits on each, as they use integer operations and IEEE arithmetic alone.
+#ifdef TICKFX_AVX2_CLONES
+template <bool Quantised>
+[[gnu::target("avx2"), gnu::flatten]] void placeRowsAvx2(const Positions& positions,
+                                                         std::size_t begin, std::size_t count,
+                                                         PlacedRows& placed) {
+  placeRows<Quantised>(positions, begin, count, placed);
+}
+template <bool Quantised>
+[[gnu::target("avx2,avx512f"), gnu::flatten]] void placeRowsAvx512(const Positions& positions,
+                                                                   std::size_t begin,
+                                                                   std::size_t count,
+                                                                   PlacedRows& placed) {
+  placeRows<Quantised>(positions, begin, count, placed);
+}
+[[gnu::target("avx2"), gnu::flatten]] bool leafIndicesAvx2(const PlacedRows& placed,
+                                                           std::size_t count, const LeafBox& box,
+                                                           std::uint32_t* leaf) {
+  return leafIndices(placed, count, box, leaf);
+}
+[[gnu::target("avx2,avx512f"), gnu::flatten]] bool leafIndicesAvx512(const PlacedRows& placed,
+                                                                     std::size_t count,
+                                                                     const LeafBox& box,
+                                                                     std::uint32_t* leaf) {
+  return leafIndices(placed, count, box, leaf);
+}
+#endif
+
+// Each point's leaf and voxel offset within its leaf (0 to 511), in row order (sorted below).
+template <bool Quantised>
+std::vector<PointSlot> slotsInRowOrder(const FrameData& frame) {
+  const std::size_t n = frame.size();
+  const Positions positions(frame);
+  std::vector<PointSlot> slots(n);
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        const openvdb::Coord voxel = positions.voxel<Quantised>(i);
+                        slots[i] =
+                            PointSlot{voxel & kLeafMask,
+                                      static_cast<openvdb::Index32>(Leaf::coordToOffset(voxel)), i};
+                      }
+                    });
+  return slots;
+}
+
+// The slots in (leaf, voxel, row) order by a sort of 64-bit keys, when the leaves' bounding box,
+// 512 voxels and the rows fit in 64 bits (any effect of sane size): the leaf's index in the box
+// (x, then y, then z, as Coord's order), its voxel and its row, one integer a point, so a plain
+// integer sort gives exactly the order of PointSlot::operator<. False, slots untouched, otherwise.
+bool sortByKeys(std::vector<PointSlot>& slots) {
+  const std::size_t n = slots.size();
+  if (n == 0) return true;
+  using Box = std::pair<openvdb::Coord, openvdb::Coord>;
+  const auto leafBox = par::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+      Box{openvdb::Coord::max(), openvdb::Coord::min()},
+      [&](const tbb::blocked_range<std::size_t>& range, Box box) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+          box.first.minComponent(slots[i].leaf);
+          box.second.maxComponent(slots[i].leaf);
+        }
+        return box;
+      },
+      [](Box a, const Box& b) {  // min and max: the same answer in any grouping
+        a.first.minComponent(b.first);
+        a.second.maxComponent(b.second);
+        return a;
+      });
+  constexpr int kLeafLog2 = static_cast<int>(Leaf::LOG2DIM);
+  std::array<std::uint64_t, 3> extent{};
+  for (int c = 0; c < 3; ++c) {
+    extent[static_cast<std::size_t>(c)] =
+        (static_cast<std::uint64_t>(static_cast<std::int64_t>(leafBox.second[c]) -
+                                    leafBox.first[c]) >>
+         kLeafLog2) +
+        1;
+  }
+  const int rowBits = std::bit_width(n - 1);
+  const int voxelBits = 3 * kLeafLog2;
+  int leafBits = 0;
+  for (const std::uint64_t e : extent) leafBits += std::bit_width(e);
+  if (leafBits + voxelBits + rowBits > 64) return false;
+
+  const auto leafIndex = [&](const openvdb::Coord& leaf) {
+    std::uint64_t index = 0;
+    for (int c = 0; c < 3; ++c) {
+      index = index * extent[static_cast<std::size_t>(c)] +
+              (static_cast<std::uint64_t>(static_cast<std::int64_t>(leaf[c]) - leafBox.first[c]) >>
+               kLeafLog2);
+    }
+    return index;
+  };
+  std::vector<std::uint64_t> keys(n);
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        const PointSlot& s = slots[i];
+                        keys[i] = (leafIndex(s.leaf) << (voxelBits + rowBits)) |
+                                  (std::uint64_t{s.voxel} << rowBits) | s.row;
+                      }
+                    });
+  par::parallel_sort(keys.begin(), keys.end());
+  // Rebuilt from the keys, in their order: the row names the point, whose leaf and voxel are
+  // those of its unsorted slot.
+  std::vector<PointSlot> sorted(n);
+  const std::uint64_t rowMask = (std::uint64_t{1} << rowBits) - 1;
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, n, kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        sorted[k] = slots[static_cast<std::size_t>(keys[k] & rowMask)];
+                      }
+                    });
+  slots = std::move(sorted);
+  return true;
+}
+
+// Consecutive leaves gathered for the counting sort: at most kBucketLeaves leaves and, unless a
+// leaf alone holds more, kBucketPoints points or a kBucketShare-th of the frame's, whichever is
+// more. Rows are first scattered by bucket (some 140 streams at 10⁶ and 10⁷ points over a 100 m
+// box, where a scatter by leaf wrote 2200 and missed the cache on nearly every value), each
+// bucket's rows in row order; then each bucket, small enough for the cache, is put in order by
+// leaf and voxel.
+constexpr std::size_t kBucketPoints = 8192;
+constexpr std::size_t kBucketShare = 128;
+constexpr std::uint32_t kBucketLeaves = 16;
+constexpr unsigned kVoxelBits = 3 * Leaf::LOG2DIM;  // a voxel's index in its leaf
+static_assert(std::size_t{1} << kVoxelBits == Leaf::SIZE);
+static_assert((kBucketLeaves << kVoxelBits) - 1 <= std::numeric_limits<std::uint16_t>::max(),
+              "a point's key in its bucket (leaf, voxel) fits the voxel column's 16 bits");
+
+std::vector<const float*> pointFloatColumns(const FrameData& frame) {
+  std::vector<const float*> columns = {frame.velocity[0].data(), frame.velocity[1].data(),
+                                       frame.velocity[2].data(), frame.age.data(),
+                                       frame.life.data(),        frame.mass.data()};
+  for (const FloatColumn& a : frame.attributes) columns.push_back(a.data());
+  return columns;
+}
+
+// The general way: every point's slot, sorted by (leaf, voxel, row).
+template <bool Quantised>
+GroupedPoints sortedPoints(const FrameData& frame) {
+  std::vector<PointSlot> slots = slotsInRowOrder<Quantised>(frame);
+  if (!sortByKeys(slots)) par::parallel_sort(slots.begin(), slots.end());
+  const std::vector<const float*> source = pointFloatColumns(frame);
+  GroupedPoints points(slots.size(), source.size());
+  const Positions positions(frame);
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        const std::size_t r = slots[k].row;
+                        points.voxel[k] = static_cast<std::uint16_t>(slots[k].voxel);
+                        positions.voxel<Quantised>(r, &points.offset[k]);
+                        points.id[k] = frame.id[r];
+                        for (std::size_t j = 0; j < source.size(); ++j)
+                          points.columns[j][k] = source[j][r];
+                      }
+                    });
+  for (std::size_t k = 0; k < slots.size(); ++k) {
+    if (k == 0 || slots[k].leaf != slots[k - 1].leaf) {
+      points.starts.push_back(k);
+      points.origins.push_back(slots[k].leaf);
+    }
+  }
+  points.starts.push_back(slots.size());
+  return points;
+}
+
+// to[at[i]] = from[i] for rows [begin, end).
+template <typename T>
+void scatter(const T* __restrict from, const std::uint32_t* __restrict at, std::size_t begin,
+             std::size_t end, T* __restrict to) {
+  for (std::size_t i = begin; i < end; ++i) to[at[i]] = from[i];
+}
+
+// Rows are bucketed in chunks of at least this many, at most kMaxChunks chunks.
+constexpr std::size_t kBucketChunk = 65536;
+constexpr std::size_t kMaxChunks = 64;
+
+// Extends [low, high] over the coordinates x[begin, end) below 2³⁰ in magnitude, and returns
+// whether some other coordinate (beyond, infinite or NaN: placed at 0) is among them. A
+// register's lanes of bounds at once, folded at the end (min and max give the same bounds in any
+// order; a zero's sign may differ, and both zeros lie in the same voxel).
+using Floats4 = float __attribute__((vector_size(16)));
+using Floats8 = float __attribute__((vector_size(32)));
+using Floats16 = float __attribute__((vector_size(64)));
+using Ints4 = std::int32_t __attribute__((vector_size(16)));
+using Ints8 = std::int32_t __attribute__((vector_size(32)));
+using Ints16 = std::int32_t __attribute__((vector_size(64)));
+
+template <typename Floats, typename Bits>
+bool extendBoundsBy(const float* x, std::size_t begin, std::size_t end, float& low, float& high) {
+  constexpr int Lanes = sizeof(Floats) / sizeof(float);
+  static_assert(sizeof(Bits) == sizeof(Floats));
+  constexpr auto kLimit = static_cast<float>(kLargestIndex);
+  Floats limit, lows, highs;
+  for (int k = 0; k < Lanes; ++k) {
+    limit[k] = kLimit;
+    lows[k] = low;
+    highs[k] = high;
+  }
+  Bits outside = {};
+  std::size_t i = begin;
+  for (; i + Lanes <= end; i += Lanes) {
+    Floats v;
+    std::memcpy(&v, x + i, sizeof v);
+    const Bits bits = __builtin_bit_cast(Bits, v);
+    const Bits inside = __builtin_bit_cast(Floats, bits & 0x7fffffff) < limit;  // all ones; not NaN
+    const Bits lower = inside & (v < lows), higher = inside & (v > highs);
+    lows = __builtin_bit_cast(Floats, (bits & lower) | (__builtin_bit_cast(Bits, lows) & ~lower));
+    highs =
+        __builtin_bit_cast(Floats, (bits & higher) | (__builtin_bit_cast(Bits, highs) & ~higher));
+    outside |= ~inside;
+  }
+  bool beyond = false;
+  for (int k = 0; k < Lanes; ++k) {
+    low = std::min(low, lows[k]);
+    high = std::max(high, highs[k]);
+    beyond |= outside[k] != 0;
+  }
+  for (; i < end; ++i) {
+    const bool inside = std::abs(x[i]) < kLimit;  // not NaN
+    low = std::min(low, inside ? x[i] : low);
+    high = std::max(high, inside ? x[i] : high);
+    beyond |= !inside;
+  }
+  return beyond;
+}
+
+#ifdef TICKFX_AVX2_CLONES
+[[gnu::target("avx2"), gnu::flatten]] bool extendBoundsAvx2(const float* x, std::size_t begin,
+                                                            std::size_t end, float& low,
+                                                            float& high) {
+  return extendBoundsBy<Floats8, Ints8>(x, begin, end, low, high);
+}
+[[gnu::target("avx2,avx512f"), gnu::flatten]] bool extendBoundsAvx512(const float* x,
+                                                                      std::size_t begin,
+                                                                      std::size_t end, float& low,
+                                                                      float& high) {
+  return extendBoundsBy<Floats16, Ints16>(x, begin, end, low, high);
+}
+#endif
+
+// The bounds', placement and leaf index loops above on one instruction set, the widest here,
+// chosen once (activeIsa()).
+template <bool Quantised>
+struct RowKernels {
+  using Bounds = bool (*)(const float*, std::size_t, std::size_t, float&, float&);
+  using Place = void (*)(const Positions&, std::size_t, std::size_t, PlacedRows&);
+  using Index = bool (*)(const PlacedRows&, std::size_t, const LeafBox&, std::uint32_t*);
+  Bounds bounds = &extendBoundsBy<Floats4, Ints4>;
+  Place place = &placeRows<Quantised>;
+  Index index = &leafIndices;
+
+  RowKernels() {
+#ifdef TICKFX_AVX2_CLONES
+    switch (activeIsa()) {
+      case Isa::Avx512:
+        bounds = &extendBoundsAvx512;
+        place = &placeRowsAvx512<Quantised>;
+        index = &leafIndicesAvx512;
+        break;
+      case Isa::Avx2:
+        bounds = &extendBoundsAvx2;
+        place = &placeRowsAvx2<Quantised>;
+        index = &leafIndicesAvx2;
+        break;
+      case Isa::Baseline:
+        break;
+    }
+#endif
+  }
+};
+
+// column[rank[i]] = column[i] for i < count, through a copy.
+template <typename T>
+void permute(T* __restrict column, const std::uint32_t* __restrict rank, std::size_t count,
+             std::vector<T>& copy) {
+  copy.assign(column, column + count);
+  for (std::size_t i = 0; i < count; ++i) column[rank[i]] = copy[i];
+}
+
+// Puts bucket b's points, in row order and with a voxel column that holds
+// each point's key (its leaf's place in the bucket, then its voxel), in order by key, rows in
+// order among equal keys (a counting sort): the voxel column then holds each point's voxel, and
+// the offsets are moved alike. Each point's place is kept in `rank` for the columns the store
+// puts in order later (orderLater()).
+void orderBucket(GroupedPoints& points, std::size_t b, BucketScratch& scratch) {
+  const auto [begin, end] = points.bucketPoints(b);
+  const std::size_t count = end - begin;
+  const std::size_t leaves = points.buckets.first[b + 1] - points.buckets.first[b];
+  std::uint16_t* const key = points.voxel.get() + begin;
+  scratch.counts.assign(leaves << kVoxelBits, 0);
+  for (std::size_t i = 0; i < count; ++i) ++scratch.counts[key[i]];
+  std::uint32_t sum = 0;
+  for (std::uint32_t& c : scratch.counts) sum += std::exchange(c, sum);
+  std::uint32_t* const rank = points.rank.get() + begin;
+  for (std::size_t i = 0; i < count; ++i) rank[i] = scratch.counts[key[i]]++;
+  permute(key, rank, count, scratch.keys);
+  for (std::size_t i = 0; i < count; ++i) key[i] &= Leaf::SIZE - 1;  // the voxel alone
+  permute(points.offset.get() + begin, rank, count, scratch.vectors);
+}
+
+constexpr std::uint8_t kOrdering = 1, kOrdered = 2;
+
+// The fast way, when the leaves' bounding box holds few enough leaves to count them in a table
+// (any effect of sane size): a stable counting sort of the rows by the leaf's index in the box
+// (x, then y, then z: Coord's order), in two steps: by bucket of leaves, then within each bucket
+// by leaf and voxel (Buckets, orderBucket). The chunks are fixed by the point count alone (the
+// order depends on neither them nor the threads). Nothing otherwise.
+template <bool Quantised>
+std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
+  const std::size_t n = frame.size();
+  if (n == 0 || n > std::numeric_limits<std::uint32_t>::max()) return std::nullopt;
+  // A box holding every point's leaf (a larger one would give the same order): the voxel of a
+  // finite coordinate within the bound rises with it, and any other is in voxel 0.
+  struct Range {
+    std::array<float, 3> low{}, high{};
+    bool placedAtZero = false;
+  };
+  Range init;
+  init.low.fill(std::numeric_limits<float>::infinity());
+  init.high.fill(-std::numeric_limits<float>::infinity());
+  const RowKernels<Quantised> kernels;
+  const Range range = par::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kPlacementGrain), init,
+      [&](const tbb::blocked_range<std::size_t>& rows, Range r) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          r.placedAtZero |= kernels.bounds(frame.position[static_cast<int>(c)].data(), rows.begin(),
+                                           rows.end(), r.low[c], r.high[c]);
+        }
+        return r;
+      },
+      [](Range a, const Range& b) {  // min, max and or: the same answer in any grouping
+        for (std::size_t c = 0; c < 3; ++c) {
+          a.low[c] = std::min(a.low[c], b.low[c]);
+          a.high[c] = std::max(a.high[c], b.high[c]);
+        }
+        a.placedAtZero |= b.placedAtZero;
+        return a;
+      });
+  std::pair<openvdb::Coord, openvdb::Coord> box{openvdb::Coord::max(), openvdb::Coord::min()};
+  for (int c = 0; c < 3; ++c) {
+    const auto k = static_cast<std::size_t>(c);
+    if (range.low[k] <= range.high[k]) {
+      box.first[c] = std::min(box.first[c], nearestVoxel(range.low[k]).first & kLeafMask);
+      box.second[c] = std::max(box.second[c], nearestVoxel(range.high[k]).first & kLeafMask);
+    }
+    if (range.placedAtZero) {
+      box.first[c] = std::min(box.first[c], 0);
+      box.second[c] = std::max(box.second[c], 0);
+    }
+  }
+  const std::size_t chunks = std::clamp<std::size_t>(n / kBucketChunk, 1, kMaxChunks);
+  // Table entries, leaves × chunks (leaf indices and the table's offsets fit 32 bits).
+  const std::uint64_t limit = std::min<std::uint64_t>(8 * std::uint64_t{n} + (1u << 20),
+                                                      std::numeric_limits<std::uint32_t>::max());
+  constexpr int kLeafLog2 = static_cast<int>(Leaf::LOG2DIM);
+  std::array<std::uint64_t, 3> extent{};
+  std::uint64_t leafCount = 1;
+  for (int c = 0; c < 3; ++c) {
+    const std::uint64_t e =
+        (static_cast<std::uint64_t>(static_cast<std::int64_t>(box.second[c]) - box.first[c]) >>
+         kLeafLog2) +
+        1;
+    extent[static_cast<std::size_t>(c)] = e;
+    if (e > limit / (leafCount * chunks)) return std::nullopt;  // (no product overflows)
+    leafCount *= e;
+  }
+  const std::size_t leaves = leafCount;
+  LeafBox leafBox;
+  for (std::size_t c = 0; c < 3; ++c) {
+    leafBox.first[c] = box.first[static_cast<int>(c)];
+    leafBox.last[c] = box.second[static_cast<int>(c)];
+    leafBox.extent[c] = static_cast<std::uint32_t>(extent[c]);
+  }
+  const auto chunkRange = [&](std::size_t chunk) {
+    return std::pair{chunk * n / chunks, (chunk + 1) * n / chunks};
+  };
+  // Each row's leaf, and each chunk's count of rows a leaf.
+  const Positions positions(frame);
+  const LargeArray<std::uint32_t> rowAt = allocateLargeArray<std::uint32_t>(n);
+  std::vector<std::uint32_t> table(leaves * chunks, 0);
+  std::vector<char> outsideBox(chunks, 0);
+  par::parallel_for(std::size_t{0}, chunks, [&](std::size_t chunk) {
+    std::uint32_t* count = table.data() + chunk * leaves;
+    const auto [begin, end] = chunkRange(chunk);
+    PlacedRows placed;
+    for (std::size_t first = begin; first < end; first += kPlacedRows) {
+      const std::size_t rows = std::min(kPlacedRows, end - first);
+      kernels.place(positions, first, rows, placed);
+      std::uint32_t* const leaf = rowAt.get() + first;
+      // (Never outside, as the box is made; but a wrong box must not write past the table.)
+      if (!kernels.index(placed, rows, leafBox, leaf)) {
+        outsideBox[chunk] = 1;
+        return;
+      }
+      for (std::size_t k = 0; k < rows; ++k) ++count[leaf[k]];
+    }
+  });
+  if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
+  const std::vector<const float*> source = pointFloatColumns(frame);
+  GroupedPoints points(n, source.size());
+  // The leaves that hold points, in order (each one's first point and origin), and the buckets.
+  std::vector<std::uint32_t> boxOf;  // each such leaf's index in the box
+  std::size_t sum = 0;
+  for (std::size_t l = 0; l < leaves; ++l) {
+    std::size_t total = 0;
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) total += table[chunk * leaves + l];
+    if (total == 0) continue;
+    boxOf.push_back(static_cast<std::uint32_t>(l));
+    points.starts.push_back(sum);
+    sum += total;
+    const std::uint64_t z = l % extent[2], y = (l / extent[2]) % extent[1],
+                        x = l / (extent[2] * extent[1]);
+    points.origins.push_back(box.first +
+                             openvdb::Coord(static_cast<openvdb::Int32>(x << kLeafLog2),
+                                            static_cast<openvdb::Int32>(y << kLeafLog2),
+                                            static_cast<openvdb::Int32>(z << kLeafLog2)));
+  }
+  points.starts.push_back(n);
+  Buckets buckets(points.starts);
+  // Each box leaf's bucket and place in it (bucket << 4 | place), looked up once a row.
+  static_assert(kBucketLeaves <= 16);
+  std::vector<std::uint32_t> bucketPlace(leaves);
+  for (std::size_t o = 0; o < boxOf.size(); ++o) {
+    const std::uint32_t b = buckets.of[o];
+    bucketPlace[boxOf[o]] = b << 4 | (static_cast<std::uint32_t>(o) - buckets.first[b]);
+  }
+  // Where each chunk's rows of a bucket go: bucket by bucket, chunk by chunk.
+  const std::size_t bucketCount = buckets.count();
+  std::vector<std::uint32_t> next(chunks * bucketCount);
+  for (std::size_t b = 0; b < bucketCount; ++b) {
+    auto at = static_cast<std::uint32_t>(points.starts[buckets.first[b]]);
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      next[chunk * bucketCount + b] = at;
+      for (std::uint32_t o = buckets.first[b]; o < buckets.first[b + 1]; ++o)
+        at += table[chunk * leaves + boxOf[o]];
+    }
+  }
+  // Each row's place in its bucket (rows in order within a bucket) and its key there, the place
+  // of its leaf in the bucket and its voxel, then its values, one column at a time over a run of
+  // chunks: a column's writes go to one line a bucket at a time, which stay in cache from one
+  // chunk to the next (all the columns of a chunk at once would evict each other's lines).
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+                    [&](const tbb::blocked_range<std::size_t>& run) {
+                      std::uint32_t* const at = rowAt.get();
+                      std::uint16_t* const __restrict key = points.voxel.get();
+                      openvdb::Vec3f* const __restrict offset = points.offset.get();
+                      PlacedRows placed;
+                      for (std::size_t chunk = run.begin(); chunk < run.end(); ++chunk) {
+                        std::uint32_t* const chunkNext = next.data() + chunk * bucketCount;
+                        const auto [begin, end] = chunkRange(chunk);
+                        for (std::size_t first = begin; first < end; first += kPlacedRows) {
+                          const std::size_t rows = std::min(kPlacedRows, end - first);
+                          kernels.place(positions, first, rows, placed);
+                          for (std::size_t k = 0; k < rows; ++k) {
+                            const std::uint32_t p = bucketPlace[at[first + k]];
+                            const std::uint32_t to = chunkNext[p >> 4]++;
+                            at[first + k] = to;
+                            key[to] = static_cast<std::uint16_t>(
+                                ((p & 15) << kVoxelBits) |
+                                static_cast<std::uint32_t>(Leaf::coordToOffset(placed.voxel(k))));
+                            offset[to] = openvdb::Vec3f(placed.offset[0][k], placed.offset[1][k],
+                                                        placed.offset[2][k]);
+                          }
+                        }
+                      }
+                      const std::size_t runBegin = chunkRange(run.begin()).first;
+                      const std::size_t runEnd = chunkRange(run.end() - 1).second;
+                      scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
+                      for (std::size_t j = 0; j < source.size(); ++j)
+                        scatter(source[j], at, runBegin, runEnd, points.columns[j].get());
+                    });
+  // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
+  points.rank = allocateLargeArray<std::uint32_t>(n);
+  points.buckets = std::move(buckets);
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, bucketCount),
+                    [&](const tbb::blocked_range<std::size_t>& some) {
+                      BucketScratch scratch;
+                      for (std::size_t b = some.begin(); b < some.end(); ++b)
+                        orderBucket(points, b, scratch);
+                    });
+  const std::size_t later = bucketCount * points.laterColumns();
+  points.later = std::make_unique<std::atomic<std::uint8_t>[]>(later);  // (zeroed: not yet)
+  return points;
+}
+
+}  // namespace
+
+Buckets::Buckets(const std::vector<std::size_t>& starts) : of(starts.size() - 1) {
+  const std::size_t most = std::max(kBucketPoints, starts.back() / kBucketShare);
+  std::size_t points = 0;
+  for (std::uint32_t l = 0; l < of.size(); ++l) {
+    const std::size_t count = starts[l + 1] - starts[l];
+    if (first.empty() || l - first.back() >= kBucketLeaves ||
+        (points > 0 && points + count > most)) {
+      first.push_back(l);
+      points = 0;
+    }
+    of[l] = static_cast<std::uint32_t>(first.size() - 1);
+    points += count;
+  }
+  first.push_back(static_cast<std::uint32_t>(of.size()));
+}
+
+void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScratch& scratch) {
+  std::atomic<std::uint8_t>& state = points.later[b * points.laterColumns() + s];
+  if (state.load(std::memory_order_acquire) == kOrdered) return;
+  std::uint8_t expected = 0;
+  if (!state.compare_exchange_strong(expected, kOrdering, std::memory_order_acquire)) {
+    while (state.load(std::memory_order_acquire) != kOrdered) std::this_thread::yield();
+    return;
+  }
+  const auto [begin, end] = points.bucketPoints(b);
+  const std::size_t count = end - begin;
+  const std::uint32_t* const rank = points.rank.get() + begin;
+  try {
+    if (s == 0)
+      permute(points.id.get() + begin, rank, count, scratch.ids);
+    else
+      permute(points.columns[s - 1].get() + begin, rank, count, scratch.floats);
+  } catch (...) {
+    state.store(0, std::memory_order_release);  // (an allocation failed: another may try)
+    throw;
+  }
+  state.store(kOrdered, std::memory_order_release);
+}
+
+void orderAllLater(GroupedPoints& points) {
+  if (!points.later) return;
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.buckets.count()),
+                    [&](const tbb::blocked_range<std::size_t>& some) {
+                      BucketScratch scratch;
+                      for (std::size_t b = some.begin(); b < some.end(); ++b)
+                        for (std::size_t s = 0; s < points.laterColumns(); ++s)
+                          orderLater(points, b, s, scratch);
+                    });
+}
+
+template <bool Quantised>
+GroupedPoints groupPoints(const FrameData& frame, Grouping grouping) {
+  std::optional<GroupedPoints> bucketed;
+  if (grouping == Grouping::Any) bucketed = bucketedPoints<Quantised>(frame);
+  return bucketed ? std::move(*bucketed) : sortedPoints<Quantised>(frame);
+}
+
+template GroupedPoints groupPoints<false>(const FrameData&, Grouping);
+template GroupedPoints groupPoints<true>(const FrameData&, Grouping);
+
+}  // namespace tickfx::io

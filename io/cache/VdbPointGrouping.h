@@ -1,0 +1,111 @@
+// A frame's points grouped into the leaves and voxels of a VDB points grid, in the order the
+// leaves' arrays hold them: what writeVdbPointCache makes its tree and stores its arrays from.
+// Internal to io/ (not installed): it includes OpenVDB's headers, which VdbPointCache.h keeps out.
+#pragma once
+
+#include <openvdb/points/PointDataGrid.h>
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "io/cache/FrameData.h"
+#include "io/cache/VdbPointsEncoder.h"
+
+namespace tickfx::io {
+
+/// The buckets of consecutive leaves that Grouping::Any sorts one at a time, for leaves whose
+/// points start at `starts` (and end at its last entry): first[b] is bucket b's first leaf
+/// (first[count()] the number of leaves), of[l] the bucket of leaf l.
+struct Buckets {
+  std::vector<std::uint32_t> first, of;
+
+  Buckets() = default;
+  explicit Buckets(const std::vector<std::size_t>& starts);
+  std::size_t count() const { return first.size() - 1; }
+};
+
+/// The points in the order the leaves' arrays hold them: the leaves in Coord order (ascending, as
+/// Coord's operator< orders them), a leaf's points by voxel, and in row order within a voxel. Each
+/// point's values are copied here in that order, so that a leaf's array is one stretch of each
+/// column, written to the file as it is.
+struct GroupedPoints {
+  std::vector<std::size_t> starts;  // each leaf's first point, and the end
+  std::vector<openvdb::Coord> origins;
+  // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
+  LargeArray<std::uint16_t> voxel;    // a point's voxel in its leaf (0 to 511)
+  LargeArray<openvdb::Vec3f> offset;  // its position's offset in the voxel
+  LargeArray<std::uint64_t> id;
+  // velocity x, y, z, age, life, mass, then the frame's attribute columns, in the frame's order
+  std::vector<LargeArray<float>> columns;
+  // Where set (Grouping::Any), `id` and `columns` are put in order bucket by bucket by the store
+  // itself, as the file is written (orderLater()): each bucket's rows of them are still in row
+  // order, rank[k] the place in its bucket of the point whose values are at row k, and
+  // later[b * laterColumns() + s] tells whether bucket b's column s (0: id, then columns[s − 1])
+  // is in order, being put in order or not yet.
+  LargeArray<std::uint32_t> rank;
+  Buckets buckets;
+  std::unique_ptr<std::atomic<std::uint8_t>[]> later;
+
+  GroupedPoints(std::size_t n, std::size_t floatColumnCount)
+      : voxel(allocateLargeArray<std::uint16_t>(n)),
+        offset(allocateLargeArray<openvdb::Vec3f>(n)),
+        id(allocateLargeArray<std::uint64_t>(n)) {
+    for (std::size_t j = 0; j < floatColumnCount; ++j)
+      columns.push_back(allocateLargeArray<float>(n));
+  }
+  // The columns `later` tells of for each bucket: the ids, then the float columns.
+  std::size_t laterColumns() const { return 1 + columns.size(); }
+  // The points of bucket b: [first, second).
+  std::pair<std::size_t, std::size_t> bucketPoints(std::size_t b) const {
+    return {starts[buckets.first[b]], starts[buckets.first[b + 1]]};
+  }
+};
+
+/// GroupedPoints::columns' first ones, from the frame's standard columns.
+inline constexpr std::size_t kStandardFloatColumns = 6;  // velocity x, y, z, age, life, mass
+
+// What the orderings reuse from one bucket to the next (orderLater()).
+struct BucketScratch {
+  std::vector<std::uint32_t> counts;
+  std::vector<std::uint16_t> keys;
+  std::vector<openvdb::Vec3f> vectors;
+  std::vector<std::uint64_t> ids;
+  std::vector<float> floats;
+};
+
+/// Which way the points are grouped: only tests ask for the general way.
+enum class Grouping {
+  /// A counting sort of the rows by bucket of leaves, then by leaf and voxel within each bucket,
+  /// where the leaves' bounding box is small enough to count them in a table (any effect of sane
+  /// size); the sort below otherwise. Its `id` and `columns` are put in order by orderLater().
+  Any,
+  /// Every point's (leaf, voxel, row) sorted: the general way.
+  Sorted,
+};
+
+/// The frame's points grouped into leaves and voxels, each point placed as the grid's position
+/// codec places it: the 16-bit fixed-point one when `Quantised`, else exactly (its voxel and
+/// offset add up to its coordinate's bits; a coordinate for which they cannot goes whole into
+/// voxel 0). The order, and so the bytes of the file, depends neither on `grouping` nor on the
+/// thread count.
+template <bool Quantised>
+GroupedPoints groupPoints(const FrameData& frame, Grouping grouping);
+extern template GroupedPoints groupPoints<false>(const FrameData&, Grouping);
+extern template GroupedPoints groupPoints<true>(const FrameData&, Grouping);
+
+/// Puts column s (0: id, then columns[s − 1]) of bucket b of points grouped by Grouping::Any in
+/// order, once: the first thread to ask does it, another that asks meanwhile waits for it (it is
+/// running, and takes microseconds). The store asks before reading a leaf's values, so this runs
+/// beside the kernel's copy of the chunk before, in time the writing threads would otherwise
+/// wait. Thread-safe for any b and s.
+void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScratch& scratch);
+
+/// Every column in order (OpenVDB's own writer reads the grouped points whole); nothing for
+/// points grouped by Grouping::Sorted, which are in order already.
+void orderAllLater(GroupedPoints& points);
+
+}  // namespace tickfx::io
