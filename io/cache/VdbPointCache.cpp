@@ -116,10 +116,12 @@ struct GridAttribute {
 std::vector<GridAttribute> gridAttributes(const std::vector<std::string>& attributeNames) {
   using Kind = GridAttribute::Kind;
   const std::vector<std::string>& standard = standardAttributes();  // P, v, id, age, life, mass
-  std::vector<GridAttribute> attributes = {
-      {standard[0], Kind::Position, 0}, {standard[1], Kind::Vector, 0},
-      {standard[2], Kind::Id, 0},       {standard[3], Kind::Float, 3},
-      {standard[4], Kind::Float, 4},    {standard[5], Kind::Float, 5}};
+  std::vector<GridAttribute> attributes = {{standard[0], Kind::Position, 0},
+                                           {standard[1], Kind::Vector, kVelocityColumn},
+                                           {standard[2], Kind::Id, 0},
+                                           {standard[3], Kind::Float, kAgeColumn},
+                                           {standard[4], Kind::Float, kLifeColumn},
+                                           {standard[5], Kind::Float, kMassColumn}};
   for (const AttributeGroup& g : attributeGroups(attributeNames)) {
     const Kind kind = g.kind == AttributeKind::Vec3  ? Kind::Vector
                       : g.kind == AttributeKind::Int ? Kind::Int

@@ -326,9 +326,11 @@ static_assert((kBucketLeaves << kVoxelBits) - 1 <= std::numeric_limits<std::uint
               "a point's key in its bucket (leaf, voxel) fits the voxel column's 16 bits");
 
 std::vector<const float*> pointFloatColumns(const FrameData& frame) {
-  std::vector<const float*> columns = {frame.velocity[0].data(), frame.velocity[1].data(),
-                                       frame.velocity[2].data(), frame.age.data(),
-                                       frame.life.data(),        frame.mass.data()};
+  std::vector<const float*> columns(kStandardFloatColumns);
+  for (std::size_t c = 0; c < 3; ++c) columns[kVelocityColumn + c] = frame.velocity[c].data();
+  columns[kAgeColumn] = frame.age.data();
+  columns[kLifeColumn] = frame.life.data();
+  columns[kMassColumn] = frame.mass.data();
   for (const FloatColumn& a : frame.attributes) columns.push_back(a.data());
   return columns;
 }

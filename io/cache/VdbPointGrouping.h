@@ -65,8 +65,13 @@ struct GroupedPoints {
   }
 };
 
-/// GroupedPoints::columns' first ones, from the frame's standard columns.
-inline constexpr std::size_t kStandardFloatColumns = 6;  // velocity x, y, z, age, life, mass
+/// GroupedPoints::columns' first ones, from the frame's standard columns: where each starts.
+/// pointFloatColumns() fills them, and the cache's grid attributes read them, by these names.
+inline constexpr std::size_t kVelocityColumn = 0;  // x, y, z
+inline constexpr std::size_t kAgeColumn = 3;
+inline constexpr std::size_t kLifeColumn = 4;
+inline constexpr std::size_t kMassColumn = 5;
+inline constexpr std::size_t kStandardFloatColumns = 6;
 
 // What the orderings reuse from one bucket to the next (orderLater()).
 struct BucketScratch {
