@@ -1,5 +1,7 @@
 #include "BenchHarness.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +29,19 @@ double processCpuSeconds() {
   timespec t{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double stolenSeconds() {
+  static const long ticksPerSecond = sysconf(_SC_CLK_TCK);
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  // cpu user nice system idle iowait irq softirq steal: the first line sums every CPU.
+  unsigned long long value[8] = {};
+  if (!(in >> cpu) || cpu != "cpu" || ticksPerSecond <= 0) return 0.0;
+  for (unsigned long long& v : value) {
+    if (!(in >> v)) return 0.0;
+  }
+  return static_cast<double>(value[7]) / static_cast<double>(ticksPerSecond);
 }
 
 double median(std::vector<double> v) {
@@ -63,6 +78,13 @@ double pairedSpeedup(const Case& c, const Case& baseline) {
   return medianOverRounds(c, baseline, [](double s, double base) { return base / s; });
 }
 
+double Case::stolenShare() const {
+  double sum = 0.0;
+  for (const double s : stolen) sum += s;
+  const double machine = timed * static_cast<double>(std::thread::hardware_concurrency());
+  return machine > 0.0 ? sum / machine : 0.0;
+}
+
 double Case::fastest() const {
   return *std::min_element(secondsPerTick.begin(), secondsPerTick.end());
 }
@@ -71,22 +93,25 @@ double Case::slowest() const {
   return *std::max_element(secondsPerTick.begin(), secondsPerTick.end());
 }
 
-// The CPU clock and the counter are read outside the wall-clock interval, so they cost the figure
-// nothing.
+// The CPU clock, the steal and the counter are read outside the wall-clock interval, so they cost
+// the figure nothing.
 std::optional<double> timeBatch(Case& c, bool record) {
   if (c.before) c.before();
   const double count0 = c.counter ? c.counter() : 0.0;
+  const double stolen0 = stolenSeconds();
   const double cpu0 = processCpuSeconds();
   const Clock::time_point start = Clock::now();
   c.run(c.batch);
   const double s = std::chrono::duration<double>(Clock::now() - start).count();
   const double cpu = processCpuSeconds() - cpu0;
+  const double stolen = stolenSeconds() - stolen0;
   const double count = c.counter ? c.counter() - count0 : 0.0;
   if (record) {
     c.secondsPerTick.push_back(s / static_cast<double>(c.batch));
     if (c.counter) c.counts.push_back(count);
     c.timed += s;
     c.cpu += cpu;
+    c.stolen.push_back(stolen);
   }
   if (c.after && !c.after()) return std::nullopt;
   return s;

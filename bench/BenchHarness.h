@@ -44,6 +44,12 @@ double processCpuSeconds();
 // The median rather than the mean: a batch hit by outside load is an outlier, not a sample.
 double median(std::vector<double> v);
 
+// The CPU seconds the hypervisor has taken from this machine's virtual CPUs so far, all of them
+// summed (the steal column of /proc/stat, in its 1/USER_HZ ticks); 0 where the kernel does not
+// say. Machine-wide: on a guest whose host is busy, a case's batches slow down by what is stolen
+// from them, which no figure of the process itself shows.
+double stolenSeconds();
+
 // ---- cases and their timing ---------------------------------------------------------------------
 
 // One thing timed. A bench derives from it to carry what its own table needs (see timeCases).
@@ -76,7 +82,8 @@ struct Case {
   std::vector<double> secondsPerTick;
   std::vector<double> counts;
   double timed = 0.0;
-  double cpu = 0.0;  // process CPU seconds over the timed batches, all threads
+  double cpu = 0.0;            // process CPU seconds over the timed batches, all threads
+  std::vector<double> stolen;  // stolenSeconds() over each timed batch, machine-wide
 
   /// The case's figure: the median over its batches of the seconds a tick.
   double seconds() const { return bench::median(secondsPerTick); }
@@ -85,6 +92,8 @@ struct Case {
   double slowest() const;
   /// The cores the process kept busy while the case ran: CPU over wall time.
   double cores() const { return timed > 0.0 ? cpu / timed : 0.0; }
+  /// The share of the machine's CPU time the hypervisor took while the case's batches ran.
+  double stolenShare() const;
 };
 
 /// How many times faster `c` ran than `baseline`, by their figures: above 1, faster.

@@ -260,6 +260,7 @@ struct ResultRow {
   double bytes;
   double writer;  // seconds a file
   double dd;      // seconds a file of the same size, in the same run
+  double stolen;  // the share of the machine's CPU time stolen while the writer ran
 };
 
 struct Part1 {
@@ -336,16 +337,18 @@ void runFormat(const FormatInfo& f, const io::FrameData& frame, bool reference, 
 
   for (const bench::Case& c : cases) {
     std::printf(
-        "  %-28s %10.4f ms/file  (median of %zu batches of %lld; %.4f to %.4f; %.2f cores)\n",
+        "  %-28s %10.4f ms/file  (median of %zu batches of %lld; %.4f to %.4f; %.2f cores; %.1f %% "
+        "stolen)\n",
         c.name.c_str(), 1e3 * c.seconds(), c.secondsPerTick.size(), static_cast<long long>(c.batch),
-        1e3 * c.fastest(), 1e3 * c.slowest(), c.cores());
+        1e3 * c.fastest(), 1e3 * c.slowest(), c.cores(), 100.0 * c.stolenShare());
   }
   std::fflush(stdout);
   for (const Writer& w : writers) {
     const bool sync = w.durability == io::Durability::Synced;
     const bench::Case& dd = cases[ddIndex + (sync ? 1 : 0)];
+    const bench::Case& writer = cases[w.index];
     out.rows.push_back({f.name, f.target, n, w.threads, sync, static_cast<double>(bytes),
-                        cases[w.index].seconds(), dd.seconds()});
+                        writer.seconds(), dd.seconds(), writer.stolenShare()});
   }
 }
 
@@ -353,8 +356,12 @@ void printPart1(const Part1& p, int allThreads) {
   std::printf(
       "\nwriters against dd (the same bytes with write() in 1 MiB blocks, renamed alike); "
       "MB = 10^6 bytes\n");
-  std::printf("%-12s %-10s %9s %10s %12s %12s %9s %12s %7s %7s %s\n", "format", "threads", "N",
-              "file MB", "writer s", "particles/s", "MB/s", "dd s", "k", "target", "met");
+  // Beside the verdict, the share of the machine's CPU time the hypervisor took while the writer
+  // ran: a busy host slows a writer's threads more than dd's one, and a row with more than a few
+  // percent stolen measures the host.
+  std::printf("%-12s %-10s %9s %10s %12s %12s %9s %12s %7s %7s %-5s %7s\n", "format", "threads",
+              "N", "file MB", "writer s", "particles/s", "MB/s", "dd s", "k", "target", "met",
+              "stolen");
   for (const ResultRow& r : p.rows) {
     const double k = r.writer / r.dd;
     // The targets are set at 10⁶ on all threads with the default durability; other rows show
@@ -366,10 +373,12 @@ void printPart1(const Part1& p, int allThreads) {
     if (r.synced) threads += " synced";
     char target[16];
     std::snprintf(target, sizeof target, "<=%.1f", r.target);
-    std::printf("%-12s %-10s %9.0e %10.3f %12.4g %12.4g %9.0f %12.4g %7.2f %7s %s\n",
+    char stolen[16];
+    std::snprintf(stolen, sizeof stolen, "%.1f%%", 100.0 * r.stolen);
+    std::printf("%-12s %-10s %9.0e %10.3f %12.4g %12.4g %9.0f %12.4g %7.2f %7s %-5s %7s\n",
                 r.format.c_str(), threads.c_str(), static_cast<double>(r.n), r.bytes / 1e6,
                 r.writer, static_cast<double>(r.n) / r.writer, r.bytes / 1e6 / r.writer, r.dd, k,
-                target, verdict.c_str());
+                target, verdict.c_str(), stolen);
   }
 
   const auto find = [&](const std::string& format, int threads, bool synced) -> const ResultRow* {
@@ -599,10 +608,11 @@ void printFigures(const Part1& p, const std::vector<OverlapRow>& overlap, int al
     // The targets are judged at 10⁶ on all threads with the default durability (printPart1).
     const bool judged = r.n == kTargetSize && r.threads == allThreads && !r.synced;
     const std::string where = judged ? "" : " at 1e6, " + threadsLabel(allThreads);
-    std::printf("cache %s: k = %.3g x dd%s (target <= %g%s), %s particles/s, %s MB/s\n",
-                name.c_str(), r.writer / r.dd, r.synced ? " with fsync" : "", r.target,
-                where.c_str(), bench::g3(static_cast<double>(r.n) / r.writer).c_str(),
-                bench::g3(r.bytes / 1e6 / r.writer).c_str());
+    std::printf(
+        "cache %s: k = %.3g x dd%s (target <= %g%s), %s particles/s, %s MB/s (%.1f %% stolen)\n",
+        name.c_str(), r.writer / r.dd, r.synced ? " with fsync" : "", r.target, where.c_str(),
+        bench::g3(static_cast<double>(r.n) / r.writer).c_str(),
+        bench::g3(r.bytes / 1e6 / r.writer).c_str(), 100.0 * r.stolen);
   }
   for (const OverlapRow& r : overlap) {
     const double a = bench::median(r.simulate.wall), b = bench::median(r.write.wall);
