@@ -324,6 +324,9 @@ class GroupedValues final : public PointValues {
   template <typename Array>
   void storeAs(std::size_t l, const GridAttribute& a, char* to) const {
     using Storage = typename Array::StorageType;
+    if constexpr (std::is_same_v<typename Array::Codec, vdbp::NullCodec>) {
+      if (storePlain(l, a, to)) return;
+    }
     eachValue(points_, l, a, [&](std::size_t k, const auto& value) {
       if constexpr (std::is_convertible_v<decltype(value), typename Array::ValueType>) {
         Storage stored;
@@ -333,6 +336,54 @@ class GroupedValues final : public PointValues {
         throw std::logic_error("VDB points: an attribute's values are not of its array's type");
       }
     });
+  }
+
+  // Leaf l's values of attribute `a` as an array that stores them as they are (NullCodec) holds
+  // them: the same bytes as storeAs()'s general way, but whole copies where the bytes are the
+  // column's (offsets, ids, floats) and, for the others, loops whose stores alias nothing (the
+  // general way's stores through `to` may alias anything, so it reloaded its pointers after each
+  // value). False for a kind it does not know.
+  bool storePlain(std::size_t l, const GridAttribute& a, char* __restrict to) const {
+    using Kind = GridAttribute::Kind;
+    const std::size_t begin = points_.starts[l];
+    const std::size_t count = points_.starts[l + 1] - begin;
+    const auto column = [&](std::size_t j) { return points_.columns[a.column + j].get() + begin; };
+    switch (a.kind) {
+      case Kind::Position:  // the offsets, as openvdb::Vec3f's three floats
+        static_assert(sizeof(openvdb::Vec3f) == 3 * sizeof(float));
+        std::memcpy(to, points_.offset.get() + begin, count * sizeof(openvdb::Vec3f));
+        return true;
+      case Kind::Id:  // std::uint64_t to std::int64_t keeps the bits
+        std::memcpy(to, points_.id.get() + begin, count * sizeof(std::uint64_t));
+        return true;
+      case Kind::Float:
+        std::memcpy(to, column(0), count * sizeof(float));
+        return true;
+      case Kind::Vector:
+        interleave(column(0), column(1), column(2), count, to);
+        return true;
+      case Kind::Int:
+        toInt32(column(0), count, to);
+        return true;
+    }
+    return false;
+  }
+
+  static void interleave(const float* __restrict x, const float* __restrict y,
+                         const float* __restrict z, std::size_t count, char* __restrict to) {
+    constexpr std::size_t kFloat = sizeof(float);
+    for (std::size_t k = 0; k < count; ++k, to += 3 * kFloat) {
+      std::memcpy(to, x + k, kFloat);
+      std::memcpy(to + kFloat, y + k, kFloat);
+      std::memcpy(to + 2 * kFloat, z + k, kFloat);
+    }
+  }
+
+  static void toInt32(const float* __restrict x, std::size_t count, char* __restrict to) {
+    for (std::size_t k = 0; k < count; ++k) {
+      const auto v = static_cast<std::int32_t>(x[k]);
+      std::memcpy(to + sizeof v * k, &v, sizeof v);
+    }
   }
 
   GroupedPoints& points_;
