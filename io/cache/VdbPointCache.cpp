@@ -327,11 +327,20 @@ class GroupedValues final : public PointValues {
     if constexpr (std::is_same_v<typename Array::Codec, vdbp::NullCodec>) {
       if (storePlain(l, a, to)) return;
     }
-    eachValue(points_, l, a, [&](std::size_t k, const auto& value) {
+    // Encoded into a buffer in cache and copied into `to` a run at a time: the 16-bit positions'
+    // 6-byte values stored one by one into the chunk, whose lines are not in cache yet, filled
+    // the store buffer (6.5 ms of the threads a frame of 10⁶ against 3.5). `to` by value: a
+    // captured reference would be reloaded after every store through it.
+    constexpr std::size_t kRun = 256;
+    const std::size_t count = points_.starts[l + 1] - points_.starts[l];
+    std::array<Storage, kRun> run;
+    eachValue(points_, l, a, [&run, to, count](std::size_t k, const auto& value) {
       if constexpr (std::is_convertible_v<decltype(value), typename Array::ValueType>) {
-        Storage stored;
-        Array::Codec::encode(typename Array::ValueType(value), stored);
-        std::memcpy(to + k * sizeof(Storage), &stored, sizeof(Storage));
+        Array::Codec::encode(typename Array::ValueType(value), run[k % kRun]);
+        if (k % kRun == kRun - 1 || k + 1 == count) {
+          const std::size_t first = k - k % kRun;
+          std::memcpy(to + first * sizeof(Storage), run.data(), (k + 1 - first) * sizeof(Storage));
+        }
       } else {
         throw std::logic_error("VDB points: an attribute's values are not of its array's type");
       }
