@@ -131,6 +131,12 @@ std::vector<GridAttribute> gridAttributes(const std::vector<std::string>& attrib
   return attributes;
 }
 
+// Leaf l's stretch of the j-th float column attribute `a` reads (a vector reads three).
+const float* leafColumn(const GroupedPoints& points, const GridAttribute& a, std::size_t j,
+                        std::size_t l) {
+  return points.columns[a.column + j].get() + points.leafPoints(l).first;
+}
+
 // Calls f(std::type_identity<Array>()) with the array type of attributes of `kind`.
 template <typename PositionArray, typename F>
 void withArrayType(GridAttribute::Kind kind, const F& f) {
@@ -167,7 +173,8 @@ vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<GridAttribu
 // sets, without its two calls a voxel.
 void setVoxelEnds(const GroupedPoints& points, std::size_t l, Leaf& leaf) {
   std::array<openvdb::Index32, Leaf::SIZE> counts{};
-  for (std::size_t k = points.starts[l]; k < points.starts[l + 1]; ++k) ++counts[points.voxel[k]];
+  const auto [begin, end] = points.leafPoints(l);
+  for (std::size_t k = begin; k < end; ++k) ++counts[points.voxel[k]];
   openvdb::PointDataIndex32* const ends = leaf.buffer().data();
   Leaf::NodeMaskType mask;  // all off
   openvdb::Index32 sum = 0;
@@ -206,9 +213,9 @@ void addUniformArrays(Leaf& leaf, const vdbp::AttributeSet::Descriptor::Ptr& des
 template <typename Set>
 void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& a, const Set& set) {
   using Kind = GridAttribute::Kind;
-  const std::size_t begin = points.starts[l];
-  const std::size_t count = points.starts[l + 1] - begin;
-  const auto column = [&](std::size_t j) { return points.columns[a.column + j].get() + begin; };
+  const auto [begin, end] = points.leafPoints(l);
+  const std::size_t count = end - begin;
+  const auto column = [&](std::size_t j) { return leafColumn(points, a, j, l); };
   switch (a.kind) {
     case Kind::Position: {
       const openvdb::Vec3f* offset = points.offset.get() + begin;
@@ -285,7 +292,8 @@ class GroupedValues final : public PointValues {
              char* to) const override {
     Local& local = local_.local();
     const std::size_t l = leafAt(origin, local.next);
-    if (points_.starts[l + 1] - points_.starts[l] != count || attribute >= attributes_.size())
+    const auto [begin, end] = points_.leafPoints(l);
+    if (end - begin != count || attribute >= attributes_.size())
       throw std::logic_error("VDB points: values asked for a leaf the frame does not have");
     local.next = l + 1;
     const GridAttribute& a = attributes_[attribute];
@@ -325,57 +333,59 @@ class GroupedValues final : public PointValues {
   void storeAs(std::size_t l, const GridAttribute& a, char* to) const {
     using Storage = typename Array::StorageType;
     if constexpr (std::is_same_v<typename Array::Codec, vdbp::NullCodec>) {
-      if (storePlain(l, a, to)) return;
-    }
-    // Encoded into a buffer in cache and copied into `to` a run at a time: the 16-bit positions'
-    // 6-byte values stored one by one into the chunk, whose lines are not in cache yet, filled
-    // the store buffer (6.5 ms of the threads a frame of 10⁶ against 3.5). `to` by value: a
-    // captured reference would be reloaded after every store through it.
-    constexpr std::size_t kRun = 256;
-    const std::size_t count = points_.starts[l + 1] - points_.starts[l];
-    std::array<Storage, kRun> run;
-    eachValue(points_, l, a, [&run, to, count](std::size_t k, const auto& value) {
-      if constexpr (std::is_convertible_v<decltype(value), typename Array::ValueType>) {
-        Array::Codec::encode(typename Array::ValueType(value), run[k % kRun]);
-        if (k % kRun == kRun - 1 || k + 1 == count) {
-          const std::size_t first = k - k % kRun;
-          std::memcpy(to + first * sizeof(Storage), run.data(), (k + 1 - first) * sizeof(Storage));
+      storePlain(l, a, to);
+    } else {
+      // Encoded into a buffer in cache and copied into `to` a run at a time: the 16-bit
+      // positions' 6-byte values stored one by one into the chunk, whose lines are not in cache
+      // yet, filled the store buffer (6.5 ms of the threads a frame of 10⁶ against 3.5). `to` by
+      // value: a captured reference would be reloaded after every store through it.
+      constexpr std::size_t kRun = 256;
+      const auto [begin, end] = points_.leafPoints(l);
+      const std::size_t count = end - begin;
+      std::array<Storage, kRun> run;
+      eachValue(points_, l, a, [&run, to, count](std::size_t k, const auto& value) {
+        if constexpr (std::is_convertible_v<decltype(value), typename Array::ValueType>) {
+          Array::Codec::encode(typename Array::ValueType(value), run[k % kRun]);
+          if (k % kRun == kRun - 1 || k + 1 == count) {
+            const std::size_t first = k - k % kRun;
+            std::memcpy(to + first * sizeof(Storage), run.data(),
+                        (k + 1 - first) * sizeof(Storage));
+          }
+        } else {
+          throw std::logic_error("VDB points: an attribute's values are not of its array's type");
         }
-      } else {
-        throw std::logic_error("VDB points: an attribute's values are not of its array's type");
-      }
-    });
+      });
+    }
   }
 
   // Leaf l's values of attribute `a` as an array that stores them as they are (NullCodec) holds
   // them: the same bytes as storeAs()'s general way, but whole copies where the bytes are the
   // column's (offsets, ids, floats) and, for the others, loops whose stores alias nothing (the
   // general way's stores through `to` may alias anything, so it reloaded its pointers after each
-  // value). False for a kind it does not know.
-  bool storePlain(std::size_t l, const GridAttribute& a, char* __restrict to) const {
+  // value).
+  void storePlain(std::size_t l, const GridAttribute& a, char* __restrict to) const {
     using Kind = GridAttribute::Kind;
-    const std::size_t begin = points_.starts[l];
-    const std::size_t count = points_.starts[l + 1] - begin;
-    const auto column = [&](std::size_t j) { return points_.columns[a.column + j].get() + begin; };
+    const auto [begin, end] = points_.leafPoints(l);
+    const std::size_t count = end - begin;
+    const auto column = [&](std::size_t j) { return leafColumn(points_, a, j, l); };
     switch (a.kind) {
       case Kind::Position:  // the offsets, as openvdb::Vec3f's three floats
         static_assert(sizeof(openvdb::Vec3f) == 3 * sizeof(float));
         std::memcpy(to, points_.offset.get() + begin, count * sizeof(openvdb::Vec3f));
-        return true;
+        return;
       case Kind::Id:  // std::uint64_t to std::int64_t keeps the bits
         std::memcpy(to, points_.id.get() + begin, count * sizeof(std::uint64_t));
-        return true;
+        return;
       case Kind::Float:
         std::memcpy(to, column(0), count * sizeof(float));
-        return true;
+        return;
       case Kind::Vector:
         interleave(column(0), column(1), column(2), count, to);
-        return true;
+        return;
       case Kind::Int:
         toInt32(column(0), count, to);
-        return true;
+        return;
     }
-    return false;
   }
 
   static void interleave(const float* __restrict x, const float* __restrict y,

@@ -59,6 +59,10 @@ struct GroupedPoints {
   }
   // The columns `later` tells of for each bucket: the ids, then the float columns.
   std::size_t laterColumns() const { return 1 + columns.size(); }
+  // The points of leaf l: [first, second).
+  std::pair<std::size_t, std::size_t> leafPoints(std::size_t l) const {
+    return {starts[l], starts[l + 1]};
+  }
   // The points of bucket b: [first, second).
   std::pair<std::size_t, std::size_t> bucketPoints(std::size_t b) const {
     return {starts[buckets.first[b]], starts[buckets.first[b + 1]]};
