@@ -79,10 +79,9 @@ double pairedSpeedup(const Case& c, const Case& baseline) {
 }
 
 double Case::stolenShare() const {
-  double sum = 0.0;
-  for (const double s : stolen) sum += s;
+  // hardware_concurrency(): the online CPUs, which /proc/stat's steal sums over.
   const double machine = timed * static_cast<double>(std::thread::hardware_concurrency());
-  return machine > 0.0 ? sum / machine : 0.0;
+  return machine > 0.0 ? stolen / machine : 0.0;
 }
 
 double Case::fastest() const {
@@ -111,7 +110,7 @@ std::optional<double> timeBatch(Case& c, bool record) {
     if (c.counter) c.counts.push_back(count);
     c.timed += s;
     c.cpu += cpu;
-    c.stolen.push_back(stolen);
+    c.stolen += stolen;
   }
   if (c.after && !c.after()) return std::nullopt;
   return s;

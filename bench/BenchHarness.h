@@ -82,8 +82,8 @@ struct Case {
   std::vector<double> secondsPerTick;
   std::vector<double> counts;
   double timed = 0.0;
-  double cpu = 0.0;            // process CPU seconds over the timed batches, all threads
-  std::vector<double> stolen;  // stolenSeconds() over each timed batch, machine-wide
+  double cpu = 0.0;     // process CPU seconds over the timed batches, all threads
+  double stolen = 0.0;  // stolenSeconds() over the timed batches, machine-wide
 
   /// The case's figure: the median over its batches of the seconds a tick.
   double seconds() const { return bench::median(secondsPerTick); }
