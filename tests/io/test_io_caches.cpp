@@ -1,8 +1,11 @@
 // Frame caches and frame schedules: what is written reads back bit for bit, and bad files fail
 // loudly with their name and place.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -10,14 +13,17 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "app/FrameTimes.h"
 #include "fields/ForceSet.h"
 #include "fields/Gravity.h"
+#include "io/cache/AttributeGroups.h"
 #include "io/cache/CsvCache.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/PlyCache.h"
@@ -126,6 +132,83 @@ TEST_F(Caches, PlyRoundTripIsBitExactWithHeaderAndMetadata) {
   std::string head(expectedHeader.size(), '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   EXPECT_EQ(head, expectedHeader);
+}
+
+// The body of a PLY cache of `frame`, made value by value: each row's id as a double, then its
+// floats in the header's order (ints for Houdini's integer attributes).
+std::string expectedPlyBody(const FrameData& frame) {
+  std::string body;
+  const auto put = [&](const void* value, std::size_t bytes) {
+    body.append(static_cast<const char*>(value), bytes);
+  };
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    const auto e = static_cast<Eigen::Index>(i);
+    const double id = static_cast<double>(frame.id[i]);
+    put(&id, sizeof id);
+    for (const FloatColumn* c :
+         {&frame.position.x, &frame.position.y, &frame.position.z, &frame.velocity.x,
+          &frame.velocity.y, &frame.velocity.z, &frame.age, &frame.life, &frame.mass})
+      put(&(*c)[e], sizeof(float));
+    for (std::size_t a = 0; a < frame.attributes.size(); ++a) {
+      if (isIntAttribute(frame.attributeNames[a])) {
+        const auto v = static_cast<std::int32_t>(frame.attributes[a][e]);
+        put(&v, sizeof v);
+      } else {
+        put(&frame.attributes[a][e], sizeof(float));
+      }
+    }
+  }
+  return body;
+}
+
+// The rows are stored a block at a time (32768 rows), the standard columns a row at a time in
+// 16-byte stores that reach into the next row: every byte of the body, over three blocks, the
+// last one partial, with and without other columns after the standard ones, on 1 and 2 threads.
+// Values with every bit pattern that matters: NaNs with payloads, −0.0, subnormals, infinities.
+TEST_F(Caches, PlyBodiesAreTheRowsValueByValueAcrossBlocks) {
+  const float special[] = {std::bit_cast<float>(0x7fc01234u),
+                           std::bit_cast<float>(0xff812345u),
+                           -0.0f,
+                           1e-40f,
+                           -std::numeric_limits<float>::infinity(),
+                           3.5f};
+  for (const std::vector<std::string>& names :
+       {std::vector<std::string>{}, std::vector<std::string>{"heat", "hitnum"}}) {
+    FrameData frame;
+    frame.frame = 7;
+    frame.resize(70001, names);
+    std::vector<FloatColumn*> columns = {&frame.position.x, &frame.position.y, &frame.position.z,
+                                         &frame.velocity.x, &frame.velocity.y, &frame.velocity.z,
+                                         &frame.age,        &frame.life,       &frame.mass};
+    for (FloatColumn& a : frame.attributes) columns.push_back(&a);
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      frame.id[i] = 3 * i + (std::uint64_t{1} << 40);
+      for (std::size_t c = 0; c < columns.size(); ++c) {
+        const std::size_t k = (i + 7 * c) % 101;
+        const bool whole = c >= 9 && isIntAttribute(names[c - 9]);  // (hitnum: no NaN to cast)
+        (*columns[c])[static_cast<Eigen::Index>(i)] =
+            k < std::size(special) && !whole
+                ? special[k]
+                : static_cast<float>(c) + (whole ? 1.0f : 0.25f) * static_cast<float>(i);
+      }
+    }
+    const std::string expected = expectedPlyBody(frame);
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE(std::to_string(names.size()) + " other columns, " + std::to_string(threads) +
+                   " threads");
+      tbb::task_arena(threads).execute([&] { writePlyCache(frame, dir_ / "f.ply"); });
+      std::ifstream in(dir_ / "f.ply", std::ios::binary);
+      const std::string file((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+      const std::size_t header = file.find("end_header\n");
+      ASSERT_NE(header, std::string::npos);
+      const std::string body = file.substr(header + std::strlen("end_header\n"));
+      ASSERT_EQ(body.size(), expected.size());
+      EXPECT_TRUE(body == expected)
+          << "first difference at body byte "
+          << std::mismatch(body.begin(), body.end(), expected.begin()).first - body.begin();
+    }
+  }
 }
 
 TEST_F(Caches, TruncatedOrForeignFilesAreRefusedByName) {
