@@ -4,6 +4,7 @@
 #include <emmintrin.h>
 #endif
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -28,6 +29,7 @@ static_assert(std::endian::native == std::endian::little,
 constexpr std::size_t kPlyRowsPerBlock = 32768;
 
 const char* const kFixedFloats[] = {"x", "y", "z", "vx", "vy", "vz", "age", "life", "mass"};
+constexpr std::size_t kStandardColumns = std::size(kFixedFloats);
 
 // The PLY convention's names for Houdini's colour and opacity (red, green, blue, alpha: floats,
 // linear, as the frame holds them); every other attribute keeps its name.
@@ -49,42 +51,36 @@ std::string columnName(const std::string& property) {
 }
 
 #if defined(__SSE2__)
-// The id and the standard columns of rows [begin, end) at `bytes`, `rowBytes` apart, a row at a
-// time: its 44 bytes are made in registers and stored by three 16-byte stores. A pass a column
-// stored each value alone, ten 4-byte stores a row at a stride of a row: the stores, not the
-// reads, bounded it. The third store reaches 4 bytes past the standard columns: into the row's
-// other columns, stored after it, or else into the next row's id, stored after it too; the
-// block's last row without other columns stores its last 12 bytes alone.
-void standardRows(const FrameData& frame, std::size_t rowBytes, std::size_t begin, std::size_t end,
-                  char* bytes) {
-  const std::uint64_t* __restrict id = frame.id.data();
-  const float* __restrict px = frame.position.x.data();
-  const float* __restrict py = frame.position.y.data();
-  const float* __restrict pz = frame.position.z.data();
-  const float* __restrict vx = frame.velocity.x.data();
-  const float* __restrict vy = frame.velocity.y.data();
-  const float* __restrict vz = frame.velocity.z.data();
-  const float* __restrict age = frame.age.data();
-  const float* __restrict life = frame.life.data();
-  const float* __restrict mass = frame.mass.data();
-  constexpr std::size_t kBytes = sizeof(double) + 9 * sizeof(float);
+// The id and the standard columns (`cols`' first, in their order) of rows [begin, end) at
+// `bytes`, `rowBytes` apart, a row at a time: its 44 bytes are made in registers and stored by
+// three 16-byte stores. A pass a column stored each value alone, ten 4-byte stores a row at a
+// stride of a row: the stores, not the reads, bounded it. The third store reaches 4 bytes past
+// the standard columns: into the row's other columns, stored after it, or else into the next
+// row's id, stored after it too; the block's last row without other columns stores its last 12
+// bytes alone.
+void standardRows(const std::uint64_t* __restrict id, const std::vector<const FloatColumn*>& cols,
+                  std::size_t rowBytes, std::size_t begin, std::size_t end, char* bytes) {
+  static_assert(kStandardColumns == 9, "three 16-byte stores: the id and nine floats");
+  std::array<const float*, kStandardColumns> column{};
+  for (std::size_t c = 0; c < kStandardColumns; ++c) column[c] = cols[c]->data();
+  constexpr std::size_t kBytes = sizeof(double) + kStandardColumns * sizeof(float);
   const bool spills = rowBytes < kBytes + sizeof(float);
   // Bit moves only (no arithmetic on the floats): NaN payloads go out as they are.
-  const auto one = [](const float* x) { return _mm_load_ss(x); };
+  const auto one = [&](std::size_t c, std::size_t i) { return _mm_load_ss(column[c] + i); };
+  const auto pair = [&](std::size_t c, std::size_t i) {
+    return _mm_unpacklo_ps(one(c, i), one(c + 1, i));
+  };
   char* __restrict to = bytes;
   for (std::size_t i = begin; i < end; ++i, to += rowBytes) {
     const __m128 idBits = _mm_castpd_ps(_mm_set_sd(static_cast<double>(id[i])));
-    const __m128 first = _mm_movelh_ps(idBits, _mm_unpacklo_ps(one(px + i), one(py + i)));
-    const __m128 middle = _mm_movelh_ps(_mm_unpacklo_ps(one(pz + i), one(vx + i)),
-                                        _mm_unpacklo_ps(one(vy + i), one(vz + i)));
-    const __m128 last = _mm_movelh_ps(_mm_unpacklo_ps(one(age + i), one(life + i)), one(mass + i));
-    _mm_storeu_ps(reinterpret_cast<float*>(to), first);
-    _mm_storeu_ps(reinterpret_cast<float*>(to + 16), middle);
+    _mm_storeu_ps(reinterpret_cast<float*>(to), _mm_movelh_ps(idBits, pair(0, i)));
+    _mm_storeu_ps(reinterpret_cast<float*>(to + 16), _mm_movelh_ps(pair(2, i), pair(4, i)));
+    const __m128 last = _mm_movelh_ps(pair(6, i), one(8, i));
     if (i + 1 < end || !spills) {
       _mm_storeu_ps(reinterpret_cast<float*>(to + 32), last);
     } else {
       _mm_storel_pi(reinterpret_cast<__m64*>(to + 32), last);
-      std::memcpy(to + 40, mass + i, sizeof(float));
+      std::memcpy(to + 40, column[8] + i, sizeof(float));
     }
   }
 }
@@ -98,8 +94,6 @@ std::vector<const FloatColumn*> floatColumns(const FrameData& f) {
   return cols;
 }
 
-constexpr std::size_t kStandardColumns = std::size(kFixedFloats);
-
 // Rows [begin, end) at `bytes`, `rowBytes` apart: each row's id (as a double), then its floats
 // (ints where `ints` says), in the order of `cols`, the standard columns first.
 void formatRows(const FrameData& frame, const std::vector<const FloatColumn*>& cols,
@@ -107,7 +101,7 @@ void formatRows(const FrameData& frame, const std::vector<const FloatColumn*>& c
                 std::size_t end, char* bytes) {
   std::size_t c = 0;
 #if defined(__SSE2__)
-  standardRows(frame, rowBytes, begin, end, bytes);
+  standardRows(frame.id.data(), cols, rowBytes, begin, end, bytes);
   c = kStandardColumns;
 #else
   for (std::size_t i = begin; i < end; ++i) {
@@ -153,7 +147,7 @@ void writePlyCache(const FrameData& frame, const std::filesystem::path& path,
         // Houdini's integers (hitnum) as 32-bit ints: their columns hold whole numbers.
         std::vector<bool> ints(cols.size(), false);
         for (std::size_t a = 0; a < frame.attributeNames.size(); ++a)
-          ints[9 + a] = isIntAttribute(frame.attributeNames[a]);
+          ints[kStandardColumns + a] = isIntAttribute(frame.attributeNames[a]);
         const std::size_t rowBytes = sizeof(double) + cols.size() * sizeof(float);
         writeRowsInBlocks(out, frame.size(), kPlyRowsPerBlock, rowBytes,
                           [&](std::size_t begin, std::size_t end, char* bytes) {
@@ -195,8 +189,9 @@ FrameData readPlyCache(const std::filesystem::path& path) {
       words >> type >> name;
       if (type == "double" && name == "id" && floats.empty()) {
         sawId = true;
-      } else if ((type == "float" || (type == "int" && floats.size() >= 9)) && !name.empty()) {
-        floats.push_back(floats.size() >= 9 ? columnName(name) : name);
+      } else if ((type == "float" || (type == "int" && floats.size() >= kStandardColumns)) &&
+                 !name.empty()) {
+        floats.push_back(floats.size() >= kStandardColumns ? columnName(name) : name);
         ints.push_back(type == "int");
       } else {
         fail("unexpected property '" + line + "'");
@@ -205,8 +200,8 @@ FrameData readPlyCache(const std::filesystem::path& path) {
       fail("unexpected header line '" + line + "'");
     }
   }
-  if (line != "end_header" || !sawId || floats.size() < 9) fail("incomplete header");
-  for (std::size_t k = 0; k < 9; ++k) {
+  if (line != "end_header" || !sawId || floats.size() < kStandardColumns) fail("incomplete header");
+  for (std::size_t k = 0; k < kStandardColumns; ++k) {
     if (floats[k] != kFixedFloats[k]) fail("unexpected property order at '" + floats[k] + "'");
   }
   // The body's size is known from the header: checked against the file before any row is
@@ -221,7 +216,7 @@ FrameData readPlyCache(const std::filesystem::path& path) {
     fail("truncated body (" + std::to_string(count) + " vertices of " + std::to_string(rowBytes) +
          " bytes, " + std::to_string(bodyBytes) + " bytes after the header)");
   }
-  frame.resize(count, std::vector<std::string>(floats.begin() + 9, floats.end()));
+  frame.resize(count, std::vector<std::string>(floats.begin() + kStandardColumns, floats.end()));
   std::vector<FloatColumn*> cols = {&frame.position.x, &frame.position.y, &frame.position.z,
                                     &frame.velocity.x, &frame.velocity.y, &frame.velocity.z,
                                     &frame.age,        &frame.life,       &frame.mass};

@@ -134,9 +134,10 @@ TEST_F(Caches, PlyRoundTripIsBitExactWithHeaderAndMetadata) {
   EXPECT_EQ(head, expectedHeader);
 }
 
-// The body of a PLY cache of `frame`, made value by value: each row's id as a double, then its
-// floats in the header's order (ints for Houdini's integer attributes).
-std::string expectedPlyBody(const FrameData& frame) {
+// The body of a PLY cache of `frame`, made value by value: each row's id as a double, then the
+// values of `columns` (the header's order: the standard columns, then the frame's attributes),
+// ints for Houdini's integer attributes.
+std::string expectedPlyBody(const FrameData& frame, const std::vector<FloatColumn*>& columns) {
   std::string body;
   const auto put = [&](const void* value, std::size_t bytes) {
     body.append(static_cast<const char*>(value), bytes);
@@ -145,16 +146,13 @@ std::string expectedPlyBody(const FrameData& frame) {
     const auto e = static_cast<Eigen::Index>(i);
     const double id = static_cast<double>(frame.id[i]);
     put(&id, sizeof id);
-    for (const FloatColumn* c :
-         {&frame.position.x, &frame.position.y, &frame.position.z, &frame.velocity.x,
-          &frame.velocity.y, &frame.velocity.z, &frame.age, &frame.life, &frame.mass})
-      put(&(*c)[e], sizeof(float));
-    for (std::size_t a = 0; a < frame.attributes.size(); ++a) {
-      if (isIntAttribute(frame.attributeNames[a])) {
-        const auto v = static_cast<std::int32_t>(frame.attributes[a][e]);
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      const std::size_t standard = columns.size() - frame.attributes.size();
+      if (c >= standard && isIntAttribute(frame.attributeNames[c - standard])) {
+        const auto v = static_cast<std::int32_t>((*columns[c])[e]);
         put(&v, sizeof v);
       } else {
-        put(&frame.attributes[a][e], sizeof(float));
+        put(&(*columns[c])[e], sizeof(float));
       }
     }
   }
@@ -192,7 +190,7 @@ TEST_F(Caches, PlyBodiesAreTheRowsValueByValueAcrossBlocks) {
                 : static_cast<float>(c) + (whole ? 1.0f : 0.25f) * static_cast<float>(i);
       }
     }
-    const std::string expected = expectedPlyBody(frame);
+    const std::string expected = expectedPlyBody(frame, columns);
     for (const int threads : {1, 2}) {
       SCOPED_TRACE(std::to_string(names.size()) + " other columns, " + std::to_string(threads) +
                    " threads");
