@@ -312,12 +312,14 @@ TEST_F(ioVdbWriter, AFullDiskLeavesTheFormerFileWhole) {
 // every point's (leaf, voxel, row) it replaced: the same leaves in the same order, the same
 // points in each voxel in the same order, so the same bytes.
 void expectGroupingsAgree(const FrameData& frame) {
-  const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism, 3);
+  const tbb::global_control allowed(
+      tbb::global_control::max_allowed_parallelism,
+      static_cast<std::size_t>(*std::max_element(kThreads.begin(), kThreads.end())));
   for (const VdbCacheOptions& options : {kDefault, kFixed16}) {
     SCOPED_TRACE(vdbPositionsName(options.positions));
     const std::string sorted = detail::vdbPointCacheBytes(
         frame, metadata(), options, VdbEncoder::Parallel, VdbGrouping::Sorted);
-    for (const int threads : {1, 2, 3}) {
+    for (const int threads : kThreads) {
       SCOPED_TRACE(std::to_string(threads) + " threads");
       tbb::task_arena arena(threads);
       std::string fastest;
