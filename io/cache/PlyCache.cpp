@@ -15,6 +15,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include "io/cache/AttributeGroups.h"
 #include "io/cache/RowBlocks.h"
@@ -86,11 +88,15 @@ void standardRows(const std::uint64_t* __restrict id, const std::vector<const Fl
 }
 #endif
 
-std::vector<const FloatColumn*> floatColumns(const FrameData& f) {
-  std::vector<const FloatColumn*> cols = {&f.position.x, &f.position.y, &f.position.z,
-                                          &f.velocity.x, &f.velocity.y, &f.velocity.z,
-                                          &f.age,        &f.life,       &f.mass};
-  for (const FloatColumn& a : f.attributes) cols.push_back(&a);
+// The columns of a row after its id, in the file's order: the standard ones (kFixedFloats), then
+// the frame's attributes. For the writer (const) and the reader alike.
+template <typename Frame>
+auto floatColumns(Frame& f) {
+  using Column = std::conditional_t<std::is_const_v<Frame>, const FloatColumn, FloatColumn>;
+  std::vector<Column*> cols = {&f.position.x, &f.position.y, &f.position.z,
+                               &f.velocity.x, &f.velocity.y, &f.velocity.z,
+                               &f.age,        &f.life,       &f.mass};
+  for (Column& a : f.attributes) cols.push_back(&a);
   return cols;
 }
 
@@ -217,10 +223,7 @@ FrameData readPlyCache(const std::filesystem::path& path) {
          " bytes, " + std::to_string(bodyBytes) + " bytes after the header)");
   }
   frame.resize(count, std::vector<std::string>(floats.begin() + kStandardColumns, floats.end()));
-  std::vector<FloatColumn*> cols = {&frame.position.x, &frame.position.y, &frame.position.z,
-                                    &frame.velocity.x, &frame.velocity.y, &frame.velocity.z,
-                                    &frame.age,        &frame.life,       &frame.mass};
-  for (FloatColumn& a : frame.attributes) cols.push_back(&a);
+  const std::vector<FloatColumn*> cols = floatColumns(frame);
   std::vector<char> row(rowBytes);
   for (std::size_t i = 0; i < count; ++i) {
     if (!in.read(row.data(), static_cast<std::streamsize>(row.size()))) fail("truncated body");
