@@ -138,6 +138,7 @@ TEST_F(Caches, PlyRoundTripIsBitExactWithHeaderAndMetadata) {
 // values of `columns` (the header's order: the standard columns, then the frame's attributes),
 // ints for Houdini's integer attributes.
 std::string expectedPlyBody(const FrameData& frame, const std::vector<FloatColumn*>& columns) {
+  const std::size_t standard = columns.size() - frame.attributes.size();
   std::string body;
   const auto put = [&](const void* value, std::size_t bytes) {
     body.append(static_cast<const char*>(value), bytes);
@@ -147,7 +148,6 @@ std::string expectedPlyBody(const FrameData& frame, const std::vector<FloatColum
     const double id = static_cast<double>(frame.id[i]);
     put(&id, sizeof id);
     for (std::size_t c = 0; c < columns.size(); ++c) {
-      const std::size_t standard = columns.size() - frame.attributes.size();
       if (c >= standard && isIntAttribute(frame.attributeNames[c - standard])) {
         const auto v = static_cast<std::int32_t>((*columns[c])[e]);
         put(&v, sizeof v);

@@ -51,6 +51,10 @@ constexpr std::array<int, 2> kSanitizedThreads{1, 3};
 constexpr std::span<const int> kThreads = tickfx::test::kSanitized
                                               ? std::span<const int>(kSanitizedThreads)
                                               : std::span<const int>(kReleaseThreads);
+// The most of them: an arena may have more threads than the machine has cores only below TBB's
+// global limit, raised to this where they run.
+constexpr std::size_t kMostThreads =
+    static_cast<std::size_t>(*std::max_element(kThreads.begin(), kThreads.end()));
 
 std::uint32_t bits(float x) { return std::bit_cast<std::uint32_t>(x); }
 
@@ -124,10 +128,7 @@ class ioVdbWriter : public ::testing::Test {
     const std::string serial =
         detail::vdbPointCacheBytes(frame, metadata(), options, VdbEncoder::Serial);
     ASSERT_GT(serial.size(), 100u);
-    // Lets an arena have more threads than the machine has cores (TBB's default limit).
-    const tbb::global_control allowed(
-        tbb::global_control::max_allowed_parallelism,
-        static_cast<std::size_t>(*std::max_element(kThreads.begin(), kThreads.end())));
+    const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism, kMostThreads);
     for (const int threads : kThreads) {
       SCOPED_TRACE(std::to_string(threads) + " threads");
       tbb::task_arena arena(threads);
@@ -312,9 +313,7 @@ TEST_F(ioVdbWriter, AFullDiskLeavesTheFormerFileWhole) {
 // every point's (leaf, voxel, row) it replaced: the same leaves in the same order, the same
 // points in each voxel in the same order, so the same bytes.
 void expectGroupingsAgree(const FrameData& frame) {
-  const tbb::global_control allowed(
-      tbb::global_control::max_allowed_parallelism,
-      static_cast<std::size_t>(*std::max_element(kThreads.begin(), kThreads.end())));
+  const tbb::global_control allowed(tbb::global_control::max_allowed_parallelism, kMostThreads);
   for (const VdbCacheOptions& options : {kDefault, kFixed16}) {
     SCOPED_TRACE(vdbPositionsName(options.positions));
     const std::string sorted = detail::vdbPointCacheBytes(

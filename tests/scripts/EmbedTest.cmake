@@ -39,23 +39,21 @@ if(NOT installed STREQUAL expected)
   message(FATAL_ERROR "installed headers:\n  ${installed}\nexpected (cmake/PublicHeaders.cmake):\n  ${expected}")
 endif()
 
-# Only include/ goes on a host's include path: installed headers include each other as
-# <tickfx/...>, never by a bare "particles/..." path that would need include/tickfx there too.
-foreach(header ${installed})
-  file(STRINGS ${prefix}/include/tickfx/${header} bare REGEX "#include \"")
-  if(bare)
-    message(FATAL_ERROR "include/tickfx/${header} includes by a bare path:\n${bare}")
-  endif()
-endforeach()
-
-# Below, each header compiles with <Eigen/Core> precompiled: parsing it was 1.4 s of a header's
-# 2.5, most of this test's time. Then a header that names Eigen but includes none of it would
-# still compile, so that is checked here on the text: each header that names Eigen reaches an
-# <Eigen/...> include of its own or through the tickfx headers it includes.
+# Two checks on each header's text:
+# - Only include/ goes on a host's include path: installed headers include each other as
+#   <tickfx/...>, never by a bare "particles/..." path that would need include/tickfx there too.
+# - Below, each header compiles with <Eigen/Core> precompiled: parsing it was 1.4 s of a
+#   header's 2.5, most of this test's time. Then a header that names Eigen but includes none of
+#   it would still compile, so each header that names Eigen must reach an <Eigen/...> include of
+#   its own or through the tickfx headers it includes.
 set(eigen_reached "")
 set(eigen_named "")
 foreach(header ${installed})
   file(READ ${prefix}/include/tickfx/${header} text)
+  string(REGEX MATCHALL "[^\n]*#include \"[^\n]*" bare "${text}")
+  if(bare)
+    message(FATAL_ERROR "include/tickfx/${header} includes by a bare path:\n${bare}")
+  endif()
   string(REGEX MATCHALL "#include <tickfx/[^>]+>" deps_${header} "${text}")
   list(TRANSFORM deps_${header} REPLACE "#include <tickfx/([^>]+)>" "\\1")
   if(text MATCHES "#include <Eigen/")
