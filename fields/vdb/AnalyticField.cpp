@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "fields/vdb/RegisteredGrid.h"
 #include "fields/vdb/VectorFieldGrids.h"
 #include "particles/DetMath.h"
 #include "particles/Random.h"
@@ -203,9 +204,8 @@ openvdb::Vec3fGrid::Ptr bakeGrid(const AnalyticField& field, const BakeSettings&
     hi[c] = static_cast<openvdb::Int32>(last);
     if (lo[c] > hi[c]) throw std::invalid_argument("bake: the box holds no voxel centre");
   }
-  openvdb::initialize();
   const openvdb::Vec3f background(s.background.x(), s.background.y(), s.background.z());
-  openvdb::Vec3fGrid::Ptr grid = openvdb::Vec3fGrid::create(background);
+  openvdb::Vec3fGrid::Ptr grid = newRegisteredGrid<openvdb::Vec3fGrid>(background);
   grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
   grid->setName(s.gridName);
   grid->setGridClass(s.staggered ? openvdb::GRID_STAGGERED : openvdb::GRID_UNKNOWN);

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "fields/ShapeCollider.h"
+#include "fields/vdb/RegisteredGrid.h"
 #include "fields/vdb/VdbGridFile.h"
 
 namespace tickfx {
@@ -209,7 +210,7 @@ Eigen::Vector3d bakeExtent(const LevelSetSettings& l) {
 openvdb::FloatGrid::Ptr bake(const LevelSetSettings& l) {
   const double h = l.voxelSize;
   const float band = kHalfWidth * static_cast<float>(h);
-  auto grid = openvdb::FloatGrid::create(band);
+  auto grid = newRegisteredGrid<openvdb::FloatGrid>(band);
   grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
   const Eigen::Vector3d extent = bakeExtent(l);

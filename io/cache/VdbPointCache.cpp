@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "fields/vdb/RegisteredGrid.h"
 #include "fields/vdb/VdbGridFile.h"
 #include "io/cache/AttributeGroups.h"
 #include "io/cache/VdbPointCacheBytes.h"
@@ -417,24 +418,20 @@ GroupedPoints groupedPoints(const FrameData& frame, Grouping grouping) {
   return groupPoints<kQuantised>(frame, grouping);
 }
 
-// The tree of `points`, each leaf made by makeLeaf(l). Leaves are independent: made in parallel
-// (as OpenVDB's point conversion does), then handed to the tree in order.
+// The grid of `points` with the frame's metadata, each leaf made by makeLeaf(l). Leaves are
+// independent: made in parallel (as OpenVDB's point conversion does), then handed to the tree in
+// order. The grid comes from OpenVDB's registry (fields/vdb/RegisteredGrid.h says why).
 template <typename MakeLeaf>
-vdbp::PointDataTree::Ptr makeTree(const GroupedPoints& points, const MakeLeaf& makeLeaf) {
+vdbp::PointDataGrid::Ptr makeGrid(const GroupedPoints& points, const MakeLeaf& makeLeaf,
+                                  const FrameData& frame, const VdbCacheMetadata& meta) {
   std::vector<std::unique_ptr<Leaf>> leaves(points.origins.size());
   par::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t l = range.begin(); l < range.end(); ++l)
                         leaves[l] = makeLeaf(l);
                     });
-  auto tree = std::make_shared<vdbp::PointDataTree>();
-  for (std::unique_ptr<Leaf>& leaf : leaves) tree->addLeaf(leaf.release());
-  return tree;
-}
-
-vdbp::PointDataGrid::Ptr makeGrid(const vdbp::PointDataTree::Ptr& tree, const FrameData& frame,
-                                  const VdbCacheMetadata& meta) {
-  auto grid = vdbp::PointDataGrid::create(tree);
+  auto grid = newRegisteredGrid<vdbp::PointDataGrid>();
+  for (std::unique_ptr<Leaf>& leaf : leaves) grid->tree().addLeaf(leaf.release());
   grid->setName(kGridName);
   grid->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
   grid->insertMeta(kMetaEffectHash, openvdb::StringMetadata(meta.effectHash));
@@ -460,11 +457,11 @@ void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
   GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
   std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
   const auto descriptor = gridDescriptor<PositionArray>(attributes);
-  auto tree = makeTree(points, [&](std::size_t l) { return makeEmptyLeaf(points, l); });
+  const vdbp::PointDataGrid::Ptr grid = makeGrid(
+      points, [&](std::size_t l) { return makeEmptyLeaf(points, l); }, frame, meta);
   // The placeholders, on the tree's first leaf (the tree's order is not the leaves' Coord order
   // where they lie far apart).
-  if (auto first = tree->beginLeaf()) addUniformArrays(*first, descriptor);
-  const vdbp::PointDataGrid::Ptr grid = makeGrid(tree, frame, meta);
+  if (auto first = grid->tree().beginLeaf()) addUniformArrays(*first, descriptor);
   const GroupedValues<PositionArray> values(points, std::move(attributes));
   EncodedPointsFile file = encodePointsFile(*grid, compressionFlags(options), values);
   use(file);
@@ -478,11 +475,10 @@ vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetada
   orderAllLater(points);
   const std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
   const auto descriptor = gridDescriptor<PositionArray>(attributes);
-  return makeGrid(makeTree(points,
-                           [&](std::size_t l) {
-                             return makeLeaf<PositionArray>(attributes, points, l, descriptor);
-                           }),
-                  frame, meta);
+  return makeGrid(
+      points,
+      [&](std::size_t l) { return makeLeaf<PositionArray>(attributes, points, l, descriptor); },
+      frame, meta);
 }
 
 template <typename Use>

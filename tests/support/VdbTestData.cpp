@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "fields/vdb/RegisteredGrid.h"
 #include "fields/vdb/VdbGridFile.h"
 #include "fields/vdb/VectorFieldGrids.h"
 
@@ -78,7 +79,7 @@ Value valueOf(const T& t) {
 template <typename GridT>
 openvdb::GridBase::Ptr makeGridAs(const GridFileSpec& spec) {
   using V = typename GridT::ValueType;
-  typename GridT::Ptr grid = GridT::create(valueAs<V>(spec.background));
+  typename GridT::Ptr grid = newRegisteredGrid<GridT>(valueAs<V>(spec.background));
   grid->setName(spec.name);
   grid->setTransform(openvdb::math::Transform::createLinearTransform(spec.voxelSize));
   for (const auto& [ijk, value] : spec.activeVoxels) {
@@ -294,7 +295,7 @@ std::unique_ptr<VectorField> oneVoxelFrames(const VectorField::Settings& setting
   for (const Coord& c : activeVoxel) {
     openvdb::GridBase::Ptr& grid = made[c];
     if (!grid) {
-      auto g = openvdb::Vec3fGrid::create();
+      auto g = newRegisteredGrid<openvdb::Vec3fGrid>(openvdb::Vec3f(0.0f));
       g->setTransform(openvdb::math::Transform::createLinearTransform(voxelSize));
       g->tree().setValueOn(openvdb::Coord(c[0], c[1], c[2]), openvdb::Vec3f(0.0f));
       grid = g;
