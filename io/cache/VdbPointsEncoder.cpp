@@ -755,17 +755,22 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
 // Its arrays being placeholders (`values`), memUsage() is what the grid would use with its arrays
 // expanded, and so is that of the shallow copy Archive::write() makes to record it in the file
 // (file_mem_bytes). That copy (copyGrid() const, the one Archive::write() calls) starts `ahead`.
-class ParallelBuffersGrid final : public vdbp::PointDataGrid {
+// A GridBase of its own that forwards to the grid, not a subclass of PointDataGrid: a subclass
+// would instantiate every virtual member of Grid<PointDataTree> and Tree<PointDataTree> here,
+// where the forwarded calls run libopenvdb's (fields/vdb/RegisteredGrid.h says what that costs).
+// What Archive::write() does not call on a grid it writes (reading, changing the tree) is refused.
+class ParallelBuffersGrid final : public openvdb::GridBase {
  public:
   ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues& values, BuffersAhead* ahead,
                       std::unique_ptr<EncodedPointsFile::Deferred>* deferred)
-      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()),
+      : openvdb::GridBase(grid, openvdb::ShallowCopy()),
+        grid_(&grid),
         values_(&values),
         ahead_(ahead),
         deferred_(deferred) {
     // Each leaf past the first lacks the first's attribute set but for its arrays' sizes; each
     // array, expanded, holds its leaf's point count of values where a placeholder holds one.
-    auto leaf = constTree().cbeginLeaf();
+    auto leaf = grid.constTree().cbeginLeaf();
     if (!leaf) return;
     const vdbp::AttributeSet& set = leaf->attributeSet();
     std::size_t bytesPerPoint = 0;
@@ -778,30 +783,77 @@ class ParallelBuffersGrid final : public vdbp::PointDataGrid {
     }
     expandedExtra_ += (leaves - 1) * setBytes;
   }
-  void writeBuffers(std::ostream& os) const override {
-    if (!writeBuffersInParallel(constTree(), saveFloatAsHalf(), *values_, os, ahead_, *deferred_))
-      vdbp::PointDataGrid::writeBuffers(os);
-  }
-  openvdb::Index64 memUsage() const override {
-    return vdbp::PointDataGrid::memUsage() + expandedExtra_;
-  }
   // A shallow copy, with what stands for the placeholders.
   ParallelBuffersGrid(ParallelBuffersGrid& grid, openvdb::ShallowCopy)
-      : vdbp::PointDataGrid(grid, openvdb::ShallowCopy()),
+      : openvdb::GridBase(grid, openvdb::ShallowCopy()),
+        grid_(grid.grid_),
         values_(grid.values_),
         ahead_(grid.ahead_),
         deferred_(grid.deferred_),
         expandedExtra_(grid.expandedExtra_) {}
+
+  void writeBuffers(std::ostream& os) const override {
+    if (!writeBuffersInParallel(grid_->constTree(), saveFloatAsHalf(), *values_, os, ahead_,
+                                *deferred_))
+      base().writeBuffers(os);
+  }
+  openvdb::Index64 memUsage() const override { return base().memUsage() + expandedExtra_; }
   openvdb::GridBase::Ptr copyGrid() override {
     return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
   }
   openvdb::GridBase::ConstPtr copyGrid() const override {
-    if (ahead_ != nullptr) ahead_->start(constTree(), saveFloatAsHalf(), *values_);
+    if (ahead_ != nullptr) ahead_->start(grid_->constTree(), saveFloatAsHalf(), *values_);
     return std::make_shared<ParallelBuffersGrid>(const_cast<ParallelBuffersGrid&>(*this),
                                                  openvdb::ShallowCopy());
   }
 
+  // The grid's own, through its virtual members.
+  openvdb::Name type() const override { return base().type(); }
+  openvdb::Name valueType() const override { return base().valueType(); }
+  openvdb::TreeBase::ConstPtr constBaseTreePtr() const override {
+    return base().constBaseTreePtr();
+  }
+  bool isTreeUnique() const override { return base().isTreeUnique(); }
+  bool empty() const override { return base().empty(); }
+  openvdb::Index64 activeVoxelCount() const override { return base().activeVoxelCount(); }
+  openvdb::CoordBBox evalActiveVoxelBoundingBox() const override {
+    return base().evalActiveVoxelBoundingBox();
+  }
+  openvdb::Coord evalActiveVoxelDim() const override { return base().evalActiveVoxelDim(); }
+  void writeTopology(std::ostream& os) const override { base().writeTopology(os); }
+  void print(std::ostream& os, int verboseLevel) const override { base().print(os, verboseLevel); }
+
+  // Not for a grid being written.
+  openvdb::GridBase::Ptr copyGridWithNewTree() const override { refuse(); }
+  openvdb::GridBase::ConstPtr copyGridReplacingMetadata(const openvdb::MetaMap&) const override {
+    refuse();
+  }
+  openvdb::GridBase::ConstPtr copyGridReplacingTransform(
+      openvdb::math::Transform::Ptr) const override {
+    refuse();
+  }
+  openvdb::GridBase::ConstPtr copyGridReplacingMetadataAndTransform(
+      const openvdb::MetaMap&, openvdb::math::Transform::Ptr) const override {
+    refuse();
+  }
+  openvdb::GridBase::Ptr deepCopyGrid() const override { refuse(); }
+  void setTree(openvdb::TreeBase::Ptr) override { refuse(); }
+  void newTree() override { refuse(); }
+  void clear() override { refuse(); }
+  void pruneGrid(float) override { refuse(); }
+  void clip(const openvdb::CoordBBox&) override { refuse(); }
+  void readTopology(std::istream&) override { refuse(); }
+  void readBuffers(std::istream&) override { refuse(); }
+  void readBuffers(std::istream&, const openvdb::CoordBBox&) override { refuse(); }
+  void readNonresidentBuffers() const override { refuse(); }
+
  private:
+  const openvdb::GridBase& base() const { return *grid_; }
+  [[noreturn]] static void refuse() {
+    throw std::logic_error("VDB points: a grid being written was asked to change or copy");
+  }
+
+  vdbp::PointDataGrid* grid_;            // (never null; outlives the write)
   const PointValues* values_ = nullptr;  // (never null)
   BuffersAhead* ahead_ = nullptr;
   std::unique_ptr<EncodedPointsFile::Deferred>* deferred_;  // where writeBuffers() leaves them
