@@ -18,14 +18,16 @@ namespace tickfx {
 
 /// A new, empty grid of the registered type GridT (every standard OpenVDB grid type, points
 /// included) with `background` as its background value. Shared ownership, as GridT::create().
-/// Throws std::logic_error if GridT is not registered.
+/// Throws openvdb::LookupError (from the registry) if GridT is not registered.
 template <typename GridT>
 typename GridT::Ptr newRegisteredGrid(
     const typename GridT::ValueType& background = openvdb::zeroVal<typename GridT::ValueType>()) {
   openvdb::initialize();  // registers the standard types; idempotent
   typename GridT::Ptr grid =
       openvdb::gridPtrCast<GridT>(openvdb::GridBase::createGrid(GridT::gridType()));
-  if (!grid) throw std::logic_error("OpenVDB has no registered grid type " + GridT::gridType());
+  // (Null only if another class were registered under GridT's name.)
+  if (!grid)
+    throw std::logic_error("OpenVDB's grid type " + GridT::gridType() + " is another class");
   grid->tree().root().setBackground(background, /*updateChildNodes=*/false);
   return grid;
 }
