@@ -86,6 +86,44 @@ void standardRows(const std::uint64_t* __restrict id, const std::vector<const Fl
     }
   }
 }
+
+// Float columns [first, last) of `cols` of rows [begin, end) at `bytes`, `rowBytes` apart, each
+// at its place in the row (after the id): four columns a pass, each row's four values put
+// together in a register and stored by one 16-byte store, then a pair by one 8-byte store, then
+// one alone. Four passes of one 4-byte store a row at a stride of a row cost four times the
+// stores. Bit moves only, as above: NaN payloads go out as they are.
+void floatColumnRuns(const std::vector<const FloatColumn*>& cols, std::size_t first,
+                     std::size_t last, std::size_t rowBytes, std::size_t begin, std::size_t end,
+                     char* bytes) {
+  std::size_t c = first;
+  for (; c + 4 <= last; c += 4) {
+    const float* __restrict a = cols[c]->data();
+    const float* __restrict b = cols[c + 1]->data();
+    const float* __restrict d = cols[c + 2]->data();
+    const float* __restrict e = cols[c + 3]->data();
+    char* __restrict to = bytes + sizeof(double) + c * sizeof(float);
+    for (std::size_t i = begin; i < end; ++i, to += rowBytes) {
+      const __m128 ab = _mm_unpacklo_ps(_mm_load_ss(a + i), _mm_load_ss(b + i));
+      const __m128 de = _mm_unpacklo_ps(_mm_load_ss(d + i), _mm_load_ss(e + i));
+      _mm_storeu_ps(reinterpret_cast<float*>(to), _mm_movelh_ps(ab, de));
+    }
+  }
+  if (c + 2 <= last) {
+    const float* __restrict a = cols[c]->data();
+    const float* __restrict b = cols[c + 1]->data();
+    char* __restrict to = bytes + sizeof(double) + c * sizeof(float);
+    for (std::size_t i = begin; i < end; ++i, to += rowBytes) {
+      _mm_storel_pi(reinterpret_cast<__m64*>(to),
+                    _mm_unpacklo_ps(_mm_load_ss(a + i), _mm_load_ss(b + i)));
+    }
+    c += 2;
+  }
+  if (c < last) {
+    const float* __restrict a = cols[c]->data();
+    char* __restrict to = bytes + sizeof(double) + c * sizeof(float);
+    for (std::size_t i = begin; i < end; ++i, to += rowBytes) std::memcpy(to, a + i, sizeof(float));
+  }
+}
 #endif
 
 // The columns of a row after its id, in the file's order: the standard ones (kFixedFloats), then
@@ -115,19 +153,28 @@ void formatRows(const FrameData& frame, const std::vector<const FloatColumn*>& c
     std::memcpy(bytes + (i - begin) * rowBytes, &id, sizeof id);
   }
 #endif
-  // The others column by column: every pass reads one column in order.
-  for (; c < cols.size(); ++c) {
-    const float* const column = cols[c]->data();
+  // The others: each run of float columns together (where SSE2 is), each int column alone.
+  while (c < cols.size()) {
     char* at = bytes + sizeof(double) + c * sizeof(float);
+    const float* const column = cols[c]->data();
     if (ints[c]) {
       for (std::size_t i = begin; i < end; ++i, at += rowBytes) {
         const auto v = static_cast<std::int32_t>(column[i]);
         std::memcpy(at, &v, sizeof v);
       }
+      ++c;
       continue;
     }
+#if defined(__SSE2__)
+    std::size_t last = c + 1;
+    while (last < cols.size() && !ints[last]) ++last;
+    floatColumnRuns(cols, c, last, rowBytes, begin, end, bytes);
+    c = last;
+#else
     for (std::size_t i = begin; i < end; ++i, at += rowBytes)
       std::memcpy(at, column + i, sizeof(float));
+    ++c;
+#endif
   }
 }
 

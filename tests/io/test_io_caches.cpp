@@ -160,8 +160,9 @@ std::string expectedPlyBody(const FrameData& frame, const std::vector<FloatColum
 }
 
 // The rows are stored a block at a time (32768 rows), the standard columns a row at a time in
-// 16-byte stores that reach into the next row: every byte of the body, over three blocks, the
-// last one partial, with and without other columns after the standard ones, on 1 and 2 threads.
+// 16-byte stores that reach into the next row, the other float columns four, two or one at a
+// time: every byte of the body, over three blocks, the last one partial, with no other columns,
+// with two, and with runs of floats of every length between int columns, on 1 and 2 threads.
 // Values with every bit pattern that matters: NaNs with payloads, −0.0, subnormals, infinities.
 TEST_F(Caches, PlyBodiesAreTheRowsValueByValueAcrossBlocks) {
   const float special[] = {std::bit_cast<float>(0x7fc01234u),
@@ -171,7 +172,10 @@ TEST_F(Caches, PlyBodiesAreTheRowsValueByValueAcrossBlocks) {
                            -std::numeric_limits<float>::infinity(),
                            3.5f};
   for (const std::vector<std::string>& names :
-       {std::vector<std::string>{}, std::vector<std::string>{"heat", "hitnum"}}) {
+       {std::vector<std::string>{}, std::vector<std::string>{"heat", "hitnum"},
+        // Runs of floats of 7 (4 + 2 + 1), an int, 1 and 2 (PlyCache's stores a run at once).
+        std::vector<std::string>{"Cd_r", "Cd_g", "Cd_b", "Alpha", "pscale", "heat", "rest",
+                                 "hitnum", "u", "contacts", "w", "t"}}) {
     FrameData frame;
     frame.frame = 7;
     frame.resize(70001, names);
