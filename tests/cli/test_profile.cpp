@@ -84,8 +84,9 @@ TEST_F(Profile, ThePhasesAddUpToTheRunsWallTime) {
   for (const char* phase : {"startup", "load", "growth", "emission", "step", "deaths", "capture",
                             "checkpoint", "cache write", "release"}) {
     ASSERT_EQ(rows.count(phase), 1u) << phase << " missing from\n" << r.out;
-    // Freeing this run's 20 MB takes under the half millisecond a row rounds to.
-    if (std::string_view(phase) != "release") {
+    // Freeing this run's 20 MB, and loading its effect of twenty lines, may take under the half
+    // millisecond a row rounds to (both have: CI73 printed 0.000 s for the load).
+    if (std::string_view(phase) != "release" && std::string_view(phase) != "load") {
       EXPECT_GT(rows.at(phase).wall, 0.0) << phase;
     }
     EXPECT_GE(rows.at(phase).serialShare, 0.0) << phase;
