@@ -86,16 +86,30 @@ void standardRows(const std::uint64_t* __restrict id, const std::vector<const Fl
     }
   }
 }
+#endif
+
+// The columns of a row after its id, in the file's order: the standard ones (kFixedFloats), then
+// the frame's attributes. For the writer (const) and the reader alike.
+template <typename Frame>
+auto floatColumns(Frame& f) {
+  using Column = std::conditional_t<std::is_const_v<Frame>, const FloatColumn, FloatColumn>;
+  std::vector<Column*> cols = {&f.position.x, &f.position.y, &f.position.z,
+                               &f.velocity.x, &f.velocity.y, &f.velocity.z,
+                               &f.age,        &f.life,       &f.mass};
+  for (Column& a : f.attributes) cols.push_back(&a);
+  return cols;
+}
 
 // Float columns [first, last) of `cols` of rows [begin, end) at `bytes`, `rowBytes` apart, each
-// at its place in the row (after the id): four columns a pass, each row's four values put
-// together in a register and stored by one 16-byte store, then a pair by one 8-byte store, then
-// one alone. Four passes of one 4-byte store a row at a stride of a row cost four times the
-// stores. Bit moves only, as above: NaN payloads go out as they are.
-void floatColumnRuns(const std::vector<const FloatColumn*>& cols, std::size_t first,
-                     std::size_t last, std::size_t rowBytes, std::size_t begin, std::size_t end,
-                     char* bytes) {
+// at its place in the row (after the id). With SSE2, four columns a pass, each row's four values
+// put together in a register and stored by one 16-byte store, then a pair by one 8-byte store:
+// four passes of one 4-byte store a row at a stride of a row cost four times the stores. What is
+// left goes a column a pass. Bit moves only, as above: NaN payloads go out as they are.
+void storeFloatColumns(const std::vector<const FloatColumn*>& cols, std::size_t first,
+                       std::size_t last, std::size_t rowBytes, std::size_t begin, std::size_t end,
+                       char* bytes) {
   std::size_t c = first;
+#if defined(__SSE2__)
   for (; c + 4 <= last; c += 4) {
     const float* __restrict a = cols[c]->data();
     const float* __restrict b = cols[c + 1]->data();
@@ -118,24 +132,12 @@ void floatColumnRuns(const std::vector<const FloatColumn*>& cols, std::size_t fi
     }
     c += 2;
   }
-  if (c < last) {
+#endif
+  for (; c < last; ++c) {
     const float* __restrict a = cols[c]->data();
     char* __restrict to = bytes + sizeof(double) + c * sizeof(float);
     for (std::size_t i = begin; i < end; ++i, to += rowBytes) std::memcpy(to, a + i, sizeof(float));
   }
-}
-#endif
-
-// The columns of a row after its id, in the file's order: the standard ones (kFixedFloats), then
-// the frame's attributes. For the writer (const) and the reader alike.
-template <typename Frame>
-auto floatColumns(Frame& f) {
-  using Column = std::conditional_t<std::is_const_v<Frame>, const FloatColumn, FloatColumn>;
-  std::vector<Column*> cols = {&f.position.x, &f.position.y, &f.position.z,
-                               &f.velocity.x, &f.velocity.y, &f.velocity.z,
-                               &f.age,        &f.life,       &f.mass};
-  for (Column& a : f.attributes) cols.push_back(&a);
-  return cols;
 }
 
 // Rows [begin, end) at `bytes`, `rowBytes` apart: each row's id (as a double), then its floats
@@ -153,28 +155,22 @@ void formatRows(const FrameData& frame, const std::vector<const FloatColumn*>& c
     std::memcpy(bytes + (i - begin) * rowBytes, &id, sizeof id);
   }
 #endif
-  // The others: each run of float columns together (where SSE2 is), each int column alone.
+  // The others: each run of float columns together, each int column alone.
   while (c < cols.size()) {
-    char* at = bytes + sizeof(double) + c * sizeof(float);
-    const float* const column = cols[c]->data();
-    if (ints[c]) {
-      for (std::size_t i = begin; i < end; ++i, at += rowBytes) {
-        const auto v = static_cast<std::int32_t>(column[i]);
-        std::memcpy(at, &v, sizeof v);
-      }
-      ++c;
+    if (!ints[c]) {
+      std::size_t last = c + 1;
+      while (last < cols.size() && !ints[last]) ++last;
+      storeFloatColumns(cols, c, last, rowBytes, begin, end, bytes);
+      c = last;
       continue;
     }
-#if defined(__SSE2__)
-    std::size_t last = c + 1;
-    while (last < cols.size() && !ints[last]) ++last;
-    floatColumnRuns(cols, c, last, rowBytes, begin, end, bytes);
-    c = last;
-#else
-    for (std::size_t i = begin; i < end; ++i, at += rowBytes)
-      std::memcpy(at, column + i, sizeof(float));
+    const float* const column = cols[c]->data();
+    char* at = bytes + sizeof(double) + c * sizeof(float);
+    for (std::size_t i = begin; i < end; ++i, at += rowBytes) {
+      const auto v = static_cast<std::int32_t>(column[i]);
+      std::memcpy(at, &v, sizeof v);
+    }
     ++c;
-#endif
   }
 }
 

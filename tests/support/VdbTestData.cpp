@@ -295,7 +295,7 @@ std::unique_ptr<VectorField> oneVoxelFrames(const VectorField::Settings& setting
   for (const Coord& c : activeVoxel) {
     openvdb::GridBase::Ptr& grid = made[c];
     if (!grid) {
-      auto g = newRegisteredGrid<openvdb::Vec3fGrid>(openvdb::Vec3f(0.0f));
+      auto g = newRegisteredGrid<openvdb::Vec3fGrid>();
       g->setTransform(openvdb::math::Transform::createLinearTransform(voxelSize));
       g->tree().setValueOn(openvdb::Coord(c[0], c[1], c[2]), openvdb::Vec3f(0.0f));
       grid = g;
