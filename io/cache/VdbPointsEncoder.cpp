@@ -12,6 +12,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 #include <ios>
@@ -748,6 +749,40 @@ bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const 
   return true;
 }
 
+// The bounding box of the tree's active voxels, as Tree::evalActiveVoxelBoundingBox() finds it
+// for a points tree (no active tiles, and a leaf only where some voxel holds points), from each
+// leaf's mask words: word x of a leaf's mask holds its voxels (x, y, z) at bit 8y + z
+// (LeafNode::coordToOffset()). OpenVDB visits each active voxel, a sixth of the serial part of
+// writing a frame of 10⁶ points (0.58 ms against 0.14). Empty for a tree without active voxels.
+openvdb::CoordBBox activeVoxelBox(const vdbp::PointDataTree& tree) {
+  static_assert(Leaf::NodeMaskType::WORD_COUNT == Leaf::DIM && Leaf::DIM * Leaf::DIM == 64);
+  openvdb::CoordBBox box;
+  for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
+    const Leaf::NodeMaskType& mask = leaf->getValueMask();
+    std::uint64_t any = 0;  // the (y, z) that some x holds
+    int firstX = -1, lastX = -1;
+    for (openvdb::Index x = 0; x < Leaf::DIM; ++x) {
+      const std::uint64_t word = mask.template getWord<std::uint64_t>(x);
+      if (word == 0) continue;
+      if (firstX < 0) firstX = static_cast<int>(x);
+      lastX = static_cast<int>(x);
+      any |= word;
+    }
+    if (any == 0) continue;
+    unsigned ys = 0, zs = 0;  // bit y (z): some active voxel has that y (z)
+    for (unsigned y = 0; y < Leaf::DIM; ++y) {
+      const auto zsOfY = static_cast<unsigned>((any >> (Leaf::DIM * y)) & 0xffu);
+      ys |= unsigned{zsOfY != 0} << y;
+      zs |= zsOfY;
+    }
+    const auto low = [](unsigned bits) { return std::countr_zero(bits); };
+    const auto high = [](unsigned bits) { return std::bit_width(bits) - 1; };
+    box.expand(leaf->origin() + openvdb::Coord(firstX, low(ys), low(zs)));
+    box.expand(leaf->origin() + openvdb::Coord(lastX, high(ys), high(zs)));
+  }
+  return box;
+}
+
 // The grid as Archive::write() sees it: the same tree, metadata and transform (a shallow copy),
 // its leaves' buffers written by writeBuffersInParallel(). Archive::write() calls the virtual
 // GridBase::writeBuffers() between the topology and the grid's end offset, which it then patches
@@ -817,7 +852,7 @@ class ParallelBuffersGrid final : public openvdb::GridBase {
   bool empty() const override { return base().empty(); }
   openvdb::Index64 activeVoxelCount() const override { return base().activeVoxelCount(); }
   openvdb::CoordBBox evalActiveVoxelBoundingBox() const override {
-    return base().evalActiveVoxelBoundingBox();
+    return activeVoxelBox(grid_->constTree());
   }
   openvdb::Coord evalActiveVoxelDim() const override { return base().evalActiveVoxelDim(); }
   void writeTopology(std::ostream& os) const override { base().writeTopology(os); }
