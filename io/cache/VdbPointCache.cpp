@@ -298,9 +298,19 @@ class GroupedValues final : public PointValues {
       throw std::logic_error("VDB points: values asked for a leaf the frame does not have");
     local.next = l + 1;
     const GridAttribute& a = attributes_[attribute];
-    if (points_.later) orderColumns(l, a, local.scratch);
+    if (points_.later) orderColumns(points_.buckets.of[l], a, local.scratch);
     withArrayType<PositionArray>(
         a.kind, [&]<typename Array>(std::type_identity<Array>) { storeAs<Array>(l, a, to); });
+  }
+
+  // Every bucket's columns put in order, attribute by attribute as the file holds them: the
+  // store then finds them in order (orderLater() does each once, whoever asks first).
+  void prepare() const override {
+    if (!points_.later) return;
+    BucketScratch scratch;
+    for (const GridAttribute& a : attributes_) {
+      for (std::size_t b = 0; b < points_.buckets.count(); ++b) orderColumns(b, a, scratch);
+    }
   }
 
  private:
@@ -321,10 +331,9 @@ class GroupedValues final : public PointValues {
     return static_cast<std::size_t>(leaf - origins.begin());
   }
 
-  // The columns attribute `a` reads, in order in leaf l's bucket (the offsets are ordered with
-  // the voxels).
-  void orderColumns(std::size_t l, const GridAttribute& a, BucketScratch& scratch) const {
-    const std::size_t b = points_.buckets.of[l];
+  // The columns attribute `a` reads, in order in bucket b (the offsets are ordered with the
+  // voxels).
+  void orderColumns(std::size_t b, const GridAttribute& a, BucketScratch& scratch) const {
     if (a.kind == GridAttribute::Kind::Id) orderLater(points_, b, 0, scratch);
     for (std::size_t j = 0; j < a.floatColumns(); ++j)
       orderLater(points_, b, 1 + a.column + j, scratch);

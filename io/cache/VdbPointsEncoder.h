@@ -51,6 +51,11 @@ class PointValues {
   /// attributes.
   virtual void store(std::size_t attribute, const openvdb::Coord& origin, std::size_t count,
                      char* to) const = 0;
+  /// Work that store() would otherwise do when asked, done ahead of it, in the order the file
+  /// asks for it: EncodedPointsFile::write() runs it on another thread beside the first chunks,
+  /// whose bytes (the header, the positions) take little making while the kernel copies them.
+  /// Called at most once a write, while store() is called from other threads.
+  virtual void prepare() const {}
 };
 
 /// Uninitialised storage for `n` values of T (a type a plain copy creates, as numbers and
@@ -82,6 +87,8 @@ class EncodedPointsFile {
     /// Writes bytes [from, to) of them at `out`. Called from several threads at once, for
     /// ranges that do not overlap.
     virtual void fill(std::size_t from, std::size_t to, char* out) const = 0;
+    /// What fill() would do when asked, done ahead of it (PointValues::prepare()).
+    virtual void prepare() const {}
   };
 
   /// `known`: the file's bytes but the deferred ones, which go at `deferredAt`.
