@@ -169,15 +169,15 @@ vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<GridAttribu
   return descriptor;
 }
 
-// Sets leaf l's voxel values, each the end of its voxel's points in the leaf's arrays, and its
+// Leaf l's voxel values, each the end of its voxel's points in the leaf's arrays, and its
 // value mask, on where a voxel holds points: what setOffsets(ends, /*updateValueMask=*/true)
 // sets, without its two calls a voxel.
-void setVoxelEnds(const GroupedPoints& points, std::size_t l, Leaf& leaf) {
+void voxelEnds(const GroupedPoints& points, std::size_t l, openvdb::PointDataIndex32* ends,
+               Leaf::NodeMaskType& mask) {
   std::array<openvdb::Index32, Leaf::SIZE> counts{};
   const auto [begin, end] = points.leafPoints(l);
   for (std::size_t k = begin; k < end; ++k) ++counts[points.voxel[k]];
-  openvdb::PointDataIndex32* const ends = leaf.buffer().data();
-  Leaf::NodeMaskType mask;  // all off
+  mask.setOff();
   openvdb::Index32 sum = 0;
   for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
     std::uint64_t word = 0;
@@ -188,20 +188,19 @@ void setVoxelEnds(const GroupedPoints& points, std::size_t l, Leaf& leaf) {
     }
     mask.template getWord<std::uint64_t>(w) = word;
   }
-  leaf.setValueMask(mask);
 }
 
-// Leaf l with its voxel values, and its default attribute set: encodePointsFile takes
-// placeholders on the tree's first leaf alone, some ten thousand arrays fewer to make and free
-// at 10⁶ points.
+// Leaf l with its voxel values, and its default attribute set.
 std::unique_ptr<Leaf> makeEmptyLeaf(const GroupedPoints& points, std::size_t l) {
   auto leaf = std::make_unique<Leaf>(points.origins[l]);
-  setVoxelEnds(points, l, *leaf);
+  Leaf::NodeMaskType mask;
+  voxelEnds(points, l, leaf->buffer().data(), mask);
+  leaf->setValueMask(mask);
   return leaf;
 }
 
-// Gives `leaf` an attribute set of its point count, each array uniform: the placeholders
-// encodePointsFile takes, or arrays to be expanded and filled.
+// Gives `leaf` an attribute set of its point count, each array uniform: arrays to be expanded
+// and filled.
 void addUniformArrays(Leaf& leaf, const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
   // (initializeAttributes takes a descriptor of P alone; this one has every attribute.)
   leaf.replaceAttributeSet(
@@ -427,20 +426,34 @@ GroupedPoints groupedPoints(const FrameData& frame, Grouping grouping) {
   return groupPoints<kQuantised>(frame, grouping);
 }
 
-// The grid of `points` with the frame's metadata, each leaf made by makeLeaf(l). Leaves are
-// independent: made in parallel (as OpenVDB's point conversion does), then handed to the tree in
-// order. The grid comes from OpenVDB's registry (fields/vdb/RegisteredGrid.h says why).
-template <typename MakeLeaf>
-vdbp::PointDataGrid::Ptr makeGrid(const GroupedPoints& points, const MakeLeaf& makeLeaf,
-                                  const FrameData& frame, const VdbCacheMetadata& meta) {
-  std::vector<std::unique_ptr<Leaf>> leaves(points.origins.size());
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t l = range.begin(); l < range.end(); ++l)
-                        leaves[l] = makeLeaf(l);
-                    });
+// The leaves of `points` for encodePointsFile, their attributes those of `descriptor`: made in
+// parallel, leaf by leaf.
+PointLeaves pointLeaves(const GroupedPoints& points,
+                        const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
+  PointLeaves leaves;
+  const std::size_t n = points.origins.size();
+  leaves.origins = points.origins;
+  leaves.counts.resize(n);
+  leaves.masks.resize(n);
+  leaves.voxelEnds = allocateLargeArray<openvdb::PointDataIndex32>(n * Leaf::SIZE);
+  par::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t l = range.begin(); l < range.end(); ++l) {
+          const auto [begin, end] = points.leafPoints(l);
+          leaves.counts[l] = end - begin;
+          voxelEnds(points, l, leaves.voxelEnds.get() + l * Leaf::SIZE, leaves.masks[l]);
+        }
+      });
+  leaves.sample = std::make_unique<Leaf>(openvdb::Coord(0));
+  leaves.sample->replaceAttributeSet(new vdbp::AttributeSet(descriptor, 1),
+                                     /*allowMismatchingDescriptors=*/true);
+  return leaves;
+}
+
+// The grid of no leaf with the frame's metadata, from OpenVDB's registry
+// (fields/vdb/RegisteredGrid.h says why).
+vdbp::PointDataGrid::Ptr emptyGrid(const FrameData& frame, const VdbCacheMetadata& meta) {
   auto grid = newRegisteredGrid<vdbp::PointDataGrid>();
-  for (std::unique_ptr<Leaf>& leaf : leaves) grid->tree().addLeaf(leaf.release());
   grid->setName(kGridName);
   grid->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
   grid->insertMeta(kMetaEffectHash, openvdb::StringMetadata(meta.effectHash));
@@ -455,24 +468,38 @@ vdbp::PointDataGrid::Ptr makeGrid(const GroupedPoints& points, const MakeLeaf& m
   return grid;
 }
 
+// The grid of `points` with the frame's metadata, each leaf made by makeLeaf(l). Leaves are
+// independent: made in parallel (as OpenVDB's point conversion does), then handed to the tree in
+// order.
+template <typename MakeLeaf>
+vdbp::PointDataGrid::Ptr makeGrid(const GroupedPoints& points, const MakeLeaf& makeLeaf,
+                                  const FrameData& frame, const VdbCacheMetadata& meta) {
+  std::vector<std::unique_ptr<Leaf>> leaves(points.origins.size());
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t l = range.begin(); l < range.end(); ++l)
+                        leaves[l] = makeLeaf(l);
+                    });
+  vdbp::PointDataGrid::Ptr grid = emptyGrid(frame, meta);
+  for (std::unique_ptr<Leaf>& leaf : leaves) grid->tree().addLeaf(leaf.release());
+  return grid;
+}
+
 std::uint32_t compressionFlags(const VdbCacheOptions& options);
 
-// The file, but for the UUID, handed to use(file) while what it is made from lives: the grid's
-// leaves hold placeholders, and the values go from the grouped points straight into the bytes
-// (encodePointsFile's PointValues) as the file is written (EncodedPointsFile).
+// The file, but for the UUID, handed to use(file) while what it is made from lives: the leaves
+// are described to the encoder (PointLeaves), not made, and the values go from the grouped points
+// straight into the bytes (encodePointsFile's PointValues) as the file is written
+// (EncodedPointsFile).
 template <typename PositionArray, typename Use>
 void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
                  const VdbCacheOptions& options, Grouping grouping, const Use& use) {
   GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
   std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
-  const auto descriptor = gridDescriptor<PositionArray>(attributes);
-  const vdbp::PointDataGrid::Ptr grid = makeGrid(
-      points, [&](std::size_t l) { return makeEmptyLeaf(points, l); }, frame, meta);
-  // The placeholders, on the tree's first leaf (the tree's order is not the leaves' Coord order
-  // where they lie far apart).
-  if (auto first = grid->tree().beginLeaf()) addUniformArrays(*first, descriptor);
+  const PointLeaves leaves = pointLeaves(points, gridDescriptor<PositionArray>(attributes));
+  const vdbp::PointDataGrid::Ptr grid = emptyGrid(frame, meta);
   const GroupedValues<PositionArray> values(points, std::move(attributes));
-  EncodedPointsFile file = encodePointsFile(*grid, compressionFlags(options), values);
+  EncodedPointsFile file = encodePointsFile(*grid, leaves, compressionFlags(options), values);
   use(file);
 }
 

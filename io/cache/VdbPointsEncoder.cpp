@@ -25,6 +25,7 @@
 #include <stdexcept>
 #include <streambuf>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -241,38 +242,66 @@ struct Piece {
 constexpr std::size_t kRangePoints = 16384;  // a leaf range ends once it holds this many points
 constexpr std::size_t kRangeLeaves = 64;     // or this many leaves
 
-// The leaves in the tree's order, and what stands in for their arrays, placeholders
-// (encodePointsFile's `values`): each leaf's point count, each attribute's bytes a value, and
-// each attribute's metadata record as OpenVDB writes it for leaf 0's array expanded.
+// The leaves in the tree's order (RootNode's and InternalNode's order: by top node, then by
+// internal node, then by leaf, each in Coord order), what their arrays hold (the sample's
+// attributes, expanded), and each attribute's bytes a value and metadata record as OpenVDB
+// writes it for the sample's array expanded.
 struct Leaves {
-  std::vector<const Leaf*> leaf;
+  const PointLeaves* leaves = nullptr;  // (never null)
+  std::vector<std::uint32_t> order;     // the tree's order: leaves->origins[order[l]]
   const PointValues* values = nullptr;  // (never null)
-  std::vector<std::size_t> count;
   std::vector<std::size_t> storage;
   std::vector<std::string> metadata;
 
-  std::size_t size() const { return leaf.size(); }
-  std::size_t points(std::size_t l) const { return count[l]; }
+  std::size_t size() const { return order.size(); }
+  std::size_t points(std::size_t l) const { return leaves->counts[order[l]]; }
+  const openvdb::Coord& origin(std::size_t l) const { return leaves->origins[order[l]]; }
+  const Leaf::NodeMaskType& mask(std::size_t l) const { return leaves->masks[order[l]]; }
+  openvdb::PointDataIndex32* voxelEnds(std::size_t l) const {
+    return leaves->voxelEnds.get() + std::size_t{order[l]} * Leaf::SIZE;
+  }
+  const vdbp::AttributeSet& attributes() const { return leaves->sample->attributeSet(); }
   // Leaf l's values of attribute a, stored at `to` by the caller's PointValues.
   void store(std::size_t l, std::size_t a, char* to) const {
-    values->store(a, leaf[l]->origin(), count[l], to);
+    values->store(a, origin(l), points(l), to);
   }
   // The bytes of leaf l's array of attribute a, without blosc's or the flag's.
   std::size_t arrayBytes(std::size_t l, std::size_t a) const { return points(l) * storage[a]; }
 };
 
-// The first leaf of each range, and the end: a pure function of the grid, not of the threads.
-std::vector<std::size_t> leafRanges(const std::vector<const Leaf*>& leaves) {
+// The nodes above a leaf: a tree's top nodes (RootNode's children) and the internal nodes
+// below them, whose children are leaves.
+using TopNode = vdbp::PointDataTree::RootNodeType::ChildNodeType;
+using LowerNode = TopNode::ChildNodeType;
+static_assert(std::is_same_v<LowerNode::ChildNodeType, Leaf>);
+openvdb::Coord topOrigin(const openvdb::Coord& leaf) { return leaf & ~(TopNode::DIM - 1); }
+openvdb::Coord lowerOrigin(const openvdb::Coord& leaf) { return leaf & ~(LowerNode::DIM - 1); }
+
+// The leaves at `origins` (ascending) in the tree's order, as indices into `origins`.
+std::vector<std::uint32_t> treeOrder(const std::vector<openvdb::Coord>& origins) {
+  std::vector<std::uint32_t> order(origins.size());
+  for (std::size_t l = 0; l < order.size(); ++l) order[l] = static_cast<std::uint32_t>(l);
+  // Stable: leaves of one internal node keep their Coord order.
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const openvdb::Coord &p = origins[a], &q = origins[b];
+    if (topOrigin(p) != topOrigin(q)) return topOrigin(p) < topOrigin(q);
+    return lowerOrigin(p) < lowerOrigin(q);
+  });
+  return order;
+}
+
+// The first leaf of each range, and the end: a pure function of the leaves, not of the threads.
+std::vector<std::size_t> leafRanges(const Leaves& all) {
   std::vector<std::size_t> starts{0};
   std::size_t points = 0;
-  for (std::size_t l = 0; l < leaves.size(); ++l) {
-    points += leaves[l]->pointCount();
+  for (std::size_t l = 0; l < all.size(); ++l) {
+    points += all.points(l);
     if (points >= kRangePoints || l + 1 - starts.back() >= kRangeLeaves) {
       starts.push_back(l + 1);
       points = 0;
     }
   }
-  if (starts.back() != leaves.size()) starts.push_back(leaves.size());
+  if (starts.back() != all.size()) starts.push_back(all.size());
   return starts;
 }
 
@@ -295,13 +324,13 @@ class LeafStream {
   std::ostream out_;
 };
 
-// ---- placeholder arrays -----------------------------------------------------------------------
+// ---- the arrays' records ---------------------------------------------------------------------
 //
 // TypedAttributeArray::writeMetadata() (points/AttributeArray.h, OpenVDB 10) writes, for an array
 // in memory and not transient: its byte count (uint64: 2 + 4 + the array's bytes, for flags and
 // size; a paged array's bytes are never compressed here), flags (uint8), serialization flags
 // (uint8), size (uint32), and the stride (uint32) only where it is not 1. Only the byte count and
-// the size depend on the point count: a placeholder's record is leaf 0's expanded array's with
+// the size depend on the point count: a leaf's record is the sample's expanded array's with
 // those two set to the leaf's.
 constexpr std::size_t kMetadataBytesAt = 0, kMetadataSizeAt = 10, kMetadataLength = 14;
 
@@ -309,11 +338,10 @@ std::uint64_t metadataByteCount(std::size_t points, std::size_t storage) {
   return sizeof(openvdb::Int16) + sizeof(openvdb::Index) + points * storage;
 }
 
-// Attribute a's record for leaf 0, written by OpenVDB for a copy of leaf 0's array expanded.
+// Attribute a's record for the sample, written by OpenVDB for a copy of its array expanded.
 std::string metadataTemplate(const Leaves& all, std::size_t a,
                              const openvdb::io::StreamMetadata& metadata) {
-  const vdbp::AttributeArray& placeholder = *all.leaf.front()->attributeSet().getConst(a);
-  const vdbp::AttributeArray::Ptr expanded = placeholder.copy();
+  const vdbp::AttributeArray::Ptr expanded = all.attributes().getConst(a)->copy();
   expanded->expand(/*fill=*/true);
   std::stringbuf text;
   {
@@ -327,8 +355,8 @@ std::string metadataTemplate(const Leaves& all, std::size_t a,
     std::memcpy(&bytes, record.data() + kMetadataBytesAt, sizeof bytes);
     std::memcpy(&size, record.data() + kMetadataSizeAt, sizeof size);
   }
-  if (record.size() != kMetadataLength || size != all.points(0) ||
-      bytes != metadataByteCount(all.points(0), all.storage[a])) {
+  if (record.size() != kMetadataLength || size != 1 ||
+      bytes != metadataByteCount(1, all.storage[a])) {
     throw std::logic_error("VDB points: an attribute's metadata is not laid out as foreseen");
   }
   return record;
@@ -366,14 +394,16 @@ constexpr std::size_t kVoxelOffsetBytes = Leaf::SIZE * sizeof(openvdb::PointData
 // compressed once. (Where pass a+2 kept them whole, OpenVDB's own call writes the size.)
 void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
                      const openvdb::io::StreamMetadata& metadata, bool toHalf, RangeBytes& range) {
-  const std::vector<const Leaf*>& leaves = all.leaf;
   MemorySink voxels((end - begin) * (kValueMaskBytes + 2 + 1024) + 4096);
   std::vector<std::uint16_t> sizes;
   {
     LeafStream stream(&voxels, metadata);
     for (std::size_t l = begin; l < end; ++l) {
       const std::size_t at = voxels.size();
-      static_cast<const Leaf::BaseLeaf&>(*leaves[l]).writeBuffers(stream.out(), toHalf);
+      // LeafNode::writeBuffers(), the leaf's part of the pass.
+      all.mask(l).save(stream.out());
+      openvdb::io::writeCompressedValues(stream.out(), all.voxelEnds(l), Leaf::SIZE, all.mask(l),
+                                         Leaf::NodeMaskType(), toHalf);
       std::uint16_t size = 0;
       if (voxels.size() >= at + kValueMaskBytes + sizeof size)
         std::memcpy(&size, voxels.data() + at + kValueMaskBytes, sizeof size);
@@ -391,15 +421,14 @@ void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
     if (size != kUncompressed)
       out.write(reinterpret_cast<const char*>(&size), sizeof size);
     else
-      openvdb::io::writeCompressedValuesSize(out, leaves[l]->buffer().data(), Leaf::SIZE);
+      openvdb::io::writeCompressedValuesSize(out, all.voxelEnds(l), Leaf::SIZE);
   }
   range.ends[0] = range.sink->size();
   for (std::size_t l = begin; l < end; ++l) {
-    const vdbp::AttributeSet& set = leaves[l]->attributeSet();
     if (l == 0) {
       const std::uint8_t shared = 1;  // one descriptor for every leaf, written with the first
       out.write(reinterpret_cast<const char*>(&shared), sizeof shared);
-      set.writeDescriptor(out, /*outputTransient=*/false);
+      all.attributes().writeDescriptor(out, /*outputTransient=*/false);
     }
     for (std::size_t a = 0; a < all.metadata.size(); ++a) writeArrayMetadata(all, l, a, out);
   }
@@ -410,7 +439,7 @@ void encodeLeafRange(const Leaves& all, std::size_t begin, std::size_t end,
 }
 
 // What AttributeArray::writeBuffers() writes without blosc (points/AttributeArray.h) for leaf
-// l's array of attribute a expanded (a placeholder stands for an array neither uniform nor
+// l's array of attribute a expanded (the sample's array, expanded, is neither uniform nor
 // transient): a flag byte (0: not compressed) and the values.
 std::size_t unpagedBytes(const Leaves& all, std::size_t l, std::size_t a) {
   return 1 + all.arrayBytes(l, a);
@@ -505,9 +534,6 @@ void encodePage(const Leaves& all, Page& page) {
   }
 }
 
-// A leaf without arrays: a default attribute set (encodePointsFile's `values`).
-bool isPlaceholderless(const Leaf& leaf) { return leaf.attributeSet().size() == 0; }
-
 // A stretch of the file: bytes made already (`data`), or when `data` is null the unpaged arrays
 // of attribute `attribute` of leaves [begin, end), `size` bytes, to be written into place.
 struct Part {
@@ -580,48 +606,37 @@ class DeferredBuffers final : public EncodedPointsFile::Deferred {
   std::vector<std::size_t> offsets_;
 };
 
-// The placeholders' sizes and metadata records (encodePointsFile's `values`).
-void describePlaceholders(Leaves& all, const openvdb::io::StreamMetadata& metadata) {
-  for (const Leaf* leaf : all.leaf) all.count.push_back(leaf->pointCount());
-  const vdbp::AttributeSet& set = all.leaf.front()->attributeSet();
+// The arrays' sizes and metadata records, from the sample (PointLeaves::sample).
+void describeArrays(Leaves& all, const openvdb::io::StreamMetadata& metadata) {
+  const vdbp::AttributeSet& set = all.attributes();
   for (std::size_t a = 0; a < set.size(); ++a) {
     const vdbp::AttributeArray& array = *set.getConst(a);
     if (array.stride() != 1 || !array.hasConstantStride())
-      throw std::logic_error("VDB points: a placeholder array with a stride");
+      throw std::logic_error("VDB points: a sample array with a stride");
+    if (!array.isUniform() || array.isTransient() || array.size() != 1 || !array.isDataLoaded())
+      throw std::logic_error("VDB points: a sample array not uniform and of one point");
     all.storage.push_back(array.storageTypeSize());
-  }
-  for (std::size_t a = 0; a < set.size(); ++a) {
-    const vdbp::AttributeArray& array = *set.getConst(a);
-    if (!array.isUniform() || array.isTransient() || array.size() != all.points(0) ||
-        !array.isDataLoaded())
-      throw std::logic_error("VDB points: an array is not a placeholder of its leaf's points");
-  }
-  for (std::size_t l = 1; l < all.size(); ++l) {
-    if (!isPlaceholderless(*all.leaf[l]))
-      throw std::logic_error("VDB points: a leaf past the first with arrays of its own");
   }
   for (std::size_t a = 0; a < set.size(); ++a)
     all.metadata.push_back(metadataTemplate(all, a, metadata));
 }
 
-// What Grid<PointDataTree>::writeBuffers() writes for `tree` after the pass count, encoded in
+// What Grid<PointDataTree>::writeBuffers() writes for `leaves` after the pass count, encoded in
 // parallel with the stream metadata `metadata` but for the parts left to fill() (DeferredBuffers);
-// or null when the tree has no leaf (two bytes that OpenVDB writes as fast). The tree's arrays
-// are placeholders of `values` (encodePointsFile): a tree with other arrays throws.
-std::unique_ptr<DeferredBuffers> encodeBuffers(const vdbp::PointDataTree& tree, bool toHalf,
+// null where there is no leaf (two bytes that OpenVDB writes as fast).
+std::unique_ptr<DeferredBuffers> encodeBuffers(const PointLeaves& leaves, bool toHalf,
                                                const PointValues& values,
                                                const openvdb::io::StreamMetadata::Ptr& metadata) {
+  if (leaves.size() == 0) return nullptr;
   Leaves all;
+  all.leaves = &leaves;
+  all.order = treeOrder(leaves.origins);
   all.values = &values;
-  std::vector<const Leaf*>& leaves = all.leaf;
-  leaves.reserve(tree.leafCount());
-  for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
-  if (leaves.empty()) return nullptr;
-  describePlaceholders(all, *metadata);
+  describeArrays(all, *metadata);
 
-  const std::size_t attributes = leaves.front()->attributeSet().size();
+  const std::size_t attributes = all.attributes().size();
   const bool paged = (metadata->compression() & openvdb::io::COMPRESS_BLOSC) != 0;
-  const std::vector<std::size_t> starts = leafRanges(leaves);
+  const std::vector<std::size_t> starts = leafRanges(all);
   const std::size_t ranges = starts.size() - 1;
   std::vector<RangeBytes> rangeBytes(ranges);
   std::vector<std::vector<Page>> pages(paged ? attributes : 0);
@@ -673,6 +688,10 @@ std::unique_ptr<DeferredBuffers> encodeBuffers(const vdbp::PointDataTree& tree, 
                                            std::move(parts));
 }
 
+// The background value of every points tree written here, where the topology's writer points
+// the stream (RootNode::writeTopology()): the leaves' and internal nodes' compression reads it.
+const openvdb::PointDataIndex32 kBackground{0};
+
 // encodeBuffers() begun ahead, on another thread, while this one goes on: Archive::write() has
 // set the stream's metadata for the grid by the time it makes the grid's statistics
 // (ParallelBuffersGrid::copyGrid()), and then writes the header and topology on this thread
@@ -691,17 +710,16 @@ class BuffersAhead {
   BuffersAhead& operator=(const BuffersAhead&) = delete;
 
   // Begins encodeBuffers() with the stream's metadata as it is now; once only.
-  void start(const vdbp::PointDataTree& tree, bool toHalf, const PointValues& values) {
+  void start(const PointLeaves& leaves, bool toHalf, const PointValues& values) {
     const openvdb::io::StreamMetadata::Ptr now = openvdb::io::getStreamMetadataPtr(os_);
     if (started_ || !now) return;
     started_ = true;
     metadata_ = std::make_shared<openvdb::io::StreamMetadata>(*now);
-    // The topology's writer (RootNode::writeTopology()) points the stream at the tree's
-    // background value, which the leaves' compression reads.
-    metadata_->setBackgroundPtr(&tree.background());
+    // As the topology's writer will have set it (writeTopology()).
+    metadata_->setBackgroundPtr(&kBackground);
     madeFor_ = metadata_->str();
-    group_.run([this, &tree, toHalf, &values] {
-      buffers_ = encodeBuffers(tree, toHalf, values, metadata_);
+    group_.run([this, &leaves, toHalf, &values] {
+      buffers_ = encodeBuffers(leaves, toHalf, values, metadata_);
     });
   }
   // What start() made, once made (an exception it threw is thrown here), when it was made with
@@ -727,39 +745,36 @@ class BuffersAhead {
   std::unique_ptr<DeferredBuffers> buffers_;
 };
 
-// Writes what Grid<PointDataTree>::writeBuffers(os) writes for `tree`, encoded in parallel but
-// for the parts left to `deferred` (DeferredBuffers: `os` skips their bytes), and returns true;
-// or writes nothing and returns false when the tree has no leaf. The buffers are those `ahead`
-// made, where it made them for this stream.
-bool writeBuffersInParallel(const vdbp::PointDataTree& tree, bool toHalf, const PointValues& values,
+// Writes what Grid<PointDataTree>::writeBuffers(os) writes for `leaves`, encoded in parallel but
+// for the parts left to `deferred` (DeferredBuffers: `os` skips their bytes). The buffers are
+// those `ahead` made, where it made them for this stream. At least one leaf.
+void writeBuffersInParallel(const PointLeaves& leaves, bool toHalf, const PointValues& values,
                             std::ostream& os, BuffersAhead* ahead,
                             std::unique_ptr<EncodedPointsFile::Deferred>& deferred) {
   auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
   const openvdb::io::StreamMetadata::Ptr metadata = openvdb::io::getStreamMetadataPtr(os);
   std::unique_ptr<DeferredBuffers> buffers =
       ahead != nullptr && metadata ? ahead->take(*metadata) : nullptr;
-  if (!tree.cbeginLeaf()) return false;
-  if (sink == nullptr)
-    throw std::logic_error("VDB points: placeholder arrays that cannot be encoded in parallel");
+  if (sink == nullptr) throw std::logic_error("VDB points: leaves written to a stream not ours");
   if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
-  if (!buffers) buffers = encodeBuffers(tree, toHalf, values, metadata);  // (not null: leaves)
-  const auto passes = static_cast<std::uint16_t>(tree.cbeginLeaf()->buffers());
+  if (!buffers) buffers = encodeBuffers(leaves, toHalf, values, metadata);  // (not null: leaves)
+  const auto passes = static_cast<std::uint16_t>(leaves.sample->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
   sink->skip(buffers->size());
   deferred = std::move(buffers);
-  return true;
 }
 
-// The bounding box of the tree's active voxels, as Tree::evalActiveVoxelBoundingBox() finds it
+// ---- the topology and the statistics ----------------------------------------------------------
+
+// The bounding box of the leaves' active voxels, as Tree::evalActiveVoxelBoundingBox() finds it
 // for a points tree (no active tiles, and a leaf only where some voxel holds points), from each
 // leaf's mask words: word x of a leaf's mask holds its voxels (x, y, z) at bit 8y + z
-// (LeafNode::coordToOffset()). OpenVDB visits each active voxel, a sixth of the serial part of
-// writing a frame of 10⁶ points (0.58 ms against 0.14). Empty for a tree without active voxels.
-openvdb::CoordBBox activeVoxelBox(const vdbp::PointDataTree& tree) {
+// (LeafNode::coordToOffset()). OpenVDB visits each active voxel.
+openvdb::CoordBBox activeVoxelBox(const PointLeaves& leaves) {
   static_assert(Leaf::NodeMaskType::WORD_COUNT == Leaf::DIM && Leaf::DIM * Leaf::DIM == 64);
   openvdb::CoordBBox box;
-  for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
-    const Leaf::NodeMaskType& mask = leaf->getValueMask();
+  for (std::size_t l = 0; l < leaves.size(); ++l) {
+    const Leaf::NodeMaskType& mask = leaves.masks[l];
     std::uint64_t any = 0;  // the (y, z) that some x holds
     int firstX = -1, lastX = -1;
     for (openvdb::Index x = 0; x < Leaf::DIM; ++x) {
@@ -778,85 +793,183 @@ openvdb::CoordBBox activeVoxelBox(const vdbp::PointDataTree& tree) {
     }
     const auto low = [](unsigned bits) { return std::countr_zero(bits); };
     const auto high = [](unsigned bits) { return std::bit_width(bits) - 1; };
-    box.expand(leaf->origin() + openvdb::Coord(firstX, low(ys), low(zs)));
-    box.expand(leaf->origin() + openvdb::Coord(lastX, high(ys), high(zs)));
+    box.expand(leaves.origins[l] + openvdb::Coord(firstX, low(ys), low(zs)));
+    box.expand(leaves.origins[l] + openvdb::Coord(lastX, high(ys), high(zs)));
   }
   return box;
 }
 
-// The grid as Archive::write() sees it: the same tree, metadata and transform (a shallow copy),
-// its leaves' buffers written by writeBuffersInParallel(). Archive::write() calls the virtual
-// GridBase::writeBuffers() between the topology and the grid's end offset, which it then patches
-// into the grid's descriptor itself.
-// Its arrays being placeholders (`values`), memUsage() is what the grid would use with its arrays
-// expanded, and so is that of the shallow copy Archive::write() makes to record it in the file
-// (file_mem_bytes). That copy (copyGrid() const, the one Archive::write() calls) starts `ahead`.
-// A GridBase of its own that forwards to the grid, not a subclass of PointDataGrid: a subclass
-// would instantiate every virtual member of Grid<PointDataTree> and Tree<PointDataTree> here,
-// where the forwarded calls run libopenvdb's (fields/vdb/RegisteredGrid.h says what that costs).
-// What Archive::write() does not call on a grid it writes (reading, changing the tree) is refused.
+// The active voxels, as Tree::activeVoxelCount() counts them.
+openvdb::Index64 activeVoxelCount(const PointLeaves& leaves) {
+  openvdb::Index64 count = 0;
+  for (const Leaf::NodeMaskType& mask : leaves.masks) count += mask.countOn();
+  return count;
+}
+
+// What tools::memUsage() (Tree::memUsage()) counts for the tree of `leaves` (OpenVDB 10,
+// tools/Count.h's MemUsageOp): the tree and its root node, each internal node's values and
+// masks and origin, and each leaf's memUsage(): the sample's with its arrays expanded, each
+// array's values a point more or fewer by its storage.
+openvdb::Index64 memUsage(const PointLeaves& leaves, const std::vector<std::uint32_t>& order) {
+  const auto nodeBytes = []<typename Node>(std::type_identity<Node>) {
+    return openvdb::Index64{Node::NUM_VALUES * sizeof(typename Node::UnionType)} +
+           2 * typename Node::NodeMaskType().memUsage() + sizeof(openvdb::Coord);
+  };
+  openvdb::Index64 bytes = sizeof(vdbp::PointDataTree) + sizeof(vdbp::PointDataTree::RootNodeType);
+  const vdbp::AttributeSet& set = leaves.sample->attributeSet();
+  openvdb::Index64 perPoint = 0;
+  for (std::size_t a = 0; a < set.size(); ++a) perPoint += set.getConst(a)->storageTypeSize();
+  const openvdb::Index64 sample = leaves.sample->memUsage();
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const openvdb::Coord& origin = leaves.origins[order[k]];
+    const bool newLower =
+        k == 0 || lowerOrigin(origin) != lowerOrigin(leaves.origins[order[k - 1]]);
+    const bool newTop = k == 0 || topOrigin(origin) != topOrigin(leaves.origins[order[k - 1]]);
+    if (newTop) bytes += nodeBytes(std::type_identity<TopNode>());
+    if (newLower) bytes += nodeBytes(std::type_identity<LowerNode>());
+    bytes += sample + (leaves.counts[order[k]] - 1) * perPoint;
+  }
+  return bytes;
+}
+
+// What an internal node of type Node writes of its values (InternalNode::writeTopology()), the
+// same for every internal node of a points tree: all its values the background, none active,
+// so OpenVDB's compression of them (io::writeCompressedValues()) depends on neither its child
+// mask nor anything else of it. Made once a frame with the stream's own settings.
+template <typename Node>
+std::string internalValues(const openvdb::io::StreamMetadata& metadata, bool toHalf) {
+  std::stringbuf text;
+  {
+    LeafStream stream(&text, metadata);
+    std::vector<openvdb::PointDataIndex32> values(Node::NUM_VALUES, kBackground);
+    const typename Node::NodeMaskType none;
+    openvdb::io::writeCompressedValues(stream.out(), values.data(), Node::NUM_VALUES, none, none,
+                                       toHalf);
+    if (!stream.out()) throw std::runtime_error("cannot encode the VDB points' topology");
+  }
+  return text.str();
+}
+
+// What Tree<PointDataTree>::writeTopology() writes for `leaves` (OpenVDB 10: TreeBase's buffer
+// count, then RootNode's, InternalNode's and LeafNode's writeTopology()), in the tree's order:
+// the background value, no tile and the top nodes, each its origin, masks, values and children,
+// each leaf its value mask. Points the stream at the background, as RootNode's does.
+void writeTopology(std::ostream& os, const PointLeaves& leaves,
+                   const std::vector<std::uint32_t>& order, bool toHalf) {
+  const auto put = [&os](const auto& value) {
+    os.write(reinterpret_cast<const char*>(&value), sizeof value);
+  };
+  put(std::int32_t{1});
+  put(kBackground);  // (toHalf leaves an integer as it is)
+  openvdb::io::setGridBackgroundValuePtr(os, &kBackground);
+  const openvdb::io::StreamMetadata::Ptr metadata = openvdb::io::getStreamMetadataPtr(os);
+  if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
+  const std::string topValues = internalValues<TopNode>(*metadata, toHalf);
+  const std::string lowerValues = internalValues<LowerNode>(*metadata, toHalf);
+  std::vector<std::size_t> tops;  // where each top node's leaves begin in `order`, and the end
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    if (k == 0 || topOrigin(leaves.origins[order[k]]) != topOrigin(leaves.origins[order[k - 1]]))
+      tops.push_back(k);
+  }
+  tops.push_back(order.size());
+  put(openvdb::Index{0});                             // tiles
+  put(static_cast<openvdb::Index>(tops.size() - 1));  // children
+  // An internal node whose children hold the leaves order[begin, end): its masks and values.
+  const auto writeNode = [&]<typename Node>(std::type_identity<Node>, std::size_t begin,
+                                            std::size_t end, const std::string& values) {
+    typename Node::NodeMaskType children;
+    for (std::size_t k = begin; k < end; ++k)
+      children.setOn(Node::coordToOffset(leaves.origins[order[k]]));
+    children.save(os);
+    typename Node::NodeMaskType().save(os);  // no active tile
+    os.write(values.data(), static_cast<std::streamsize>(values.size()));
+  };
+  for (std::size_t t = 0; t + 1 < tops.size(); ++t) {
+    const openvdb::Coord top = topOrigin(leaves.origins[order[tops[t]]]);
+    os.write(reinterpret_cast<const char*>(top.asPointer()), 3 * sizeof(openvdb::Int32));
+    writeNode(std::type_identity<TopNode>(), tops[t], tops[t + 1], topValues);
+    for (std::size_t k = tops[t]; k < tops[t + 1];) {
+      std::size_t end = k + 1;
+      const openvdb::Coord lower = lowerOrigin(leaves.origins[order[k]]);
+      while (end < tops[t + 1] && lowerOrigin(leaves.origins[order[end]]) == lower) ++end;
+      writeNode(std::type_identity<LowerNode>(), k, end, lowerValues);
+      for (; k < end; ++k) leaves.masks[order[k]].save(os);
+    }
+  }
+}
+
+// The grid as Archive::write() sees it: the leaves' grid (encodePointsFile's `grid`, whose
+// metadata and transform it shares: a shallow copy) with the tree of `leaves`, which it writes
+// itself: its topology (writeTopology() above), its statistics and its leaves' buffers
+// (writeBuffersInParallel()). Archive::write() calls the virtual GridBase::writeTopology() and
+// writeBuffers() in turn, then patches the grid's end offset into its descriptor itself; the
+// statistics it records in the file (file_bbox_min/max, file_mem_bytes, file_voxel_count) come
+// from the shallow copy it makes (copyGrid() const, which starts `ahead`).
+// A GridBase of its own, not a PointDataGrid: a subclass would instantiate every virtual member
+// of Grid<PointDataTree> and Tree<PointDataTree> here (fields/vdb/RegisteredGrid.h says what that
+// costs). Without leaves, everything is the leaves' grid's own. What Archive::write() does not
+// call on a grid it writes (reading, changing the tree) is refused.
 class ParallelBuffersGrid final : public openvdb::GridBase {
  public:
-  ParallelBuffersGrid(vdbp::PointDataGrid& grid, const PointValues& values, BuffersAhead* ahead,
+  ParallelBuffersGrid(const vdbp::PointDataGrid& grid, const PointLeaves& leaves,
+                      const PointValues& values, BuffersAhead* ahead,
                       std::unique_ptr<EncodedPointsFile::Deferred>* deferred)
-      : openvdb::GridBase(grid, openvdb::ShallowCopy()),
+      : openvdb::GridBase(grid),  // (its metadata and transform; the transform is shared)
         grid_(&grid),
+        leaves_(&leaves),
         values_(&values),
         ahead_(ahead),
         deferred_(deferred) {
-    // Each leaf past the first lacks the first's attribute set but for its arrays' sizes; each
-    // array, expanded, holds its leaf's point count of values where a placeholder holds one.
-    auto leaf = grid.constTree().cbeginLeaf();
-    if (!leaf) return;
-    const vdbp::AttributeSet& set = leaf->attributeSet();
-    std::size_t bytesPerPoint = 0;
-    for (std::size_t a = 0; a < set.size(); ++a)
-      bytesPerPoint += set.getConst(a)->storageTypeSize();
-    const std::size_t setBytes = set.memUsage() - vdbp::AttributeSet().memUsage();
-    std::size_t leaves = 0;
-    for (; leaf; ++leaf, ++leaves) {
-      if (leaf->pointCount() > 0) expandedExtra_ += (leaf->pointCount() - 1) * bytesPerPoint;
-    }
-    expandedExtra_ += (leaves - 1) * setBytes;
+    if (!grid.constTree().empty())
+      throw std::logic_error("VDB points: the leaves' grid holds leaves of its own");
+    if (leaves.size() > 0) order_ = treeOrder(leaves.origins);
   }
-  // A shallow copy, with what stands for the placeholders.
-  ParallelBuffersGrid(ParallelBuffersGrid& grid, openvdb::ShallowCopy)
-      : openvdb::GridBase(grid, openvdb::ShallowCopy()),
+  // A shallow copy.
+  ParallelBuffersGrid(const ParallelBuffersGrid& grid, openvdb::ShallowCopy)
+      : openvdb::GridBase(grid),
         grid_(grid.grid_),
+        leaves_(grid.leaves_),
         values_(grid.values_),
         ahead_(grid.ahead_),
         deferred_(grid.deferred_),
-        expandedExtra_(grid.expandedExtra_) {}
+        order_(grid.order_) {}
 
-  void writeBuffers(std::ostream& os) const override {
-    if (!writeBuffersInParallel(grid_->constTree(), saveFloatAsHalf(), *values_, os, ahead_,
-                                *deferred_))
-      base().writeBuffers(os);
+  void writeTopology(std::ostream& os) const override {
+    if (!hasLeaves()) return base().writeTopology(os);
+    tickfx::io::writeTopology(os, *leaves_, order_, saveFloatAsHalf());
   }
-  openvdb::Index64 memUsage() const override { return base().memUsage() + expandedExtra_; }
+  void writeBuffers(std::ostream& os) const override {
+    if (!hasLeaves()) return base().writeBuffers(os);
+    writeBuffersInParallel(*leaves_, saveFloatAsHalf(), *values_, os, ahead_, *deferred_);
+  }
+  openvdb::Index64 memUsage() const override {
+    return hasLeaves() ? tickfx::io::memUsage(*leaves_, order_) : base().memUsage();
+  }
+  openvdb::Index64 activeVoxelCount() const override {
+    return hasLeaves() ? tickfx::io::activeVoxelCount(*leaves_) : base().activeVoxelCount();
+  }
+  openvdb::CoordBBox evalActiveVoxelBoundingBox() const override {
+    return hasLeaves() ? activeVoxelBox(*leaves_) : base().evalActiveVoxelBoundingBox();
+  }
+  openvdb::Coord evalActiveVoxelDim() const override {
+    return hasLeaves() ? activeVoxelBox(*leaves_).dim() : base().evalActiveVoxelDim();
+  }
+  bool empty() const override { return !hasLeaves(); }
   openvdb::GridBase::Ptr copyGrid() override {
     return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
   }
   openvdb::GridBase::ConstPtr copyGrid() const override {
-    if (ahead_ != nullptr) ahead_->start(grid_->constTree(), saveFloatAsHalf(), *values_);
-    return std::make_shared<ParallelBuffersGrid>(const_cast<ParallelBuffersGrid&>(*this),
-                                                 openvdb::ShallowCopy());
+    if (ahead_ != nullptr && hasLeaves()) ahead_->start(*leaves_, saveFloatAsHalf(), *values_);
+    return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
   }
 
-  // The grid's own, through its virtual members.
+  // The leaves' grid's own, through its virtual members.
   openvdb::Name type() const override { return base().type(); }
   openvdb::Name valueType() const override { return base().valueType(); }
   openvdb::TreeBase::ConstPtr constBaseTreePtr() const override {
     return base().constBaseTreePtr();
   }
   bool isTreeUnique() const override { return base().isTreeUnique(); }
-  bool empty() const override { return base().empty(); }
-  openvdb::Index64 activeVoxelCount() const override { return base().activeVoxelCount(); }
-  openvdb::CoordBBox evalActiveVoxelBoundingBox() const override {
-    return activeVoxelBox(grid_->constTree());
-  }
-  openvdb::Coord evalActiveVoxelDim() const override { return base().evalActiveVoxelDim(); }
-  void writeTopology(std::ostream& os) const override { base().writeTopology(os); }
   void print(std::ostream& os, int verboseLevel) const override { base().print(os, verboseLevel); }
 
   // Not for a grid being written.
@@ -885,15 +998,17 @@ class ParallelBuffersGrid final : public openvdb::GridBase {
 
  private:
   const openvdb::GridBase& base() const { return *grid_; }
+  bool hasLeaves() const { return leaves_->size() > 0; }
   [[noreturn]] static void refuse() {
     throw std::logic_error("VDB points: a grid being written was asked to change or copy");
   }
 
-  vdbp::PointDataGrid* grid_;            // (never null; outlives the write)
+  const vdbp::PointDataGrid* grid_;      // (never null; outlives the write)
+  const PointLeaves* leaves_;            // (never null)
   const PointValues* values_ = nullptr;  // (never null)
   BuffersAhead* ahead_ = nullptr;
   std::unique_ptr<EncodedPointsFile::Deferred>* deferred_;  // where writeBuffers() leaves them
-  openvdb::Index64 expandedExtra_ = 0;
+  std::vector<std::uint32_t> order_;  // the leaves in the tree's order (treeOrder())
 };
 
 // Archive::write(), protected in OpenVDB, with File::write()'s seekable stream.
@@ -1015,14 +1130,15 @@ void EncodedPointsFile::write(std::ostream& out) const {
   ahead.wait();
 }
 
-EncodedPointsFile encodePointsFile(vdbp::PointDataGrid& grid, std::uint32_t compression,
-                                   const PointValues& values, std::size_t expectedBytes) {
+EncodedPointsFile encodePointsFile(const vdbp::PointDataGrid& grid, const PointLeaves& leaves,
+                                   std::uint32_t compression, const PointValues& values,
+                                   std::size_t expectedBytes) {
   std::unique_ptr<EncodedPointsFile::Deferred> deferred;
   MemorySink sink(expectedBytes);
   std::ostream os(&sink);
   BuffersAhead ahead(os);
   const openvdb::GridCPtrVec grids{
-      std::make_shared<const ParallelBuffersGrid>(grid, values, &ahead, &deferred)};
+      std::make_shared<const ParallelBuffersGrid>(grid, leaves, values, &ahead, &deferred)};
   PointsArchive(compression).writeSeekable(os, grids);
   if (!os) throw std::runtime_error("cannot encode the VDB points grid");
   const std::size_t at = deferred ? sink.gapAt() : sink.held();

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 namespace tickfx::io {
 
@@ -70,6 +71,28 @@ LargeArray<T> allocateLargeArray(std::size_t n) {
   return LargeArray<T>(reinterpret_cast<T*>(FileBytes::allocate(n * sizeof(T)).release()));
 }
 
+/// A points grid's leaves as encodePointsFile() writes them, in place of a tree of
+/// PointDataLeafNodes (whose making, adding and freeing took some 4 ms of a thread at 10⁶
+/// points, for a tree written once): what each leaf would hold but its arrays, whose values a
+/// PointValues stores.
+struct PointLeaves {
+  using Leaf = openvdb::points::PointDataTree::LeafNodeType;
+  /// Each leaf's origin (each axis a multiple of Leaf::DIM), each once, in ascending Coord order.
+  std::vector<openvdb::Coord> origins;
+  /// Each leaf's point count, at least 1.
+  std::vector<std::size_t> counts;
+  /// Each leaf's active voxels: those that hold points.
+  std::vector<Leaf::NodeMaskType> masks;
+  /// Each leaf's Leaf::SIZE voxel values, leaf after leaf: the end of each voxel's points in the
+  /// leaf's arrays (PointDataLeafNode's offsets).
+  LargeArray<openvdb::PointDataIndex32> voxelEnds;
+  /// A leaf whose attribute set is every leaf's: one point, each array uniform and of stride 1.
+  /// Each leaf's arrays are these expanded to its point count.
+  std::unique_ptr<Leaf> sample;
+
+  std::size_t size() const { return origins.size(); }
+};
+
 /// A .vdb file encoded in memory but for its largest part, the attribute arrays' values without
 /// blosc: those are stored as the file is written, a chunk at a time on every thread, while the
 /// chunk made before goes to the kernel; the rest of the leaves' buffers (voxel offsets, the
@@ -117,28 +140,26 @@ class EncodedPointsFile {
   std::unique_ptr<Deferred> deferred_;
 };
 
-/// What openvdb::io::File::write() writes for `grid` alone (its name unique, no file metadata)
-/// with `compression` (openvdb::io::COMPRESS_* flags), to be made as it is written: the bytes of
-/// io::Archive::write(os, {grid}, seekable = true), every one of them but the header's UUID, which
-/// OpenVDB draws at random each time. (File writes through its own std::ofstream and ignores its
-/// failures, so a full disk left a truncated .vdb under the frame's name and the run went on:
-/// writeVdbPointCache writes these bytes with writeFileAtomically instead.)
-/// OpenVDB writes the header, the grid's descriptor (and the offsets it patches in), its
-/// metadata, transform and topology, as ever, into memory; the rest of the leaves' buffers (voxel
-/// offsets, the arrays' records, blosc's pages) are made by OpenVDB's own leaf and attribute
-/// writers on every thread (TBB), leaf range by leaf range and page by page, begun on other
-/// threads while this one writes the header and topology; the arrays' values without blosc,
-/// nearly all of the file, are stored as the file is written (EncodedPointsFile). The bytes do
-/// not depend on the thread count. A grid without a leaf is written by OpenVDB alone, to the same
-/// bytes.
-/// The grid's arrays are placeholders of `values`: the first leaf's arrays uniform, of the leaf's
-/// point count, stride 1, in memory, and every other leaf without arrays (a default attribute
-/// set: it stands for the first leaf's set with its own point count). The file is the one the
-/// grid would give with every leaf holding the first's attributes, each array expanded to hold
-/// the values `values` stores (its metadata, the file's memory statistics and the arrays' bytes).
-/// A grid with other arrays throws std::logic_error. `expectedBytes`: the room reserved for the
-/// header, metadata and topology. `grid` and `values` must outlive the result.
-EncodedPointsFile encodePointsFile(openvdb::points::PointDataGrid& grid, std::uint32_t compression,
+/// What openvdb::io::File::write() writes for a PointDataGrid alone (its name unique, no file
+/// metadata) with `compression` (openvdb::io::COMPRESS_* flags), to be made as it is written: the
+/// bytes of io::Archive::write(os, {grid}, seekable = true), every one of them but the header's
+/// UUID, which OpenVDB draws at random each time. (File writes through its own std::ofstream and
+/// ignores its failures, so a full disk left a truncated .vdb under the frame's name and the run
+/// went on: writeVdbPointCache writes these bytes with writeFileAtomically instead.)
+/// The grid is `grid`, which holds no leaf (its name, metadata and transform), with the leaves
+/// `leaves`, each holding the sample's attributes expanded to its point count, with the values
+/// `values` stores. OpenVDB writes the header, the grid's descriptor (and the offsets it patches
+/// in), its metadata and transform into memory, as ever; the topology, the file's statistics
+/// and the leaves' buffers (voxel offsets, the arrays' records, blosc's pages) are made here, by
+/// OpenVDB's own calls for each node, leaf, array and page, on every thread (TBB), leaf range by
+/// leaf range and page by page, begun while the header is written; the arrays' values without
+/// blosc, nearly all of the file, are stored as the file is written (EncodedPointsFile). The
+/// bytes do not depend on the thread count. Without leaves, OpenVDB writes the grid alone, to
+/// the same bytes. A sample whose arrays are not uniform, of one point and stride 1 throws
+/// std::logic_error. `expectedBytes`: the room reserved for the header, metadata and topology.
+/// `grid`, `leaves` and `values` must outlive the result.
+EncodedPointsFile encodePointsFile(const openvdb::points::PointDataGrid& grid,
+                                   const PointLeaves& leaves, std::uint32_t compression,
                                    const PointValues& values, std::size_t expectedBytes = 1 << 20);
 
 /// The same bytes made by io::Archive::write() alone, on one thread, into a std::ostringstream:
