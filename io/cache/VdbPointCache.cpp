@@ -169,33 +169,12 @@ vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<GridAttribu
   return descriptor;
 }
 
-// Leaf l's voxel values, each the end of its voxel's points in the leaf's arrays, and its
-// value mask, on where a voxel holds points: what setOffsets(ends, /*updateValueMask=*/true)
-// sets, without its two calls a voxel.
-void voxelEnds(const GroupedPoints& points, std::size_t l, openvdb::PointDataIndex32* ends,
-               Leaf::NodeMaskType& mask) {
-  std::array<openvdb::Index32, Leaf::SIZE> counts{};
-  const auto [begin, end] = points.leafPoints(l);
-  for (std::size_t k = begin; k < end; ++k) ++counts[points.voxel[k]];
-  mask.setOff();
-  openvdb::Index32 sum = 0;
-  for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
-    std::uint64_t word = 0;
-    for (openvdb::Index b = 0; b < 64; ++b) {
-      const openvdb::Index32 count = counts[64 * w + b];
-      word |= std::uint64_t{count > 0} << b;
-      ends[64 * w + b] = sum += count;
-    }
-    mask.template getWord<std::uint64_t>(w) = word;
-  }
-}
-
 // Leaf l with its voxel values, and its default attribute set.
 std::unique_ptr<Leaf> makeEmptyLeaf(const GroupedPoints& points, std::size_t l) {
   auto leaf = std::make_unique<Leaf>(points.origins[l]);
-  Leaf::NodeMaskType mask;
-  voxelEnds(points, l, leaf->buffer().data(), mask);
-  leaf->setValueMask(mask);
+  std::memcpy(leaf->buffer().data(), points.voxelEnds.get() + l * Leaf::SIZE,
+              Leaf::SIZE * sizeof(openvdb::PointDataIndex32));
+  leaf->setValueMask(points.masks[l]);
   return leaf;
 }
 
@@ -426,24 +405,18 @@ GroupedPoints groupedPoints(const FrameData& frame, Grouping grouping) {
   return groupPoints<kQuantised>(frame, grouping);
 }
 
-// The leaves of `points` for encodePointsFile, their attributes those of `descriptor`: made in
-// parallel, leaf by leaf.
-PointLeaves pointLeaves(const GroupedPoints& points,
+// The leaves of `points` for encodePointsFile, their attributes those of `descriptor`; their voxel
+// ends and masks are moved from `points`.
+PointLeaves pointLeaves(GroupedPoints& points,
                         const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
   PointLeaves leaves;
-  const std::size_t n = points.origins.size();
   leaves.origins = points.origins;
-  leaves.counts.resize(n);
-  leaves.masks.resize(n);
-  leaves.voxelEnds = allocateLargeArray<openvdb::PointDataIndex32>(n * Leaf::SIZE);
-  par::parallel_for(
-      tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t l = range.begin(); l < range.end(); ++l) {
-          const auto [begin, end] = points.leafPoints(l);
-          leaves.counts[l] = end - begin;
-          voxelEnds(points, l, leaves.voxelEnds.get() + l * Leaf::SIZE, leaves.masks[l]);
-        }
-      });
+  for (std::size_t l = 0; l < points.origins.size(); ++l) {
+    const auto [begin, end] = points.leafPoints(l);
+    leaves.counts.push_back(end - begin);
+  }
+  leaves.masks = std::move(points.masks);
+  leaves.voxelEnds = std::move(points.voxelEnds);
   leaves.sample = std::make_unique<Leaf>(openvdb::Coord(0));
   leaves.sample->replaceAttributeSet(new vdbp::AttributeSet(descriptor, 1),
                                      /*allowMismatchingDescriptors=*/true);

@@ -336,6 +336,33 @@ std::vector<const float*> pointFloatColumns(const FrameData& frame) {
   return columns;
 }
 
+// Room for each leaf's voxel ends and mask.
+void allocateVoxelEnds(GroupedPoints& points) {
+  points.voxelEnds =
+      allocateLargeArray<openvdb::PointDataIndex32>(points.origins.size() * Leaf::SIZE);
+  points.masks.resize(points.origins.size());
+}
+
+// Leaf l's voxel ends and mask, from each of its voxels' end in some run of points where the
+// leaf's begin at `leafBegin`: what setOffsets(ends, /*updateValueMask=*/true) sets on a leaf,
+// without its two calls a voxel.
+void setVoxelEnds(GroupedPoints& points, std::size_t l, const std::uint32_t* end,
+                  std::uint32_t leafBegin) {
+  openvdb::PointDataIndex32* const ends = points.voxelEnds.get() + l * Leaf::SIZE;
+  Leaf::NodeMaskType& mask = points.masks[l];
+  std::uint32_t previous = leafBegin;
+  for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
+    std::uint64_t word = 0;
+    for (openvdb::Index b = 0; b < 64; ++b) {
+      const std::uint32_t e = end[64 * w + b];
+      word |= std::uint64_t{e != previous} << b;
+      ends[64 * w + b] = e - leafBegin;
+      previous = e;
+    }
+    mask.template getWord<std::uint64_t>(w) = word;
+  }
+}
+
 // The general way: every point's slot, sorted by (leaf, voxel, row).
 template <bool Quantised>
 GroupedPoints sortedPoints(const FrameData& frame) {
@@ -348,7 +375,6 @@ GroupedPoints sortedPoints(const FrameData& frame) {
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t k = range.begin(); k < range.end(); ++k) {
                         const std::size_t r = slots[k].row;
-                        points.voxel[k] = static_cast<std::uint16_t>(slots[k].voxel);
                         positions.voxel<Quantised>(r, &points.offset[k]);
                         points.id[k] = frame.id[r];
                         for (std::size_t j = 0; j < source.size(); ++j)
@@ -362,6 +388,18 @@ GroupedPoints sortedPoints(const FrameData& frame) {
     }
   }
   points.starts.push_back(slots.size());
+  allocateVoxelEnds(points);
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.origins.size()),
+                    [&](const tbb::blocked_range<std::size_t>& leaves) {
+                      for (std::size_t l = leaves.begin(); l < leaves.end(); ++l) {
+                        std::array<std::uint32_t, Leaf::SIZE> counts{};
+                        for (std::size_t k = points.starts[l]; k < points.starts[l + 1]; ++k)
+                          ++counts[slots[k].voxel];
+                        std::uint32_t sum = 0;
+                        for (std::uint32_t& c : counts) c = sum += c;  // each voxel's end
+                        setVoxelEnds(points, l, counts.data(), 0);
+                      }
+                    });
   return points;
 }
 
@@ -494,24 +532,28 @@ void permute(T* __restrict column, const std::uint32_t* __restrict rank, std::si
   for (std::size_t i = 0; i < count; ++i) column[rank[i]] = copy[i];
 }
 
-// Puts bucket b's points, in row order and with a voxel column that holds
-// each point's key (its leaf's place in the bucket, then its voxel), in order by key, rows in
-// order among equal keys (a counting sort): the voxel column then holds each point's voxel, and
-// the offsets are moved alike. Each point's place is kept in `rank` for the columns the store
-// puts in order later (orderLater()).
-void orderBucket(GroupedPoints& points, std::size_t b, BucketScratch& scratch) {
+// Puts bucket b's points, in row order, in order by their keys (`keys`, each its leaf's place in
+// the bucket, then its voxel), rows in order among equal keys (a counting sort): its offsets are
+// moved, and each point's place is kept in `rank` for the columns the store puts in order later
+// (orderLater()). Each leaf's voxel ends and mask come from the sort's counts.
+void orderBucket(GroupedPoints& points, const std::uint16_t* keys, std::size_t b,
+                 BucketScratch& scratch) {
   const auto [begin, end] = points.bucketPoints(b);
   const std::size_t count = end - begin;
   const std::size_t leaves = points.buckets.first[b + 1] - points.buckets.first[b];
-  std::uint16_t* const key = points.voxel.get() + begin;
+  const std::uint16_t* const key = keys + begin;
   scratch.counts.assign(leaves << kVoxelBits, 0);
   for (std::size_t i = 0; i < count; ++i) ++scratch.counts[key[i]];
   std::uint32_t sum = 0;
   for (std::uint32_t& c : scratch.counts) sum += std::exchange(c, sum);
   std::uint32_t* const rank = points.rank.get() + begin;
   for (std::size_t i = 0; i < count; ++i) rank[i] = scratch.counts[key[i]]++;
-  permute(key, rank, count, scratch.keys);
-  for (std::size_t i = 0; i < count; ++i) key[i] &= Leaf::SIZE - 1;  // the voxel alone
+  // (counts[k] is now the end of key k's points in the bucket.)
+  for (std::uint32_t l = points.buckets.first[b]; l < points.buckets.first[b + 1]; ++l) {
+    const std::uint32_t p = l - points.buckets.first[b];
+    setVoxelEnds(points, l, scratch.counts.data() + (std::size_t{p} << kVoxelBits),
+                 static_cast<std::uint32_t>(points.starts[l] - begin));
+  }
   permute(points.offset.get() + begin, rank, count, scratch.vectors);
 }
 
@@ -615,6 +657,8 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
   const std::vector<const float*> source = pointFloatColumns(frame);
   GroupedPoints points(n, source.size());
+  // Each row's key in its bucket, at its place there: its leaf's place in the bucket, its voxel.
+  const LargeArray<std::uint16_t> keys = allocateLargeArray<std::uint16_t>(n);
   // The leaves that hold points, in order (each one's first point and origin), and the buckets.
   std::vector<std::uint32_t> boxOf;  // each such leaf's index in the box
   std::size_t sum = 0;
@@ -659,7 +703,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   par::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
                     [&](const tbb::blocked_range<std::size_t>& run) {
                       std::uint32_t* const at = rowAt.get();
-                      std::uint16_t* const __restrict key = points.voxel.get();
+                      std::uint16_t* const __restrict key = keys.get();
                       openvdb::Vec3f* const __restrict offset = points.offset.get();
                       PlacedRows placed;
                       for (std::size_t chunk = run.begin(); chunk < run.end(); ++chunk) {
@@ -691,11 +735,12 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
   points.rank = allocateLargeArray<std::uint32_t>(n);
   points.buckets = std::move(buckets);
+  allocateVoxelEnds(points);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, bucketCount),
                     [&](const tbb::blocked_range<std::size_t>& some) {
                       BucketScratch scratch;
                       for (std::size_t b = some.begin(); b < some.end(); ++b)
-                        orderBucket(points, b, scratch);
+                        orderBucket(points, keys.get(), b, scratch);
                     });
   const std::size_t later = bucketCount * points.laterColumns();
   points.later = std::make_unique<std::atomic<std::uint8_t>[]>(later);  // (zeroed: not yet)

@@ -36,11 +36,15 @@ struct GroupedPoints {
   std::vector<std::size_t> starts;  // each leaf's first point, and the end
   std::vector<openvdb::Coord> origins;
   // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
-  LargeArray<std::uint16_t> voxel;    // a point's voxel in its leaf (0 to 511)
-  LargeArray<openvdb::Vec3f> offset;  // its position's offset in the voxel
+  LargeArray<openvdb::Vec3f> offset;  // each point's position's offset in its voxel
   LargeArray<std::uint64_t> id;
   // velocity x, y, z, age, life, mass, then the frame's attribute columns, in the frame's order
   std::vector<LargeArray<float>> columns;
+  // Each leaf's voxel values, Leaf::SIZE a leaf, leaf after leaf: the end of each voxel's points
+  // in the leaf's arrays (PointDataLeafNode's offsets); and each leaf's value mask, on the
+  // voxels that hold points.
+  LargeArray<openvdb::PointDataIndex32> voxelEnds;
+  std::vector<openvdb::points::PointDataTree::LeafNodeType::NodeMaskType> masks;
   // Where set (Grouping::Any), `id` and `columns` are put in order bucket by bucket by the store
   // itself, as the file is written (orderLater()): each bucket's rows of them are still in row
   // order, rank[k] the place in its bucket of the point whose values are at row k, and
@@ -51,9 +55,7 @@ struct GroupedPoints {
   std::unique_ptr<std::atomic<std::uint8_t>[]> later;
 
   GroupedPoints(std::size_t n, std::size_t floatColumnCount)
-      : voxel(allocateLargeArray<std::uint16_t>(n)),
-        offset(allocateLargeArray<openvdb::Vec3f>(n)),
-        id(allocateLargeArray<std::uint64_t>(n)) {
+      : offset(allocateLargeArray<openvdb::Vec3f>(n)), id(allocateLargeArray<std::uint64_t>(n)) {
     for (std::size_t j = 0; j < floatColumnCount; ++j)
       columns.push_back(allocateLargeArray<float>(n));
   }
@@ -80,7 +82,6 @@ inline constexpr std::size_t kStandardFloatColumns = 6;
 // What the orderings reuse from one bucket to the next (orderLater()).
 struct BucketScratch {
   std::vector<std::uint32_t> counts;
-  std::vector<std::uint16_t> keys;
   std::vector<openvdb::Vec3f> vectors;
   std::vector<std::uint64_t> ids;
   std::vector<float> floats;
