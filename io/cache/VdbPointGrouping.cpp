@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -425,7 +426,7 @@ void scatter(const T* __restrict from, const std::uint32_t* __restrict at, std::
   }
 }
 
-// Rows are bucketed in chunks of at least this many, at most kMaxChunks chunks.
+// Rows are bucketed in chunks of about this many, at most kMaxChunks chunks.
 constexpr std::size_t kBucketChunk = 65536;
 constexpr std::size_t kMaxChunks = 64;
 
@@ -562,8 +563,8 @@ constexpr std::uint8_t kOrdering = 1, kOrdered = 2;
 // The fast way, when the leaves' bounding box holds few enough leaves to count them in a table
 // (any effect of sane size): a stable counting sort of the rows by the leaf's index in the box
 // (x, then y, then z: Coord's order), in two steps: by bucket of leaves, then within each bucket
-// by leaf and voxel (Buckets, orderBucket). The chunks are fixed by the point count alone (the
-// order depends on neither them nor the threads). Nothing otherwise.
+// by leaf and voxel (Buckets, orderBucket). The chunks of rows are fixed by the point count and
+// the thread count; the order depends on neither. Nothing otherwise.
 template <bool Quantised>
 std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   const std::size_t n = frame.size();
@@ -607,7 +608,13 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
       box.second[c] = std::max(box.second[c], 0);
     }
   }
-  const std::size_t chunks = std::clamp<std::size_t>(n / kBucketChunk, 1, kMaxChunks);
+  // A multiple of the threads, so that each takes as many (the order does not depend on them): at
+  // 10⁶ points 16 chunks rather than 15 on 2 threads took 0.4–1.0 ms off the grouping's 12.
+  std::size_t chunks = std::clamp<std::size_t>(n / kBucketChunk, 1, kMaxChunks);
+  if (const auto threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+      threads <= kMaxChunks) {
+    chunks = std::min(kMaxChunks / threads, (chunks + threads - 1) / threads) * threads;
+  }
   // Table entries, leaves × chunks (leaf indices and the table's offsets fit 32 bits).
   const std::uint64_t limit = std::min<std::uint64_t>(8 * std::uint64_t{n} + (1u << 20),
                                                       std::numeric_limits<std::uint32_t>::max());
