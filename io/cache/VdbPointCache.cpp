@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -281,14 +282,15 @@ class GroupedValues final : public PointValues {
         a.kind, [&]<typename Array>(std::type_identity<Array>) { storeAs<Array>(l, a, to); });
   }
 
-  // Every bucket's columns put in order, attribute by attribute as the file holds them: the
+  // The next bucket's columns put in order, attribute by attribute as the file holds them: the
   // store then finds them in order (orderLater() does each once, whoever asks first).
-  void prepare() const override {
-    if (!points_.later) return;
-    BucketScratch scratch;
-    for (const GridAttribute& a : attributes_) {
-      for (std::size_t b = 0; b < points_.buckets.count(); ++b) orderColumns(b, a, scratch);
-    }
+  bool prepareStep() const override {
+    if (!points_.later) return false;
+    const std::size_t buckets = points_.buckets.count();
+    const std::size_t step = nextStep_.fetch_add(1, std::memory_order_relaxed);
+    if (step >= attributes_.size() * buckets) return false;
+    orderColumns(step % buckets, attributes_[step / buckets], local_.local().scratch);
+    return true;
   }
 
  private:
@@ -396,6 +398,7 @@ class GroupedValues final : public PointValues {
   GroupedPoints& points_;
   std::vector<GridAttribute> attributes_;
   mutable tbb::enumerable_thread_specific<Local> local_;
+  mutable std::atomic<std::size_t> nextStep_{0};  // prepareStep()'s next: attribute, bucket
 };
 
 // The frame's points grouped as the grid's position array places them.

@@ -7,14 +7,15 @@
 #include <openvdb/points/StreamCompression.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <ios>
 #include <limits>
 #include <memory>
@@ -25,6 +26,7 @@
 #include <stdexcept>
 #include <streambuf>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -579,7 +581,7 @@ class DeferredBuffers final : public EncodedPointsFile::Deferred {
     for (std::size_t p = 0; p < parts_.size(); ++p) offsets_[p + 1] = offsets_[p] + parts_[p].size;
   }
   std::size_t size() const override { return offsets_.back(); }
-  void prepare() const override { all_.values->prepare(); }
+  bool prepareStep() const override { return all_.values->prepareStep(); }
   void fill(std::size_t from, std::size_t to, char* out) const override {
     // The parts that [from, to) overlaps, the first found by a binary search.
     auto p = static_cast<std::size_t>(std::upper_bound(offsets_.begin(), offsets_.end(), from) -
@@ -1080,54 +1082,77 @@ FileBytes EncodedPointsFile::bytes() const {
 }
 
 void EncodedPointsFile::write(std::ostream& out) const {
+  const profile::ParallelScope parallel;
   const std::size_t size = this->size(), chunks = chunkCount(size);
-  // One buffer a chunk in flight, made by one thread while another writes the one before.
-  const std::size_t tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
-  const FileBytes::Storage room = FileBytes::allocate(tokens * kChunkBytes);
-  std::vector<std::size_t> free(tokens);
-  for (std::size_t t = 0; t < tokens; ++t) free[t] = t;
-  std::mutex freeLock;
-  struct Chunk {
-    std::size_t index = 0, slot = 0;
+  const auto threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  // Chunk c is made into slot c % slots once chunk c − slots is written: made by whichever
+  // thread claims it first, written by this one, in order. The other threads make chunks while
+  // a slot is free and otherwise do the deferred bytes' work ahead (Deferred::prepareStep()), so
+  // that this thread, copying into the kernel one chunk after another, finds the next made: a
+  // pipeline whose threads each made and wrote (TBB's) left the kernel idle while one thread
+  // made the positions' chunks and the other put the columns in order. With one thread, this
+  // one makes each chunk before writing it, into the one slot, which stays in cache.
+  const std::size_t slots = threads == 1 ? 1 : std::max<std::size_t>(8, 2 * threads);
+  const FileBytes::Storage room = FileBytes::allocate(slots * kChunkBytes);
+  std::atomic<std::size_t> claimed{0}, written{0};
+  const std::unique_ptr<std::atomic<bool>[]> made = std::make_unique<std::atomic<bool>[]>(chunks);
+  std::atomic<bool> stop{false};
+  const auto makeChunk = [&](std::size_t c) {
+    const auto [from, to] = chunkBytes(c, size);
+    fill(from, to, room.get() + (c % slots) * kChunkBytes);
+    made[c].store(true, std::memory_order_release);
   };
-  std::size_t next = 0;
-  const auto take = [&](tbb::flow_control& control) {
-    if (next >= chunks) {
-      control.stop();
-      return Chunk{};
+  // Claims the next chunk and makes it, where its slot is free and, for `only`, it is `only`.
+  const auto claimAndMake = [&](std::size_t only) {
+    std::size_t c = claimed.load(std::memory_order_relaxed);
+    while (c < chunks && c < written.load(std::memory_order_acquire) + slots &&
+           (only == chunks || c == only)) {
+      if (claimed.compare_exchange_weak(c, c + 1, std::memory_order_relaxed)) {
+        makeChunk(c);
+        return true;
+      }
     }
-    const std::lock_guard lock(freeLock);
-    const Chunk chunk{next++, free.back()};
-    free.pop_back();
-    return chunk;
+    return false;
   };
-  const auto make = [&](Chunk chunk) {
-    const auto [from, to] = chunkBytes(chunk.index, size);
-    fill(from, to, room.get() + chunk.slot * kChunkBytes);
-    return chunk;
+  tbb::task_group makers;
+  std::exception_ptr failure;
+  std::mutex failureLock;
+  const auto fail = [&] {
+    const std::lock_guard lock(failureLock);
+    if (!failure) failure = std::current_exception();
+    stop.store(true, std::memory_order_release);
   };
-  const auto put = [&](Chunk chunk) {
-    const auto [from, to] = chunkBytes(chunk.index, size);
-    if (out)
-      out.write(room.get() + chunk.slot * kChunkBytes, static_cast<std::streamsize>(to - from));
-    const std::lock_guard lock(freeLock);
-    free.push_back(chunk.slot);
-  };
-  // The deferred bytes' work done ahead on a thread of its own while the pipeline begins, where
-  // the kernel's copy of the first chunks would leave the threads that make them waiting (a
-  // frame of 10⁶ points wrote in 9.7–10.0 ms against 10.7–11.3).
-  tbb::task_group ahead;
-  if (deferred_) ahead.run([this] { deferred_->prepare(); });
-  try {
-    par::parallel_pipeline(
-        tokens, tbb::make_filter<void, Chunk>(tbb::filter_mode::serial_in_order, take) &
-                    tbb::make_filter<Chunk, Chunk>(tbb::filter_mode::parallel, make) &
-                    tbb::make_filter<Chunk, void>(tbb::filter_mode::serial_in_order, put));
-  } catch (...) {
-    ahead.wait();  // (what it reads must outlive it)
-    throw;
+  for (std::size_t t = 1; t < threads; ++t) {
+    makers.run([&] {
+      try {
+        while (!stop.load(std::memory_order_acquire)) {
+          if (claimAndMake(chunks)) continue;
+          if (deferred_ && deferred_->prepareStep()) continue;
+          if (claimed.load(std::memory_order_relaxed) >= chunks) break;
+          std::this_thread::yield();
+        }
+      } catch (...) {
+        fail();
+      }
+    });
   }
-  ahead.wait();
+  try {
+    for (std::size_t c = 0; c < chunks && !stop.load(std::memory_order_acquire); ++c) {
+      while (!made[c].load(std::memory_order_acquire) && !stop.load(std::memory_order_acquire)) {
+        if (!claimAndMake(c)) std::this_thread::yield();  // (being made by another)
+      }
+      if (stop.load(std::memory_order_acquire)) break;
+      const auto [from, to] = chunkBytes(c, size);
+      if (out)
+        out.write(room.get() + (c % slots) * kChunkBytes, static_cast<std::streamsize>(to - from));
+      written.store(c + 1, std::memory_order_release);
+    }
+  } catch (...) {
+    fail();
+  }
+  stop.store(true, std::memory_order_release);
+  makers.wait();
+  if (failure) std::rethrow_exception(failure);
 }
 
 EncodedPointsFile encodePointsFile(const vdbp::PointDataGrid& grid, const PointLeaves& leaves,

@@ -52,11 +52,12 @@ class PointValues {
   /// attributes.
   virtual void store(std::size_t attribute, const openvdb::Coord& origin, std::size_t count,
                      char* to) const = 0;
-  /// Work that store() would otherwise do when asked, done ahead of it, in the order the file
-  /// asks for it: EncodedPointsFile::write() runs it on another thread beside the first chunks,
-  /// whose bytes (the header, the positions) take little making while the kernel copies them.
-  /// Called at most once a write, while store() is called from other threads.
-  virtual void prepare() const {}
+  /// Does one more step of the work store() would otherwise do when asked, in the order the file
+  /// asks for it, and returns true; false when no step is left. EncodedPointsFile::write() calls
+  /// it on the threads that make chunks while none is free to be made (the kernel copying the
+  /// header and positions, whose chunks take little making). Called from several threads at
+  /// once, beside store().
+  virtual bool prepareStep() const { return false; }
 };
 
 /// Uninitialised storage for `n` values of T (a type a plain copy creates, as numbers and
@@ -110,8 +111,8 @@ class EncodedPointsFile {
     /// Writes bytes [from, to) of them at `out`. Called from several threads at once, for
     /// ranges that do not overlap.
     virtual void fill(std::size_t from, std::size_t to, char* out) const = 0;
-    /// What fill() would do when asked, done ahead of it (PointValues::prepare()).
-    virtual void prepare() const {}
+    /// A step of what fill() would do when asked, done ahead (PointValues::prepareStep()).
+    virtual bool prepareStep() const { return false; }
   };
 
   /// `known`: the file's bytes but the deferred ones, which go at `deferredAt`.
@@ -126,7 +127,8 @@ class EncodedPointsFile {
   /// Writes the whole file to `out`, in order, in blocks that start at multiples of 512 KiB from
   /// the file's first byte (a page cache of large folios takes a write into a new file a fifth
   /// faster when its offset is so aligned: `out` should be at the start of its file); stops at
-  /// the first failed write (`out` tells).
+  /// the first failed write (`out` tells). The calling thread writes; the arena's other threads
+  /// make the blocks ahead of it.
   void write(std::ostream& out) const;
   /// The whole file in memory.
   FileBytes bytes() const;
