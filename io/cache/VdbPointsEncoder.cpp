@@ -1139,7 +1139,9 @@ void EncodedPointsFile::write(std::ostream& out) const {
   try {
     for (std::size_t c = 0; c < chunks && !stop.load(std::memory_order_acquire); ++c) {
       while (!made[c].load(std::memory_order_acquire) && !stop.load(std::memory_order_acquire)) {
-        if (!claimAndMake(c)) std::this_thread::yield();  // (being made by another)
+        // Chunk c is being made by another: a step ahead meanwhile (a bucket's column, some
+        // 20 µs), rather than nothing (the write then took 11.2–11.4 ms against 11.7–12.4).
+        if (!claimAndMake(c) && !(deferred_ && deferred_->prepareStep())) std::this_thread::yield();
       }
       if (stop.load(std::memory_order_acquire)) break;
       const auto [from, to] = chunkBytes(c, size);
