@@ -623,16 +623,18 @@ void describeArrays(Leaves& all, const openvdb::io::StreamMetadata& metadata) {
     all.metadata.push_back(metadataTemplate(all, a, metadata));
 }
 
-// What Grid<PointDataTree>::writeBuffers() writes for `leaves` after the pass count, encoded in
-// parallel with the stream metadata `metadata` but for the parts left to fill() (DeferredBuffers);
-// null where there is no leaf (two bytes that OpenVDB writes as fast).
-std::unique_ptr<DeferredBuffers> encodeBuffers(const PointLeaves& leaves, bool toHalf,
+// What Grid<PointDataTree>::writeBuffers() writes for `leaves` (in the tree's order `order`) after
+// the pass count, encoded in parallel with the stream metadata `metadata` but for the parts left
+// to fill() (DeferredBuffers); null where there is no leaf (two bytes that OpenVDB writes as
+// fast).
+std::unique_ptr<DeferredBuffers> encodeBuffers(const PointLeaves& leaves,
+                                               const std::vector<std::uint32_t>& order, bool toHalf,
                                                const PointValues& values,
                                                const openvdb::io::StreamMetadata::Ptr& metadata) {
   if (leaves.size() == 0) return nullptr;
   Leaves all;
   all.leaves = &leaves;
-  all.order = treeOrder(leaves.origins);
+  all.order = order;
   all.values = &values;
   describeArrays(all, *metadata);
 
@@ -712,7 +714,8 @@ class BuffersAhead {
   BuffersAhead& operator=(const BuffersAhead&) = delete;
 
   // Begins encodeBuffers() with the stream's metadata as it is now; once only.
-  void start(const PointLeaves& leaves, bool toHalf, const PointValues& values) {
+  void start(const PointLeaves& leaves, const std::vector<std::uint32_t>& order, bool toHalf,
+             const PointValues& values) {
     const openvdb::io::StreamMetadata::Ptr now = openvdb::io::getStreamMetadataPtr(os_);
     if (started_ || !now) return;
     started_ = true;
@@ -720,8 +723,8 @@ class BuffersAhead {
     // As the topology's writer will have set it (writeTopology()).
     metadata_->setBackgroundPtr(&kBackground);
     madeFor_ = metadata_->str();
-    group_.run([this, &leaves, toHalf, &values] {
-      buffers_ = encodeBuffers(leaves, toHalf, values, metadata_);
+    group_.run([this, &leaves, &order, toHalf, &values] {
+      buffers_ = encodeBuffers(leaves, order, toHalf, values, metadata_);
     });
   }
   // What start() made, once made (an exception it threw is thrown here), when it was made with
@@ -750,8 +753,9 @@ class BuffersAhead {
 // Writes what Grid<PointDataTree>::writeBuffers(os) writes for `leaves`, encoded in parallel but
 // for the parts left to `deferred` (DeferredBuffers: `os` skips their bytes). The buffers are
 // those `ahead` made, where it made them for this stream. At least one leaf.
-void writeBuffersInParallel(const PointLeaves& leaves, bool toHalf, const PointValues& values,
-                            std::ostream& os, BuffersAhead* ahead,
+void writeBuffersInParallel(const PointLeaves& leaves, const std::vector<std::uint32_t>& order,
+                            bool toHalf, const PointValues& values, std::ostream& os,
+                            BuffersAhead* ahead,
                             std::unique_ptr<EncodedPointsFile::Deferred>& deferred) {
   auto* const sink = dynamic_cast<MemorySink*>(os.rdbuf());
   const openvdb::io::StreamMetadata::Ptr metadata = openvdb::io::getStreamMetadataPtr(os);
@@ -759,7 +763,7 @@ void writeBuffersInParallel(const PointLeaves& leaves, bool toHalf, const PointV
       ahead != nullptr && metadata ? ahead->take(*metadata) : nullptr;
   if (sink == nullptr) throw std::logic_error("VDB points: leaves written to a stream not ours");
   if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
-  if (!buffers) buffers = encodeBuffers(leaves, toHalf, values, metadata);  // (not null: leaves)
+  if (!buffers) buffers = encodeBuffers(leaves, order, toHalf, values, metadata);  // (leaves)
   const auto passes = static_cast<std::uint16_t>(leaves.sample->buffers());
   os.write(reinterpret_cast<const char*>(&passes), sizeof passes);
   sink->skip(buffers->size());
@@ -808,30 +812,42 @@ openvdb::Index64 activeVoxelCount(const PointLeaves& leaves) {
   return count;
 }
 
+// Where the leaves of each internal node begin in the tree's order `order`, each list ended by
+// order.size(): the top nodes' (RootNode's children) and the nodes' below them.
+struct NodeStarts {
+  std::vector<std::size_t> top, lower;
+};
+NodeStarts nodeStarts(const PointLeaves& leaves, const std::vector<std::uint32_t>& order) {
+  NodeStarts starts;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const openvdb::Coord& origin = leaves.origins[order[k]];
+    const openvdb::Coord* const before = k == 0 ? nullptr : &leaves.origins[order[k - 1]];
+    if (!before || topOrigin(origin) != topOrigin(*before)) starts.top.push_back(k);
+    if (!before || lowerOrigin(origin) != lowerOrigin(*before)) starts.lower.push_back(k);
+  }
+  starts.top.push_back(order.size());
+  starts.lower.push_back(order.size());
+  return starts;
+}
+
 // What tools::memUsage() (Tree::memUsage()) counts for the tree of `leaves` (OpenVDB 10,
 // tools/Count.h's MemUsageOp): the tree and its root node, each internal node's values and
 // masks and origin, and each leaf's memUsage(): the sample's with its arrays expanded, each
 // array's values a point more or fewer by its storage.
-openvdb::Index64 memUsage(const PointLeaves& leaves, const std::vector<std::uint32_t>& order) {
+openvdb::Index64 memUsage(const PointLeaves& leaves, const NodeStarts& nodes) {
   const auto nodeBytes = []<typename Node>(std::type_identity<Node>) {
     return openvdb::Index64{Node::NUM_VALUES * sizeof(typename Node::UnionType)} +
            2 * typename Node::NodeMaskType().memUsage() + sizeof(openvdb::Coord);
   };
-  openvdb::Index64 bytes = sizeof(vdbp::PointDataTree) + sizeof(vdbp::PointDataTree::RootNodeType);
   const vdbp::AttributeSet& set = leaves.sample->attributeSet();
   openvdb::Index64 perPoint = 0;
   for (std::size_t a = 0; a < set.size(); ++a) perPoint += set.getConst(a)->storageTypeSize();
-  const openvdb::Index64 sample = leaves.sample->memUsage();
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const openvdb::Coord& origin = leaves.origins[order[k]];
-    const bool newLower =
-        k == 0 || lowerOrigin(origin) != lowerOrigin(leaves.origins[order[k - 1]]);
-    const bool newTop = k == 0 || topOrigin(origin) != topOrigin(leaves.origins[order[k - 1]]);
-    if (newTop) bytes += nodeBytes(std::type_identity<TopNode>());
-    if (newLower) bytes += nodeBytes(std::type_identity<LowerNode>());
-    bytes += sample + (leaves.counts[order[k]] - 1) * perPoint;
-  }
-  return bytes;
+  openvdb::Index64 points = 0;
+  for (const std::size_t count : leaves.counts) points += count;
+  return sizeof(vdbp::PointDataTree) + sizeof(vdbp::PointDataTree::RootNodeType) +
+         (nodes.top.size() - 1) * nodeBytes(std::type_identity<TopNode>()) +
+         (nodes.lower.size() - 1) * nodeBytes(std::type_identity<LowerNode>()) +
+         leaves.size() * leaves.sample->memUsage() + (points - leaves.size()) * perPoint;
 }
 
 // What an internal node of type Node writes of its values (InternalNode::writeTopology()), the
@@ -853,11 +869,12 @@ std::string internalValues(const openvdb::io::StreamMetadata& metadata, bool toH
 }
 
 // What Tree<PointDataTree>::writeTopology() writes for `leaves` (OpenVDB 10: TreeBase's buffer
-// count, then RootNode's, InternalNode's and LeafNode's writeTopology()), in the tree's order:
-// the background value, no tile and the top nodes, each its origin, masks, values and children,
-// each leaf its value mask. Points the stream at the background, as RootNode's does.
+// count, then RootNode's, InternalNode's and LeafNode's writeTopology()), in the tree's order
+// `order`, whose internal nodes begin at `nodes`: the background value, no tile and the top
+// nodes, each its origin, masks, values and children, each leaf its value mask. Points the
+// stream at the background, as RootNode's does.
 void writeTopology(std::ostream& os, const PointLeaves& leaves,
-                   const std::vector<std::uint32_t>& order, bool toHalf) {
+                   const std::vector<std::uint32_t>& order, const NodeStarts& nodes, bool toHalf) {
   const auto put = [&os](const auto& value) {
     os.write(reinterpret_cast<const char*>(&value), sizeof value);
   };
@@ -868,14 +885,8 @@ void writeTopology(std::ostream& os, const PointLeaves& leaves,
   if (!metadata) throw std::runtime_error("VDB points: a stream without OpenVDB's metadata");
   const std::string topValues = internalValues<TopNode>(*metadata, toHalf);
   const std::string lowerValues = internalValues<LowerNode>(*metadata, toHalf);
-  std::vector<std::size_t> tops;  // where each top node's leaves begin in `order`, and the end
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    if (k == 0 || topOrigin(leaves.origins[order[k]]) != topOrigin(leaves.origins[order[k - 1]]))
-      tops.push_back(k);
-  }
-  tops.push_back(order.size());
-  put(openvdb::Index{0});                             // tiles
-  put(static_cast<openvdb::Index>(tops.size() - 1));  // children
+  put(openvdb::Index{0});                                  // tiles
+  put(static_cast<openvdb::Index>(nodes.top.size() - 1));  // children
   // An internal node whose children hold the leaves order[begin, end): its masks and values.
   const auto writeNode = [&]<typename Node>(std::type_identity<Node>, std::size_t begin,
                                             std::size_t end, const std::string& values) {
@@ -886,22 +897,22 @@ void writeTopology(std::ostream& os, const PointLeaves& leaves,
     typename Node::NodeMaskType().save(os);  // no active tile
     os.write(values.data(), static_cast<std::streamsize>(values.size()));
   };
-  for (std::size_t t = 0; t + 1 < tops.size(); ++t) {
-    const openvdb::Coord top = topOrigin(leaves.origins[order[tops[t]]]);
+  std::size_t lower = 0;  // in nodes.lower
+  for (std::size_t t = 0; t + 1 < nodes.top.size(); ++t) {
+    const openvdb::Coord top = topOrigin(leaves.origins[order[nodes.top[t]]]);
     os.write(reinterpret_cast<const char*>(top.asPointer()), 3 * sizeof(openvdb::Int32));
-    writeNode(std::type_identity<TopNode>(), tops[t], tops[t + 1], topValues);
-    for (std::size_t k = tops[t]; k < tops[t + 1];) {
-      std::size_t end = k + 1;
-      const openvdb::Coord lower = lowerOrigin(leaves.origins[order[k]]);
-      while (end < tops[t + 1] && lowerOrigin(leaves.origins[order[end]]) == lower) ++end;
-      writeNode(std::type_identity<LowerNode>(), k, end, lowerValues);
-      for (; k < end; ++k) leaves.masks[order[k]].save(os);
+    writeNode(std::type_identity<TopNode>(), nodes.top[t], nodes.top[t + 1], topValues);
+    // (A top node's leaves begin a lower node's.)
+    for (; nodes.lower[lower] < nodes.top[t + 1]; ++lower) {
+      const std::size_t begin = nodes.lower[lower], end = nodes.lower[lower + 1];
+      writeNode(std::type_identity<LowerNode>(), begin, end, lowerValues);
+      for (std::size_t k = begin; k < end; ++k) leaves.masks[order[k]].save(os);
     }
   }
 }
 
 // The grid as Archive::write() sees it: the leaves' grid (encodePointsFile's `grid`, whose
-// metadata and transform it shares: a shallow copy) with the tree of `leaves`, which it writes
+// metadata and transform it copies) with the tree of `leaves`, which it writes
 // itself: its topology (writeTopology() above), its statistics and its leaves' buffers
 // (writeBuffersInParallel()). Archive::write() calls the virtual GridBase::writeTopology() and
 // writeBuffers() in turn, then patches the grid's end offset into its descriptor itself; the
@@ -913,39 +924,43 @@ void writeTopology(std::ostream& os, const PointLeaves& leaves,
 // call on a grid it writes (reading, changing the tree) is refused.
 class ParallelBuffersGrid final : public openvdb::GridBase {
  public:
+  // `order` and `nodes`: the leaves' tree order (treeOrder()) and its nodes (nodeStarts()).
   ParallelBuffersGrid(const vdbp::PointDataGrid& grid, const PointLeaves& leaves,
+                      const std::vector<std::uint32_t>& order, const NodeStarts& nodes,
                       const PointValues& values, BuffersAhead* ahead,
                       std::unique_ptr<EncodedPointsFile::Deferred>* deferred)
-      : openvdb::GridBase(grid),  // (its metadata and transform; the transform is shared)
+      : openvdb::GridBase(grid),  // (its metadata and transform, copied)
         grid_(&grid),
         leaves_(&leaves),
+        order_(&order),
+        nodes_(&nodes),
         values_(&values),
         ahead_(ahead),
         deferred_(deferred) {
     if (!grid.constTree().empty())
       throw std::logic_error("VDB points: the leaves' grid holds leaves of its own");
-    if (leaves.size() > 0) order_ = treeOrder(leaves.origins);
   }
   // A shallow copy.
   ParallelBuffersGrid(const ParallelBuffersGrid& grid, openvdb::ShallowCopy)
       : openvdb::GridBase(grid),
         grid_(grid.grid_),
         leaves_(grid.leaves_),
+        order_(grid.order_),
+        nodes_(grid.nodes_),
         values_(grid.values_),
         ahead_(grid.ahead_),
-        deferred_(grid.deferred_),
-        order_(grid.order_) {}
+        deferred_(grid.deferred_) {}
 
   void writeTopology(std::ostream& os) const override {
     if (!hasLeaves()) return base().writeTopology(os);
-    tickfx::io::writeTopology(os, *leaves_, order_, saveFloatAsHalf());
+    tickfx::io::writeTopology(os, *leaves_, *order_, *nodes_, saveFloatAsHalf());
   }
   void writeBuffers(std::ostream& os) const override {
     if (!hasLeaves()) return base().writeBuffers(os);
-    writeBuffersInParallel(*leaves_, saveFloatAsHalf(), *values_, os, ahead_, *deferred_);
+    writeBuffersInParallel(*leaves_, *order_, saveFloatAsHalf(), *values_, os, ahead_, *deferred_);
   }
   openvdb::Index64 memUsage() const override {
-    return hasLeaves() ? tickfx::io::memUsage(*leaves_, order_) : base().memUsage();
+    return hasLeaves() ? tickfx::io::memUsage(*leaves_, *nodes_) : base().memUsage();
   }
   openvdb::Index64 activeVoxelCount() const override {
     return hasLeaves() ? tickfx::io::activeVoxelCount(*leaves_) : base().activeVoxelCount();
@@ -961,7 +976,8 @@ class ParallelBuffersGrid final : public openvdb::GridBase {
     return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
   }
   openvdb::GridBase::ConstPtr copyGrid() const override {
-    if (ahead_ != nullptr && hasLeaves()) ahead_->start(*leaves_, saveFloatAsHalf(), *values_);
+    if (ahead_ != nullptr && hasLeaves())
+      ahead_->start(*leaves_, *order_, saveFloatAsHalf(), *values_);
     return std::make_shared<ParallelBuffersGrid>(*this, openvdb::ShallowCopy());
   }
 
@@ -1005,12 +1021,13 @@ class ParallelBuffersGrid final : public openvdb::GridBase {
     throw std::logic_error("VDB points: a grid being written was asked to change or copy");
   }
 
-  const vdbp::PointDataGrid* grid_;      // (never null; outlives the write)
-  const PointLeaves* leaves_;            // (never null)
-  const PointValues* values_ = nullptr;  // (never null)
+  const vdbp::PointDataGrid* grid_;          // (never null; outlives the write)
+  const PointLeaves* leaves_;                // (never null)
+  const std::vector<std::uint32_t>* order_;  // (never null)
+  const NodeStarts* nodes_;                  // (never null)
+  const PointValues* values_ = nullptr;      // (never null)
   BuffersAhead* ahead_ = nullptr;
   std::unique_ptr<EncodedPointsFile::Deferred>* deferred_;  // where writeBuffers() leaves them
-  std::vector<std::uint32_t> order_;  // the leaves in the tree's order (treeOrder())
 };
 
 // Archive::write(), protected in OpenVDB, with File::write()'s seekable stream.
@@ -1163,9 +1180,11 @@ EncodedPointsFile encodePointsFile(const vdbp::PointDataGrid& grid, const PointL
   std::unique_ptr<EncodedPointsFile::Deferred> deferred;
   MemorySink sink(expectedBytes);
   std::ostream os(&sink);
-  BuffersAhead ahead(os);
-  const openvdb::GridCPtrVec grids{
-      std::make_shared<const ParallelBuffersGrid>(grid, leaves, values, &ahead, &deferred)};
+  const std::vector<std::uint32_t> order = treeOrder(leaves.origins);
+  const NodeStarts nodes = nodeStarts(leaves, order);
+  BuffersAhead ahead(os);  // (after `order`, which it reads until it is destroyed)
+  const openvdb::GridCPtrVec grids{std::make_shared<const ParallelBuffersGrid>(
+      grid, leaves, order, nodes, values, &ahead, &deferred)};
   PointsArchive(compression).writeSeekable(os, grids);
   if (!os) throw std::runtime_error("cannot encode the VDB points grid");
   const std::size_t at = deferred ? sink.gapAt() : sink.held();
