@@ -172,10 +172,10 @@ vdbp::AttributeSet::Descriptor::Ptr gridDescriptor(const std::vector<GridAttribu
 
 // Leaf l with its voxel values, and its default attribute set.
 std::unique_ptr<Leaf> makeEmptyLeaf(const GroupedPoints& points, std::size_t l) {
-  auto leaf = std::make_unique<Leaf>(points.origins[l]);
-  std::memcpy(leaf->buffer().data(), points.voxelEnds.get() + l * Leaf::SIZE,
+  auto leaf = std::make_unique<Leaf>(points.leaves.origins[l]);
+  std::memcpy(leaf->buffer().data(), points.leaves.voxelEnds.get() + l * Leaf::SIZE,
               Leaf::SIZE * sizeof(openvdb::PointDataIndex32));
-  leaf->setValueMask(points.masks[l]);
+  leaf->setValueMask(points.leaves.masks[l]);
   return leaf;
 }
 
@@ -303,7 +303,7 @@ class GroupedValues final : public PointValues {
 
   // The index of the leaf at `origin`, tried first at `guess`.
   std::size_t leafAt(const openvdb::Coord& origin, std::size_t guess) const {
-    const auto& origins = points_.origins;
+    const auto& origins = points_.leaves.origins;
     if (guess < origins.size() && origins[guess] == origin) return guess;
     const auto leaf = std::lower_bound(origins.begin(), origins.end(), origin);
     if (leaf == origins.end() || *leaf != origin)
@@ -408,22 +408,12 @@ GroupedPoints groupedPoints(const FrameData& frame, Grouping grouping) {
   return groupPoints<kQuantised>(frame, grouping);
 }
 
-// The leaves of `points` for encodePointsFile, their attributes those of `descriptor`; their voxel
-// ends and masks are moved from `points`.
-PointLeaves pointLeaves(GroupedPoints& points,
-                        const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
-  PointLeaves leaves;
-  leaves.origins = points.origins;
-  for (std::size_t l = 0; l < points.origins.size(); ++l) {
-    const auto [begin, end] = points.leafPoints(l);
-    leaves.counts.push_back(end - begin);
-  }
-  leaves.masks = std::move(points.masks);
-  leaves.voxelEnds = std::move(points.voxelEnds);
-  leaves.sample = std::make_unique<Leaf>(openvdb::Coord(0));
-  leaves.sample->replaceAttributeSet(new vdbp::AttributeSet(descriptor, 1),
-                                     /*allowMismatchingDescriptors=*/true);
-  return leaves;
+// A leaf of one point whose arrays are those of `descriptor`, each uniform: PointLeaves::sample.
+std::unique_ptr<Leaf> sampleLeaf(const vdbp::AttributeSet::Descriptor::Ptr& descriptor) {
+  auto leaf = std::make_unique<Leaf>(openvdb::Coord(0));
+  leaf->replaceAttributeSet(new vdbp::AttributeSet(descriptor, 1),
+                            /*allowMismatchingDescriptors=*/true);
+  return leaf;
 }
 
 // The grid of no leaf with the frame's metadata, from OpenVDB's registry
@@ -450,7 +440,7 @@ vdbp::PointDataGrid::Ptr emptyGrid(const FrameData& frame, const VdbCacheMetadat
 template <typename MakeLeaf>
 vdbp::PointDataGrid::Ptr makeGrid(const GroupedPoints& points, const MakeLeaf& makeLeaf,
                                   const FrameData& frame, const VdbCacheMetadata& meta) {
-  std::vector<std::unique_ptr<Leaf>> leaves(points.origins.size());
+  std::vector<std::unique_ptr<Leaf>> leaves(points.leaves.size());
   par::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t l = range.begin(); l < range.end(); ++l)
@@ -472,10 +462,11 @@ void encodeFrame(const FrameData& frame, const VdbCacheMetadata& meta,
                  const VdbCacheOptions& options, Grouping grouping, const Use& use) {
   GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
   std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
-  const PointLeaves leaves = pointLeaves(points, gridDescriptor<PositionArray>(attributes));
+  points.leaves.sample = sampleLeaf(gridDescriptor<PositionArray>(attributes));
   const vdbp::PointDataGrid::Ptr grid = emptyGrid(frame, meta);
   const GroupedValues<PositionArray> values(points, std::move(attributes));
-  EncodedPointsFile file = encodePointsFile(*grid, leaves, compressionFlags(options), values);
+  EncodedPointsFile file =
+      encodePointsFile(*grid, points.leaves, compressionFlags(options), values);
   use(file);
 }
 

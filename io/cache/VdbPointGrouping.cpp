@@ -337,11 +337,13 @@ std::vector<const float*> pointFloatColumns(const FrameData& frame) {
   return columns;
 }
 
-// Room for each leaf's voxel ends and mask.
-void allocateVoxelEnds(GroupedPoints& points) {
-  points.voxelEnds =
-      allocateLargeArray<openvdb::PointDataIndex32>(points.origins.size() * Leaf::SIZE);
-  points.masks.resize(points.origins.size());
+// Each leaf's point count, from the starts, and room for its voxel ends and mask.
+void describeLeaves(GroupedPoints& points) {
+  PointLeaves& leaves = points.leaves;
+  for (std::size_t l = 0; l < leaves.origins.size(); ++l)
+    leaves.counts.push_back(points.starts[l + 1] - points.starts[l]);
+  leaves.voxelEnds = allocateLargeArray<openvdb::PointDataIndex32>(leaves.size() * Leaf::SIZE);
+  leaves.masks.resize(leaves.size());
 }
 
 // Leaf l's voxel ends and mask, from each of its voxels' end in some run of points where the
@@ -349,8 +351,8 @@ void allocateVoxelEnds(GroupedPoints& points) {
 // without its two calls a voxel.
 void setVoxelEnds(GroupedPoints& points, std::size_t l, const std::uint32_t* end,
                   std::uint32_t leafBegin) {
-  openvdb::PointDataIndex32* const ends = points.voxelEnds.get() + l * Leaf::SIZE;
-  Leaf::NodeMaskType& mask = points.masks[l];
+  openvdb::PointDataIndex32* const ends = points.leaves.voxelEnds.get() + l * Leaf::SIZE;
+  Leaf::NodeMaskType& mask = points.leaves.masks[l];
   std::uint32_t previous = leafBegin;
   for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
     std::uint64_t word = 0;
@@ -385,12 +387,12 @@ GroupedPoints sortedPoints(const FrameData& frame) {
   for (std::size_t k = 0; k < slots.size(); ++k) {
     if (k == 0 || slots[k].leaf != slots[k - 1].leaf) {
       points.starts.push_back(k);
-      points.origins.push_back(slots[k].leaf);
+      points.leaves.origins.push_back(slots[k].leaf);
     }
   }
   points.starts.push_back(slots.size());
-  allocateVoxelEnds(points);
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.origins.size()),
+  describeLeaves(points);
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.leaves.size()),
                     [&](const tbb::blocked_range<std::size_t>& leaves) {
                       for (std::size_t l = leaves.begin(); l < leaves.end(); ++l) {
                         std::array<std::uint32_t, Leaf::SIZE> counts{};
@@ -678,10 +680,10 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     sum += total;
     const std::uint64_t z = l % extent[2], y = (l / extent[2]) % extent[1],
                         x = l / (extent[2] * extent[1]);
-    points.origins.push_back(box.first +
-                             openvdb::Coord(static_cast<openvdb::Int32>(x << kLeafLog2),
-                                            static_cast<openvdb::Int32>(y << kLeafLog2),
-                                            static_cast<openvdb::Int32>(z << kLeafLog2)));
+    points.leaves.origins.push_back(box.first +
+                                    openvdb::Coord(static_cast<openvdb::Int32>(x << kLeafLog2),
+                                                   static_cast<openvdb::Int32>(y << kLeafLog2),
+                                                   static_cast<openvdb::Int32>(z << kLeafLog2)));
   }
   points.starts.push_back(n);
   Buckets buckets(points.starts);
@@ -742,7 +744,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
   points.rank = allocateLargeArray<std::uint32_t>(n);
   points.buckets = std::move(buckets);
-  allocateVoxelEnds(points);
+  describeLeaves(points);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, bucketCount),
                     [&](const tbb::blocked_range<std::size_t>& some) {
                       BucketScratch scratch;

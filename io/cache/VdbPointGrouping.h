@@ -34,17 +34,14 @@ struct Buckets {
 /// column, written to the file as it is.
 struct GroupedPoints {
   std::vector<std::size_t> starts;  // each leaf's first point, and the end
-  std::vector<openvdb::Coord> origins;
+  // Each leaf's origin, point count, mask and voxel ends (the encoder's description of the
+  // leaves; its sample leaf is the cache's to set).
+  PointLeaves leaves;
   // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
   LargeArray<openvdb::Vec3f> offset;  // each point's position's offset in its voxel
   LargeArray<std::uint64_t> id;
   // velocity x, y, z, age, life, mass, then the frame's attribute columns, in the frame's order
   std::vector<LargeArray<float>> columns;
-  // Each leaf's voxel values, Leaf::SIZE a leaf, leaf after leaf: the end of each voxel's points
-  // in the leaf's arrays (PointDataLeafNode's offsets); and each leaf's value mask, on the
-  // voxels that hold points.
-  LargeArray<openvdb::PointDataIndex32> voxelEnds;
-  std::vector<openvdb::points::PointDataTree::LeafNodeType::NodeMaskType> masks;
   // Where set (Grouping::Any), `id` and `columns` are put in order bucket by bucket by the store
   // itself, as the file is written (orderLater()): each bucket's rows of them are still in row
   // order, rank[k] the place in its bucket of the point whose values are at row k, and
