@@ -133,12 +133,6 @@ std::vector<GridAttribute> gridAttributes(const std::vector<std::string>& attrib
   return attributes;
 }
 
-// Leaf l's stretch of the j-th float column attribute `a` reads (a vector reads three).
-const float* leafColumn(const GroupedPoints& points, const GridAttribute& a, std::size_t j,
-                        std::size_t l) {
-  return points.columns[a.column + j].get() + points.leafPoints(l).first;
-}
-
 // Calls f(std::type_identity<Array>()) with the array type of attributes of `kind`.
 template <typename PositionArray, typename F>
 void withArrayType(GridAttribute::Kind kind, const F& f) {
@@ -193,35 +187,37 @@ void addUniformArrays(Leaf& leaf, const vdbp::AttributeSet::Descriptor::Ptr& des
 template <typename Set>
 void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& a, const Set& set) {
   using Kind = GridAttribute::Kind;
-  const auto [begin, end] = points.leafPoints(l);
-  const std::size_t count = end - begin;
-  const auto column = [&](std::size_t j) { return leafColumn(points, a, j, l); };
+  const std::size_t begin = points.leafPoints(l).first;
+  const std::size_t count = points.leafPoints(l).second - begin;
+  const auto column = [&](std::size_t j) { return points.columns[a.column + j].get(); };
+  const auto row = [&](std::size_t k) { return points.row(begin + k); };
   switch (a.kind) {
     case Kind::Position: {
-      const openvdb::Vec3f* offset = points.offset.get() + begin;
-      for (std::size_t k = 0; k < count; ++k) set(k, offset[k]);
+      const openvdb::Vec3f* offset = points.offset.get();
+      for (std::size_t k = 0; k < count; ++k) set(k, offset[row(k)]);
       return;
     }
     case Kind::Vector: {
       const float *x = column(0), *y = column(1), *z = column(2);
       for (std::size_t k = 0; k < count; ++k) {
-        set(k, openvdb::Vec3f(x[k], y[k], z[k]));
+        const std::size_t r = row(k);
+        set(k, openvdb::Vec3f(x[r], y[r], z[r]));
       }
       return;
     }
     case Kind::Id: {
-      const std::uint64_t* id = points.id.get() + begin;
-      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int64_t>(id[k]));
+      const std::uint64_t* id = points.id.get();
+      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int64_t>(id[row(k)]));
       return;
     }
     case Kind::Int: {
       const float* x = column(0);
-      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[k]));
+      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[row(k)]));
       return;
     }
     case Kind::Float: {
       const float* x = column(0);
-      for (std::size_t k = 0; k < count; ++k) set(k, x[k]);
+      for (std::size_t k = 0; k < count; ++k) set(k, x[row(k)]);
       return;
     }
   }
@@ -270,37 +266,18 @@ class GroupedValues final : public PointValues {
 
   void store(std::size_t attribute, const openvdb::Coord& origin, std::size_t count,
              char* to) const override {
-    Local& local = local_.local();
-    const std::size_t l = leafAt(origin, local.next);
+    std::size_t& next = next_.local();
+    const std::size_t l = leafAt(origin, next);
     const auto [begin, end] = points_.leafPoints(l);
     if (end - begin != count || attribute >= attributes_.size())
       throw std::logic_error("VDB points: values asked for a leaf the frame does not have");
-    local.next = l + 1;
+    next = l + 1;
     const GridAttribute& a = attributes_[attribute];
-    if (points_.later) orderColumns(points_.buckets.of[l], a, local.scratch);
     withArrayType<PositionArray>(
         a.kind, [&]<typename Array>(std::type_identity<Array>) { storeAs<Array>(l, a, to); });
   }
 
-  // The next bucket's columns put in order, attribute by attribute as the file holds them: the
-  // store then finds them in order (orderLater() does each once, whoever asks first).
-  bool prepareStep() const override {
-    if (!points_.later) return false;
-    const std::size_t buckets = points_.buckets.count();
-    const std::size_t step = nextStep_.fetch_add(1, std::memory_order_relaxed);
-    if (step >= attributes_.size() * buckets) return false;
-    orderColumns(step % buckets, attributes_[step / buckets], local_.local().scratch);
-    return true;
-  }
-
  private:
-  // A thread's own: the leaf after the last it stored (the encoder asks for leaves in the tree's
-  // order, which is nearly always the leaves' Coord order), and orderLater()'s scratch.
-  struct Local {
-    std::size_t next = 0;
-    BucketScratch scratch;
-  };
-
   // The index of the leaf at `origin`, tried first at `guess`.
   std::size_t leafAt(const openvdb::Coord& origin, std::size_t guess) const {
     const auto& origins = points_.leaves.origins;
@@ -309,14 +286,6 @@ class GroupedValues final : public PointValues {
     if (leaf == origins.end() || *leaf != origin)
       throw std::logic_error("VDB points: values asked for a leaf the frame does not have");
     return static_cast<std::size_t>(leaf - origins.begin());
-  }
-
-  // The columns attribute `a` reads, in order in bucket b (the offsets are ordered with the
-  // voxels).
-  void orderColumns(std::size_t b, const GridAttribute& a, BucketScratch& scratch) const {
-    if (a.kind == GridAttribute::Kind::Id) orderLater(points_, b, 0, scratch);
-    for (std::size_t j = 0; j < a.floatColumns(); ++j)
-      orderLater(points_, b, 1 + a.column + j, scratch);
   }
 
   template <typename Array>
@@ -349,56 +318,78 @@ class GroupedValues final : public PointValues {
   }
 
   // Leaf l's values of attribute `a` as an array that stores them as they are (NullCodec) holds
-  // them: the same bytes as storeAs()'s general way, but whole copies where the bytes are the
-  // column's (offsets, ids, floats) and, for the others, loops whose stores alias nothing (the
-  // general way's stores through `to` may alias anything, so it reloaded its pointers after each
-  // value).
+  // them: the same bytes as storeAs()'s general way, but copies of the offsets and, for the
+  // others, loops whose stores alias nothing (the general way's stores through `to` may alias
+  // anything, so it reloaded its pointers after each value), each value gathered from its row
+  // where the rows are not in order.
   void storePlain(std::size_t l, const GridAttribute& a, char* __restrict to) const {
+    const std::size_t begin = points_.leafPoints(l).first;
+    const std::size_t count = points_.leafPoints(l).second - begin;
+    if (points_.source) {
+      storeRows(a, count, to, [rows = points_.source.get() + begin](std::size_t k) {
+        return std::size_t{rows[k]};
+      });
+    } else {
+      storeRows(a, count, to, [begin](std::size_t k) { return begin + k; });
+    }
+  }
+
+  // The values of attribute `a` at rows row(0), … row(count − 1), at `to`.
+  template <typename Row>
+  void storeRows(const GridAttribute& a, std::size_t count, char* __restrict to,
+                 const Row& row) const {
     using Kind = GridAttribute::Kind;
-    const auto [begin, end] = points_.leafPoints(l);
-    const std::size_t count = end - begin;
-    const auto column = [&](std::size_t j) { return leafColumn(points_, a, j, l); };
-    switch (a.kind) {
-      case Kind::Position:  // the offsets, as openvdb::Vec3f's three floats
-        static_assert(sizeof(openvdb::Vec3f) == 3 * sizeof(float));
-        std::memcpy(to, points_.offset.get() + begin, count * sizeof(openvdb::Vec3f));
-        return;
-      case Kind::Id:  // std::uint64_t to std::int64_t keeps the bits
-        std::memcpy(to, points_.id.get() + begin, count * sizeof(std::uint64_t));
-        return;
-      case Kind::Float:
-        std::memcpy(to, column(0), count * sizeof(float));
-        return;
-      case Kind::Vector:
-        interleave(column(0), column(1), column(2), count, to);
-        return;
-      case Kind::Int:
-        toInt32(column(0), count, to);
-        return;
-    }
-  }
-
-  static void interleave(const float* __restrict x, const float* __restrict y,
-                         const float* __restrict z, std::size_t count, char* __restrict to) {
+    const auto column = [&](std::size_t j) -> const float* {
+      return points_.columns[a.column + j].get();
+    };
     constexpr std::size_t kFloat = sizeof(float);
-    for (std::size_t k = 0; k < count; ++k, to += 3 * kFloat) {
-      std::memcpy(to, x + k, kFloat);
-      std::memcpy(to + kFloat, y + k, kFloat);
-      std::memcpy(to + 2 * kFloat, z + k, kFloat);
-    }
-  }
-
-  static void toInt32(const float* __restrict x, std::size_t count, char* __restrict to) {
-    for (std::size_t k = 0; k < count; ++k) {
-      const auto v = static_cast<std::int32_t>(x[k]);
-      std::memcpy(to + sizeof v * k, &v, sizeof v);
+    switch (a.kind) {
+      case Kind::Position: {  // the offsets, as openvdb::Vec3f's three floats
+        static_assert(sizeof(openvdb::Vec3f) == 3 * sizeof(float));
+        const openvdb::Vec3f* const __restrict offset = points_.offset.get();
+        for (std::size_t k = 0; k < count; ++k)
+          std::memcpy(to + k * sizeof(openvdb::Vec3f), offset + row(k), sizeof(openvdb::Vec3f));
+        return;
+      }
+      case Kind::Id: {  // std::uint64_t to std::int64_t keeps the bits
+        const std::uint64_t* const __restrict id = points_.id.get();
+        for (std::size_t k = 0; k < count; ++k)
+          std::memcpy(to + k * sizeof(std::uint64_t), id + row(k), sizeof(std::uint64_t));
+        return;
+      }
+      case Kind::Float: {
+        const float* const __restrict x = column(0);
+        for (std::size_t k = 0; k < count; ++k) std::memcpy(to + k * kFloat, x + row(k), kFloat);
+        return;
+      }
+      case Kind::Vector: {
+        const float* const __restrict x = column(0);
+        const float* const __restrict y = column(1);
+        const float* const __restrict z = column(2);
+        for (std::size_t k = 0; k < count; ++k, to += 3 * kFloat) {
+          const std::size_t r = row(k);
+          std::memcpy(to, x + r, kFloat);
+          std::memcpy(to + kFloat, y + r, kFloat);
+          std::memcpy(to + 2 * kFloat, z + r, kFloat);
+        }
+        return;
+      }
+      case Kind::Int: {
+        const float* const __restrict x = column(0);
+        for (std::size_t k = 0; k < count; ++k) {
+          const auto v = static_cast<std::int32_t>(x[row(k)]);
+          std::memcpy(to + sizeof v * k, &v, sizeof v);
+        }
+        return;
+      }
     }
   }
 
   GroupedPoints& points_;
   std::vector<GridAttribute> attributes_;
-  mutable tbb::enumerable_thread_specific<Local> local_;
-  mutable std::atomic<std::size_t> nextStep_{0};  // prepareStep()'s next: attribute, bucket
+  // A thread's own: the leaf after the last it stored (the encoder asks for leaves in the tree's
+  // order, which is nearly always the leaves' Coord order).
+  mutable tbb::enumerable_thread_specific<std::size_t> next_;
 };
 
 // The frame's points grouped as the grid's position array places them.
@@ -475,7 +466,6 @@ template <typename PositionArray>
 vdbp::PointDataGrid::Ptr filledGrid(const FrameData& frame, const VdbCacheMetadata& meta,
                                     Grouping grouping) {
   GroupedPoints points = groupedPoints<PositionArray>(frame, grouping);
-  orderAllLater(points);
   const std::vector<GridAttribute> attributes = gridAttributes(frame.attributeNames);
   const auto descriptor = gridDescriptor<PositionArray>(attributes);
   return makeGrid(

@@ -527,40 +527,42 @@ struct RowKernels {
   }
 };
 
-// column[rank[i]] = column[i] for i < count, through a copy.
-template <typename T>
-void permute(T* __restrict column, const std::uint32_t* __restrict rank, std::size_t count,
-             std::vector<T>& copy) {
-  copy.assign(column, column + count);
-  for (std::size_t i = 0; i < count; ++i) column[rank[i]] = copy[i];
-}
-
 // Puts bucket b's points, in row order, in order by their keys (`keys`, each its leaf's place in
-// the bucket, then its voxel), rows in order among equal keys (a counting sort): its offsets are
-// moved, and each point's place is kept in `rank` for the columns the store puts in order later
-// (orderLater()). Each leaf's voxel ends and mask come from the sort's counts.
+// the bucket, then its voxel), rows in order among equal keys (a counting sort): each point's row
+// is kept in `source`, through which the store gathers its values. Each leaf's voxel ends and
+// mask are set from the counts as they are summed (one pass over the voxels, which outnumber the
+// points).
 void orderBucket(GroupedPoints& points, const std::uint16_t* keys, std::size_t b,
-                 BucketScratch& scratch) {
+                 std::vector<std::uint32_t>& counts) {
   const auto [begin, end] = points.bucketPoints(b);
   const std::size_t count = end - begin;
-  const std::size_t leaves = points.buckets.first[b + 1] - points.buckets.first[b];
+  const std::uint32_t firstLeaf = points.buckets.first[b], endLeaf = points.buckets.first[b + 1];
   const std::uint16_t* const key = keys + begin;
-  scratch.counts.assign(leaves << kVoxelBits, 0);
-  for (std::size_t i = 0; i < count; ++i) ++scratch.counts[key[i]];
-  std::uint32_t sum = 0;
-  for (std::uint32_t& c : scratch.counts) sum += std::exchange(c, sum);
-  std::uint32_t* const rank = points.rank.get() + begin;
-  for (std::size_t i = 0; i < count; ++i) rank[i] = scratch.counts[key[i]]++;
-  // (counts[k] is now the end of key k's points in the bucket.)
-  for (std::uint32_t l = points.buckets.first[b]; l < points.buckets.first[b + 1]; ++l) {
-    const std::uint32_t p = l - points.buckets.first[b];
-    setVoxelEnds(points, l, scratch.counts.data() + (std::size_t{p} << kVoxelBits),
-                 static_cast<std::uint32_t>(points.starts[l] - begin));
+  counts.assign(std::size_t{endLeaf - firstLeaf} << kVoxelBits, 0);
+  for (std::size_t i = 0; i < count; ++i) ++counts[key[i]];
+  // Each key's count becomes its first place; each voxel's end and mask bit are set.
+  auto at = static_cast<std::uint32_t>(begin);
+  for (std::uint32_t l = firstLeaf; l < endLeaf; ++l) {
+    std::uint32_t* const first = counts.data() + (std::size_t{l - firstLeaf} << kVoxelBits);
+    openvdb::PointDataIndex32* const ends = points.leaves.voxelEnds.get() + l * Leaf::SIZE;
+    Leaf::NodeMaskType& mask = points.leaves.masks[l];
+    const auto leafBegin = static_cast<std::uint32_t>(points.starts[l]);
+    for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
+      std::uint64_t word = 0;
+      for (openvdb::Index bit = 0; bit < 64; ++bit) {
+        const std::uint32_t n = first[64 * w + bit];
+        first[64 * w + bit] = at;
+        at += n;
+        ends[64 * w + bit] = at - leafBegin;
+        word |= std::uint64_t{n != 0} << bit;
+      }
+      mask.template getWord<std::uint64_t>(w) = word;
+    }
   }
-  permute(points.offset.get() + begin, rank, count, scratch.vectors);
+  std::uint32_t* const source = points.source.get();
+  for (std::size_t i = 0; i < count; ++i)
+    source[counts[key[i]]++] = static_cast<std::uint32_t>(begin + i);
 }
-
-constexpr std::uint8_t kOrdering = 1, kOrdered = 2;
 
 // The fast way, when the leaves' bounding box holds few enough leaves to count them in a table
 // (any effect of sane size): a stable counting sort of the rows by the leaf's index in the box
@@ -742,17 +744,15 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
                         scatter(source[j], at, runBegin, runEnd, points.columns[j].get());
                     });
   // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
-  points.rank = allocateLargeArray<std::uint32_t>(n);
+  points.source = allocateLargeArray<std::uint32_t>(n);
   points.buckets = std::move(buckets);
   describeLeaves(points);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, bucketCount),
                     [&](const tbb::blocked_range<std::size_t>& some) {
-                      BucketScratch scratch;
+                      std::vector<std::uint32_t> counts;
                       for (std::size_t b = some.begin(); b < some.end(); ++b)
-                        orderBucket(points, keys.get(), b, scratch);
+                        orderBucket(points, keys.get(), b, counts);
                     });
-  const std::size_t later = bucketCount * points.laterColumns();
-  points.later = std::make_unique<std::atomic<std::uint8_t>[]>(later);  // (zeroed: not yet)
   return points;
 }
 
@@ -772,40 +772,6 @@ Buckets::Buckets(const std::vector<std::size_t>& starts) : of(starts.size() - 1)
     points += count;
   }
   first.push_back(static_cast<std::uint32_t>(of.size()));
-}
-
-void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScratch& scratch) {
-  std::atomic<std::uint8_t>& state = points.later[b * points.laterColumns() + s];
-  if (state.load(std::memory_order_acquire) == kOrdered) return;
-  std::uint8_t expected = 0;
-  if (!state.compare_exchange_strong(expected, kOrdering, std::memory_order_acquire)) {
-    while (state.load(std::memory_order_acquire) != kOrdered) std::this_thread::yield();
-    return;
-  }
-  const auto [begin, end] = points.bucketPoints(b);
-  const std::size_t count = end - begin;
-  const std::uint32_t* const rank = points.rank.get() + begin;
-  try {
-    if (s == 0)
-      permute(points.id.get() + begin, rank, count, scratch.ids);
-    else
-      permute(points.columns[s - 1].get() + begin, rank, count, scratch.floats);
-  } catch (...) {
-    state.store(0, std::memory_order_release);  // (an allocation failed: another may try)
-    throw;
-  }
-  state.store(kOrdered, std::memory_order_release);
-}
-
-void orderAllLater(GroupedPoints& points) {
-  if (!points.later) return;
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, points.buckets.count()),
-                    [&](const tbb::blocked_range<std::size_t>& some) {
-                      BucketScratch scratch;
-                      for (std::size_t b = some.begin(); b < some.end(); ++b)
-                        for (std::size_t s = 0; s < points.laterColumns(); ++s)
-                          orderLater(points, b, s, scratch);
-                    });
 }
 
 template <bool Quantised>

@@ -5,7 +5,6 @@
 
 #include <openvdb/points/PointDataGrid.h>
 
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -30,8 +29,8 @@ struct Buckets {
 
 /// The points in the order the leaves' arrays hold them: the leaves in Coord order (ascending, as
 /// Coord's operator< orders them), a leaf's points by voxel, and in row order within a voxel. Each
-/// point's values are copied here in that order, so that a leaf's array is one stretch of each
-/// column, written to the file as it is.
+/// point's values are copied here, point k's at row(k): in that order, or each bucket's in the
+/// frame's row order (Grouping::Any).
 struct GroupedPoints {
   std::vector<std::size_t> starts;  // each leaf's first point, and the end
   // Each leaf's origin, point count, mask and voxel ends (the encoder's description of the
@@ -42,22 +41,21 @@ struct GroupedPoints {
   LargeArray<std::uint64_t> id;
   // velocity x, y, z, age, life, mass, then the frame's attribute columns, in the frame's order
   std::vector<LargeArray<float>> columns;
-  // Where set (Grouping::Any), `id` and `columns` are put in order bucket by bucket by the store
-  // itself, as the file is written (orderLater()): each bucket's rows of them are still in row
-  // order, rank[k] the place in its bucket of the point whose values are at row k, and
-  // later[b * laterColumns() + s] tells whether bucket b's column s (0: id, then columns[s − 1])
-  // is in order, being put in order or not yet.
-  LargeArray<std::uint32_t> rank;
+  // Where set (Grouping::Any), `offset`, `id` and `columns` hold each bucket's rows in the
+  // frame's row order, not in the leaves' order: point k's values are at row source[k] (in its
+  // own bucket). The store gathers each leaf's values through it straight into the file's bytes,
+  // the bucket's rows in cache: putting each column in order first took a copy and a scatter of
+  // it, and the store a copy more. Null: point k's values are at row k.
+  LargeArray<std::uint32_t> source;
   Buckets buckets;
-  std::unique_ptr<std::atomic<std::uint8_t>[]> later;
 
   GroupedPoints(std::size_t n, std::size_t floatColumnCount)
       : offset(allocateLargeArray<openvdb::Vec3f>(n)), id(allocateLargeArray<std::uint64_t>(n)) {
     for (std::size_t j = 0; j < floatColumnCount; ++j)
       columns.push_back(allocateLargeArray<float>(n));
   }
-  // The columns `later` tells of for each bucket: the ids, then the float columns.
-  std::size_t laterColumns() const { return 1 + columns.size(); }
+  // The row of `offset`, `id` and `columns` that holds point k's values.
+  std::size_t row(std::size_t k) const { return source ? source[k] : k; }
   // The points of leaf l: [first, second).
   std::pair<std::size_t, std::size_t> leafPoints(std::size_t l) const {
     return {starts[l], starts[l + 1]};
@@ -76,19 +74,11 @@ inline constexpr std::size_t kLifeColumn = 4;
 inline constexpr std::size_t kMassColumn = 5;
 inline constexpr std::size_t kStandardFloatColumns = 6;
 
-// What the orderings reuse from one bucket to the next (orderLater()).
-struct BucketScratch {
-  std::vector<std::uint32_t> counts;
-  std::vector<openvdb::Vec3f> vectors;
-  std::vector<std::uint64_t> ids;
-  std::vector<float> floats;
-};
-
 /// Which way the points are grouped: only tests ask for the general way.
 enum class Grouping {
   /// A counting sort of the rows by bucket of leaves, then by leaf and voxel within each bucket,
   /// where the leaves' bounding box is small enough to count them in a table (any effect of sane
-  /// size); the sort below otherwise. Its `id` and `columns` are put in order by orderLater().
+  /// size); the sort below otherwise. Its `id` and `columns` are read through `source`.
   Any,
   /// Every point's (leaf, voxel, row) sorted: the general way.
   Sorted,
@@ -103,16 +93,5 @@ template <bool Quantised>
 GroupedPoints groupPoints(const FrameData& frame, Grouping grouping);
 extern template GroupedPoints groupPoints<false>(const FrameData&, Grouping);
 extern template GroupedPoints groupPoints<true>(const FrameData&, Grouping);
-
-/// Puts column s (0: id, then columns[s − 1]) of bucket b of points grouped by Grouping::Any in
-/// order, once: the first thread to ask does it, another that asks meanwhile waits for it (it is
-/// running, and takes microseconds). The store asks before reading a leaf's values, so this runs
-/// beside the kernel's copy of the chunk before, in time the writing threads would otherwise
-/// wait. Thread-safe for any b and s.
-void orderLater(GroupedPoints& points, std::size_t b, std::size_t s, BucketScratch& scratch);
-
-/// Every column in order (OpenVDB's own writer reads the grouped points whole); nothing for
-/// points grouped by Grouping::Sorted, which are in order already.
-void orderAllLater(GroupedPoints& points);
 
 }  // namespace tickfx::io

@@ -581,7 +581,6 @@ class DeferredBuffers final : public EncodedPointsFile::Deferred {
     for (std::size_t p = 0; p < parts_.size(); ++p) offsets_[p + 1] = offsets_[p] + parts_[p].size;
   }
   std::size_t size() const override { return offsets_.back(); }
-  bool prepareStep() const override { return all_.values->prepareStep(); }
   void fill(std::size_t from, std::size_t to, char* out) const override {
     // The parts that [from, to) overlaps, the first found by a binary search.
     auto p = static_cast<std::size_t>(std::upper_bound(offsets_.begin(), offsets_.end(), from) -
@@ -1103,12 +1102,12 @@ void EncodedPointsFile::write(std::ostream& out) const {
   const std::size_t size = this->size(), chunks = chunkCount(size);
   const auto threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   // Chunk c is made into slot c % slots once chunk c − slots is written: made by whichever
-  // thread claims it first, written by this one, in order. The other threads make chunks while
-  // a slot is free and otherwise do the deferred bytes' work ahead (Deferred::prepareStep()), so
-  // that this thread, copying into the kernel one chunk after another, finds the next made: a
-  // pipeline whose threads each made and wrote (TBB's) left the kernel idle while one thread
-  // made the positions' chunks and the other put the columns in order. With one thread, this
-  // one makes each chunk before writing it, into the one slot, which stays in cache.
+  // thread claims it first, written by this one, in order. Every thread makes the next chunk
+  // while a slot is free; this one, copying into the kernel one chunk after another, makes one
+  // only while the next it writes is being made (waiting then left the kernel idle some 3 ms a
+  // frame of 10⁶ points on 2 threads). A pipeline whose threads each made and wrote (TBB's) left
+  // the kernel idle while one thread made the positions' chunks. With one thread, this one makes
+  // each chunk before writing it, into the one slot, which stays in cache.
   const std::size_t slots = threads == 1 ? 1 : std::max<std::size_t>(8, 2 * threads);
   const FileBytes::Storage room = FileBytes::allocate(slots * kChunkBytes);
   std::atomic<std::size_t> claimed{0}, written{0};
@@ -1119,11 +1118,10 @@ void EncodedPointsFile::write(std::ostream& out) const {
     fill(from, to, room.get() + (c % slots) * kChunkBytes);
     made[c].store(true, std::memory_order_release);
   };
-  // Claims the next chunk and makes it, where its slot is free and, for `only`, it is `only`.
-  const auto claimAndMake = [&](std::size_t only) {
+  // Claims the next chunk and makes it, where its slot is free.
+  const auto claimAndMake = [&] {
     std::size_t c = claimed.load(std::memory_order_relaxed);
-    while (c < chunks && c < written.load(std::memory_order_acquire) + slots &&
-           (only == chunks || c == only)) {
+    while (c < chunks && c < written.load(std::memory_order_acquire) + slots) {
       if (claimed.compare_exchange_weak(c, c + 1, std::memory_order_relaxed)) {
         makeChunk(c);
         return true;
@@ -1143,8 +1141,7 @@ void EncodedPointsFile::write(std::ostream& out) const {
     makers.run([&] {
       try {
         while (!stop.load(std::memory_order_acquire)) {
-          if (claimAndMake(chunks)) continue;
-          if (deferred_ && deferred_->prepareStep()) continue;
+          if (claimAndMake()) continue;
           if (claimed.load(std::memory_order_relaxed) >= chunks) break;
           std::this_thread::yield();
         }
@@ -1156,9 +1153,7 @@ void EncodedPointsFile::write(std::ostream& out) const {
   try {
     for (std::size_t c = 0; c < chunks && !stop.load(std::memory_order_acquire); ++c) {
       while (!made[c].load(std::memory_order_acquire) && !stop.load(std::memory_order_acquire)) {
-        // Chunk c is being made by another: a step ahead meanwhile (a bucket's column, some
-        // 20 µs), rather than nothing (the write then took 11.2–11.4 ms against 11.7–12.4).
-        if (!claimAndMake(c) && !(deferred_ && deferred_->prepareStep())) std::this_thread::yield();
+        if (!claimAndMake()) std::this_thread::yield();  // (chunk c is being made)
       }
       if (stop.load(std::memory_order_acquire)) break;
       const auto [from, to] = chunkBytes(c, size);

@@ -52,12 +52,6 @@ class PointValues {
   /// attributes.
   virtual void store(std::size_t attribute, const openvdb::Coord& origin, std::size_t count,
                      char* to) const = 0;
-  /// Does one more step of the work store() would otherwise do when asked, in the order the file
-  /// asks for it, and returns true; false when no step is left. EncodedPointsFile::write() calls
-  /// it on the threads that make chunks while none is free to be made (the kernel copying the
-  /// header and positions, whose chunks take little making). Called from several threads at
-  /// once, beside store().
-  virtual bool prepareStep() const { return false; }
 };
 
 /// Uninitialised storage for `n` values of T (a type a plain copy creates, as numbers and
@@ -111,8 +105,6 @@ class EncodedPointsFile {
     /// Writes bytes [from, to) of them at `out`. Called from several threads at once, for
     /// ranges that do not overlap.
     virtual void fill(std::size_t from, std::size_t to, char* out) const = 0;
-    /// A step of what fill() would do when asked, done ahead (PointValues::prepareStep()).
-    virtual bool prepareStep() const { return false; }
   };
 
   /// `known`: the file's bytes but the deferred ones, which go at `deferredAt`.
