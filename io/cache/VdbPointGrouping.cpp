@@ -315,12 +315,15 @@ bool sortByKeys(std::vector<PointSlot>& slots) {
 
 // Consecutive leaves gathered for the counting sort: at most kBucketLeaves leaves and, unless a
 // leaf alone holds more, kBucketPoints points or a kBucketShare-th of the frame's, whichever is
-// more. Rows are first scattered by bucket (some 140 streams at 10⁶ and 10⁷ points over a 100 m
+// more. Rows are first scattered by bucket (some 550 streams at 10⁶ and 10⁷ points over a 100 m
 // box, where a scatter by leaf wrote 2200 and missed the cache on nearly every value), each
-// bucket's rows in row order; then each bucket, small enough for the cache, is put in order by
-// leaf and voxel.
-constexpr std::size_t kBucketPoints = 8192;
-constexpr std::size_t kBucketShare = 128;
+// bucket's rows in row order; then each bucket is put in order by leaf and voxel, and the store
+// gathers each leaf's values from its bucket's rows. A bucket's rows of a column should stay in
+// the first caches while its leaves are gathered (2048 offsets take 24 KiB): buckets of up to 16
+// leaves and a 128th of the frame (140 streams) made the frame 6 % slower at 10⁶ points and 21 %
+// slower at 10⁷, where a bucket's offsets took 900 KiB (docs/performance.md).
+constexpr std::size_t kBucketPoints = 2048;
+constexpr std::size_t kBucketShare = 512;
 constexpr std::uint32_t kBucketLeaves = 16;
 constexpr unsigned kVoxelBits = 3 * Leaf::LOG2DIM;  // a voxel's index in its leaf
 static_assert(std::size_t{1} << kVoxelBits == Leaf::SIZE);
