@@ -100,18 +100,13 @@ using Leaf = vdbp::PointDataTree::LeafNodeType;
 
 // What an attribute of the grid holds, in the descriptor's order: P, v, id, age, life, mass, then
 // the frame's attribute groups as Houdini's typed attributes (hitnum an int32, hitpos a vec3s).
-// `column`: the first of GroupedPoints::columns it reads (a vector reads three).
+// `column`: the GroupedPoints::columns it reads, of one float a row; a vector reads a column of
+// rows of three (the velocity) or the three columns from `column` on.
 struct GridAttribute {
   enum class Kind { Position, Vector, Id, Float, Int };
   std::string name;
   Kind kind = Kind::Float;
   std::size_t column = 0;
-
-  // How many of GroupedPoints::columns it reads, from `column` on (the offsets and the ids are
-  // columns apart).
-  std::size_t floatColumns() const {
-    return kind == Kind::Vector ? 3 : kind == Kind::Float || kind == Kind::Int ? 1 : 0;
-  }
 };
 
 // The grid's attributes of a frame with these attribute columns.
@@ -198,9 +193,11 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
       return;
     }
     case Kind::Vector: {
-      const float *x = column(0), *y = column(1), *z = column(2);
+      const bool inRows = points.widths[a.column] == 3;
+      const float *x = column(0), *y = inRows ? x + 1 : column(1), *z = inRows ? x + 2 : column(2);
+      const std::size_t width = inRows ? 3 : 1;
       for (std::size_t k = 0; k < count; ++k) {
-        const std::size_t r = row(k);
+        const std::size_t r = row(k) * width;
         set(k, openvdb::Vec3f(x[r], y[r], z[r]));
       }
       return;
@@ -363,6 +360,12 @@ class GroupedValues final : public PointValues {
         return;
       }
       case Kind::Vector: {
+        if (points_.widths[a.column] == 3) {  // a row of three, as the array holds it
+          const float* const __restrict xyz = column(0);
+          for (std::size_t k = 0; k < count; ++k)
+            std::memcpy(to + k * 3 * kFloat, xyz + row(k) * 3, 3 * kFloat);
+          return;
+        }
         const float* const __restrict x = column(0);
         const float* const __restrict y = column(1);
         const float* const __restrict z = column(2);

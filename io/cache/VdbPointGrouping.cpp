@@ -330,14 +330,28 @@ static_assert(std::size_t{1} << kVoxelBits == Leaf::SIZE);
 static_assert((kBucketLeaves << kVoxelBits) - 1 <= std::numeric_limits<std::uint16_t>::max(),
               "a point's key in its bucket (leaf, voxel) fits the voxel column's 16 bits");
 
-std::vector<const float*> pointFloatColumns(const FrameData& frame) {
-  std::vector<const float*> columns(kStandardFloatColumns);
-  for (std::size_t c = 0; c < 3; ++c) columns[kVelocityColumn + c] = frame.velocity[c].data();
-  columns[kAgeColumn] = frame.age.data();
-  columns[kLifeColumn] = frame.life.data();
-  columns[kMassColumn] = frame.mass.data();
-  for (const FloatColumn& a : frame.attributes) columns.push_back(a.data());
+// A float column of GroupedPoints from the frame: `width` of the frame's columns a row.
+struct SourceColumn {
+  std::array<const float*, 3> lanes{};
+  std::size_t width = 1;
+};
+
+// GroupedPoints::columns' sources, in its order.
+std::vector<SourceColumn> pointFloatColumns(const FrameData& frame) {
+  std::vector<SourceColumn> columns(kStandardFloatColumns);
+  columns[kVelocityColumn] = {
+      {frame.velocity[0].data(), frame.velocity[1].data(), frame.velocity[2].data()}, 3};
+  columns[kAgeColumn] = {{frame.age.data()}, 1};
+  columns[kLifeColumn] = {{frame.life.data()}, 1};
+  columns[kMassColumn] = {{frame.mass.data()}, 1};
+  for (const FloatColumn& a : frame.attributes) columns.push_back({{a.data()}, 1});
   return columns;
+}
+
+std::vector<std::size_t> columnWidths(const std::vector<SourceColumn>& columns) {
+  std::vector<std::size_t> widths;
+  for (const SourceColumn& c : columns) widths.push_back(c.width);
+  return widths;
 }
 
 // Each leaf's point count, from the starts, and room for its voxel ends and mask.
@@ -374,8 +388,8 @@ template <bool Quantised>
 GroupedPoints sortedPoints(const FrameData& frame) {
   std::vector<PointSlot> slots = slotsInRowOrder<Quantised>(frame);
   if (!sortByKeys(slots)) par::parallel_sort(slots.begin(), slots.end());
-  const std::vector<const float*> source = pointFloatColumns(frame);
-  GroupedPoints points(slots.size(), source.size());
+  const std::vector<SourceColumn> source = pointFloatColumns(frame);
+  GroupedPoints points(slots.size(), columnWidths(source));
   const Positions positions(frame);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -383,8 +397,11 @@ GroupedPoints sortedPoints(const FrameData& frame) {
                         const std::size_t r = slots[k].row;
                         positions.voxel<Quantised>(r, &points.offset[k]);
                         points.id[k] = frame.id[r];
-                        for (std::size_t j = 0; j < source.size(); ++j)
-                          points.columns[j][k] = source[j][r];
+                        for (std::size_t j = 0; j < source.size(); ++j) {
+                          for (std::size_t lane = 0; lane < source[j].width; ++lane)
+                            points.columns[j][k * source[j].width + lane] =
+                                source[j].lanes[lane][r];
+                        }
                       }
                     });
   for (std::size_t k = 0; k < slots.size(); ++k) {
@@ -428,6 +445,20 @@ void scatter(const T* __restrict from, const std::uint32_t* __restrict at, std::
   for (std::size_t i = begin; i < end; ++i) {
     prefetchNextLine(to + at[i]);
     to[at[i]] = from[i];
+  }
+}
+
+// to[3 at[i] + c] = from[c][i] for rows [begin, end): three columns into rows of three, one
+// stream a bucket rather than three.
+void scatterRows(const std::array<const float*, 3>& from, const std::uint32_t* __restrict at,
+                 std::size_t begin, std::size_t end, float* __restrict to) {
+  const float* __restrict x = from[0], * __restrict y = from[1], * __restrict z = from[2];
+  for (std::size_t i = begin; i < end; ++i) {
+    float* const row = to + std::size_t{3} * at[i];
+    prefetchNextLine(row);
+    row[0] = x[i];
+    row[1] = y[i];
+    row[2] = z[i];
   }
 }
 
@@ -669,8 +700,8 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     }
   });
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
-  const std::vector<const float*> source = pointFloatColumns(frame);
-  GroupedPoints points(n, source.size());
+  const std::vector<SourceColumn> source = pointFloatColumns(frame);
+  GroupedPoints points(n, columnWidths(source));
   // Each row's key in its bucket, at its place there: its leaf's place in the bucket, its voxel.
   const LargeArray<std::uint16_t> keys = allocateLargeArray<std::uint16_t>(n);
   // The leaves that hold points, in order (each one's first point and origin), and the buckets.
@@ -714,38 +745,43 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   // of its leaf in the bucket and its voxel, then its values, one column at a time over a run of
   // chunks: a column's writes go to one line a bucket at a time, which stay in cache from one
   // chunk to the next (all the columns of a chunk at once would evict each other's lines).
-  par::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
-                    [&](const tbb::blocked_range<std::size_t>& run) {
-                      std::uint32_t* const at = rowAt.get();
-                      std::uint16_t* const __restrict key = keys.get();
-                      openvdb::Vec3f* const __restrict offset = points.offset.get();
-                      PlacedRows placed;
-                      for (std::size_t chunk = run.begin(); chunk < run.end(); ++chunk) {
-                        std::uint32_t* const chunkNext = next.data() + chunk * bucketCount;
-                        const auto [begin, end] = chunkRange(chunk);
-                        for (std::size_t first = begin; first < end; first += kPlacedRows) {
-                          const std::size_t rows = std::min(kPlacedRows, end - first);
-                          kernels.place(positions, first, rows, placed);
-                          for (std::size_t k = 0; k < rows; ++k) {
-                            const std::uint32_t p = bucketPlace[at[first + k]];
-                            const std::uint32_t to = chunkNext[p >> 4]++;
-                            at[first + k] = to;
-                            prefetchNextLine(key + to);
-                            prefetchNextLine(offset + to);
-                            key[to] = static_cast<std::uint16_t>(
-                                ((p & 15) << kVoxelBits) |
-                                static_cast<std::uint32_t>(Leaf::coordToOffset(placed.voxel(k))));
-                            offset[to] = openvdb::Vec3f(placed.offset[0][k], placed.offset[1][k],
-                                                        placed.offset[2][k]);
-                          }
-                        }
-                      }
-                      const std::size_t runBegin = chunkRange(run.begin()).first;
-                      const std::size_t runEnd = chunkRange(run.end() - 1).second;
-                      scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
-                      for (std::size_t j = 0; j < source.size(); ++j)
-                        scatter(source[j], at, runBegin, runEnd, points.columns[j].get());
-                    });
+  par::parallel_for(
+      tbb::blocked_range<std::size_t>(0, chunks, 1),
+      [&](const tbb::blocked_range<std::size_t>& run) {
+        std::uint32_t* const at = rowAt.get();
+        std::uint16_t* const __restrict key = keys.get();
+        openvdb::Vec3f* const __restrict offset = points.offset.get();
+        PlacedRows placed;
+        for (std::size_t chunk = run.begin(); chunk < run.end(); ++chunk) {
+          std::uint32_t* const chunkNext = next.data() + chunk * bucketCount;
+          const auto [begin, end] = chunkRange(chunk);
+          for (std::size_t first = begin; first < end; first += kPlacedRows) {
+            const std::size_t rows = std::min(kPlacedRows, end - first);
+            kernels.place(positions, first, rows, placed);
+            for (std::size_t k = 0; k < rows; ++k) {
+              const std::uint32_t p = bucketPlace[at[first + k]];
+              const std::uint32_t to = chunkNext[p >> 4]++;
+              at[first + k] = to;
+              prefetchNextLine(key + to);
+              prefetchNextLine(offset + to);
+              key[to] = static_cast<std::uint16_t>(
+                  ((p & 15) << kVoxelBits) |
+                  static_cast<std::uint32_t>(Leaf::coordToOffset(placed.voxel(k))));
+              offset[to] =
+                  openvdb::Vec3f(placed.offset[0][k], placed.offset[1][k], placed.offset[2][k]);
+            }
+          }
+        }
+        const std::size_t runBegin = chunkRange(run.begin()).first;
+        const std::size_t runEnd = chunkRange(run.end() - 1).second;
+        scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
+        for (std::size_t j = 0; j < source.size(); ++j) {
+          if (source[j].width == 3)
+            scatterRows(source[j].lanes, at, runBegin, runEnd, points.columns[j].get());
+          else
+            scatter(source[j].lanes[0], at, runBegin, runEnd, points.columns[j].get());
+        }
+      });
   // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.
   points.source = allocateLargeArray<std::uint32_t>(n);
   points.buckets = std::move(buckets);

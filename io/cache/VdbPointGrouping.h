@@ -39,8 +39,11 @@ struct GroupedPoints {
   // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
   LargeArray<openvdb::Vec3f> offset;  // each point's position's offset in its voxel
   LargeArray<std::uint64_t> id;
-  // velocity x, y, z, age, life, mass, then the frame's attribute columns, in the frame's order
+  // Float values, each column `widths[c]` floats a row: the velocity's x, y, z in rows of three
+  // (scattered as one stream rather than three, and read whole), then the ages, lives and
+  // masses, then the frame's attribute columns, one float a row (kStandardFloatColumns).
   std::vector<LargeArray<float>> columns;
+  std::vector<std::size_t> widths;
   // Where set (Grouping::Any), `offset`, `id` and `columns` hold each bucket's rows in the
   // frame's row order, not in the leaves' order: point k's values are at row source[k] (in its
   // own bucket). The store gathers each leaf's values through it straight into the file's bytes,
@@ -49,10 +52,11 @@ struct GroupedPoints {
   LargeArray<std::uint32_t> source;
   Buckets buckets;
 
-  GroupedPoints(std::size_t n, std::size_t floatColumnCount)
-      : offset(allocateLargeArray<openvdb::Vec3f>(n)), id(allocateLargeArray<std::uint64_t>(n)) {
-    for (std::size_t j = 0; j < floatColumnCount; ++j)
-      columns.push_back(allocateLargeArray<float>(n));
+  GroupedPoints(std::size_t n, std::vector<std::size_t> columnWidths)
+      : offset(allocateLargeArray<openvdb::Vec3f>(n)),
+        id(allocateLargeArray<std::uint64_t>(n)),
+        widths(std::move(columnWidths)) {
+    for (const std::size_t width : widths) columns.push_back(allocateLargeArray<float>(n * width));
   }
   // The row of `offset`, `id` and `columns` that holds point k's values.
   std::size_t row(std::size_t k) const { return source ? source[k] : k; }
@@ -66,13 +70,14 @@ struct GroupedPoints {
   }
 };
 
-/// GroupedPoints::columns' first ones, from the frame's standard columns: where each starts.
-/// pointFloatColumns() fills them, and the cache's grid attributes read them, by these names.
-inline constexpr std::size_t kVelocityColumn = 0;  // x, y, z
-inline constexpr std::size_t kAgeColumn = 3;
-inline constexpr std::size_t kLifeColumn = 4;
-inline constexpr std::size_t kMassColumn = 5;
-inline constexpr std::size_t kStandardFloatColumns = 6;
+/// GroupedPoints::columns' first ones, from the frame's standard columns: the velocity's x, y, z
+/// in rows of three, then the ages, lives and masses one float a row. The frame's attribute
+/// columns follow, one float a row.
+inline constexpr std::size_t kVelocityColumn = 0;
+inline constexpr std::size_t kAgeColumn = 1;
+inline constexpr std::size_t kLifeColumn = 2;
+inline constexpr std::size_t kMassColumn = 3;
+inline constexpr std::size_t kStandardFloatColumns = 4;
 
 /// Which way the points are grouped: only tests ask for the general way.
 enum class Grouping {
