@@ -128,6 +128,18 @@ std::vector<GridAttribute> gridAttributes(const std::vector<std::string>& attrib
   return attributes;
 }
 
+// The x, y and z of vector attribute `a`: lane j of row r at lanes[j][r * stride], from a column
+// of rows of three (stride 3) or three columns of one float a row (stride 1).
+struct VectorLanes {
+  std::array<const float*, 3> lanes;
+  std::size_t stride;
+};
+VectorLanes vectorLanes(const GroupedPoints& points, const GridAttribute& a) {
+  const float* const x = points.columns[a.column].get();
+  if (points.widths[a.column] == 3) return {{x, x + 1, x + 2}, 3};
+  return {{x, points.columns[a.column + 1].get(), points.columns[a.column + 2].get()}, 1};
+}
+
 // Calls f(std::type_identity<Array>()) with the array type of attributes of `kind`.
 template <typename PositionArray, typename F>
 void withArrayType(GridAttribute::Kind kind, const F& f) {
@@ -184,7 +196,7 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
   using Kind = GridAttribute::Kind;
   const std::size_t begin = points.leafPoints(l).first;
   const std::size_t count = points.leafPoints(l).second - begin;
-  const auto column = [&](std::size_t j) { return points.columns[a.column + j].get(); };
+  const float* const column = points.columns[a.column].get();  // (Float, Int)
   const auto row = [&](std::size_t k) { return points.row(begin + k); };
   switch (a.kind) {
     case Kind::Position: {
@@ -193,12 +205,10 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
       return;
     }
     case Kind::Vector: {
-      const bool inRows = points.widths[a.column] == 3;
-      const float *x = column(0), *y = inRows ? x + 1 : column(1), *z = inRows ? x + 2 : column(2);
-      const std::size_t width = inRows ? 3 : 1;
+      const auto [lanes, stride] = vectorLanes(points, a);
       for (std::size_t k = 0; k < count; ++k) {
-        const std::size_t r = row(k) * width;
-        set(k, openvdb::Vec3f(x[r], y[r], z[r]));
+        const std::size_t r = row(k) * stride;
+        set(k, openvdb::Vec3f(lanes[0][r], lanes[1][r], lanes[2][r]));
       }
       return;
     }
@@ -208,12 +218,12 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
       return;
     }
     case Kind::Int: {
-      const float* x = column(0);
+      const float* x = column;
       for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[row(k)]));
       return;
     }
     case Kind::Float: {
-      const float* x = column(0);
+      const float* x = column;
       for (std::size_t k = 0; k < count; ++k) set(k, x[row(k)]);
       return;
     }
@@ -336,9 +346,7 @@ class GroupedValues final : public PointValues {
   void storeRows(const GridAttribute& a, std::size_t count, char* __restrict to,
                  const Row& row) const {
     using Kind = GridAttribute::Kind;
-    const auto column = [&](std::size_t j) -> const float* {
-      return points_.columns[a.column + j].get();
-    };
+    const float* const column = points_.columns[a.column].get();  // (Float, Int)
     constexpr std::size_t kFloat = sizeof(float);
     switch (a.kind) {
       case Kind::Position: {  // the offsets, as openvdb::Vec3f's three floats
@@ -355,20 +363,19 @@ class GroupedValues final : public PointValues {
         return;
       }
       case Kind::Float: {
-        const float* const __restrict x = column(0);
+        const float* const __restrict x = column;
         for (std::size_t k = 0; k < count; ++k) std::memcpy(to + k * kFloat, x + row(k), kFloat);
         return;
       }
       case Kind::Vector: {
-        if (points_.widths[a.column] == 3) {  // a row of three, as the array holds it
-          const float* const __restrict xyz = column(0);
+        const VectorLanes v = vectorLanes(points_, a);
+        if (v.stride == 3) {  // rows of three, as the array holds them
+          const float* const __restrict xyz = v.lanes[0];
           for (std::size_t k = 0; k < count; ++k)
             std::memcpy(to + k * 3 * kFloat, xyz + row(k) * 3, 3 * kFloat);
           return;
         }
-        const float* const __restrict x = column(0);
-        const float* const __restrict y = column(1);
-        const float* const __restrict z = column(2);
+        const float* const __restrict x = v.lanes[0], * const __restrict y = v.lanes[1], * const __restrict z = v.lanes[2];
         for (std::size_t k = 0; k < count; ++k, to += 3 * kFloat) {
           const std::size_t r = row(k);
           std::memcpy(to, x + r, kFloat);
@@ -378,7 +385,7 @@ class GroupedValues final : public PointValues {
         return;
       }
       case Kind::Int: {
-        const float* const __restrict x = column(0);
+        const float* const __restrict x = column;
         for (std::size_t k = 0; k < count; ++k) {
           const auto v = static_cast<std::int32_t>(x[row(k)]);
           std::memcpy(to + sizeof v * k, &v, sizeof v);

@@ -363,21 +363,23 @@ void describeLeaves(GroupedPoints& points) {
   leaves.masks.resize(leaves.size());
 }
 
-// Leaf l's voxel ends and mask, from each of its voxels' end in some run of points where the
-// leaf's begin at `leafBegin`: what setOffsets(ends, /*updateValueMask=*/true) sets on a leaf,
-// without its two calls a voxel.
-void setVoxelEnds(GroupedPoints& points, std::size_t l, const std::uint32_t* end,
-                  std::uint32_t leafBegin) {
+// Leaf l's voxel ends and mask from its voxels' point counts (Leaf::SIZE of them, at `counts`),
+// the leaf's points beginning at `first` in some run of points: what setOffsets(ends,
+// /*updateValueMask=*/true) sets on a leaf, without its two calls a voxel. Each count is replaced
+// by its voxel's first place in the run (a counting sort's starts).
+void setVoxelEnds(GroupedPoints& points, std::size_t l, std::uint32_t* counts,
+                  std::uint32_t first) {
   openvdb::PointDataIndex32* const ends = points.leaves.voxelEnds.get() + l * Leaf::SIZE;
   Leaf::NodeMaskType& mask = points.leaves.masks[l];
-  std::uint32_t previous = leafBegin;
+  std::uint32_t at = first;
   for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
     std::uint64_t word = 0;
-    for (openvdb::Index b = 0; b < 64; ++b) {
-      const std::uint32_t e = end[64 * w + b];
-      word |= std::uint64_t{e != previous} << b;
-      ends[64 * w + b] = e - leafBegin;
-      previous = e;
+    for (openvdb::Index bit = 0; bit < 64; ++bit) {
+      const std::uint32_t n = counts[64 * w + bit];
+      counts[64 * w + bit] = at;
+      at += n;
+      ends[64 * w + bit] = at - first;
+      word |= std::uint64_t{n != 0} << bit;
     }
     mask.template getWord<std::uint64_t>(w) = word;
   }
@@ -418,8 +420,6 @@ GroupedPoints sortedPoints(const FrameData& frame) {
                         std::array<std::uint32_t, Leaf::SIZE> counts{};
                         for (std::size_t k = points.starts[l]; k < points.starts[l + 1]; ++k)
                           ++counts[slots[k].voxel];
-                        std::uint32_t sum = 0;
-                        for (std::uint32_t& c : counts) c = sum += c;  // each voxel's end
                         setVoxelEnds(points, l, counts.data(), 0);
                       }
                     });
@@ -564,8 +564,7 @@ struct RowKernels {
 // Puts bucket b's points, in row order, in order by their keys (`keys`, each its leaf's place in
 // the bucket, then its voxel), rows in order among equal keys (a counting sort): each point's row
 // is kept in `source`, through which the store gathers its values. Each leaf's voxel ends and
-// mask are set from the counts as they are summed (one pass over the voxels, which outnumber the
-// points).
+// mask are set as its counts are summed (one pass over the voxels, which outnumber the points).
 void orderBucket(GroupedPoints& points, const std::uint16_t* keys, std::size_t b,
                  std::vector<std::uint32_t>& counts) {
   const auto [begin, end] = points.bucketPoints(b);
@@ -574,24 +573,10 @@ void orderBucket(GroupedPoints& points, const std::uint16_t* keys, std::size_t b
   const std::uint16_t* const key = keys + begin;
   counts.assign(std::size_t{endLeaf - firstLeaf} << kVoxelBits, 0);
   for (std::size_t i = 0; i < count; ++i) ++counts[key[i]];
-  // Each key's count becomes its first place; each voxel's end and mask bit are set.
-  auto at = static_cast<std::uint32_t>(begin);
+  // Each key's count becomes its first place (a leaf's points begin at its start).
   for (std::uint32_t l = firstLeaf; l < endLeaf; ++l) {
-    std::uint32_t* const first = counts.data() + (std::size_t{l - firstLeaf} << kVoxelBits);
-    openvdb::PointDataIndex32* const ends = points.leaves.voxelEnds.get() + l * Leaf::SIZE;
-    Leaf::NodeMaskType& mask = points.leaves.masks[l];
-    const auto leafBegin = static_cast<std::uint32_t>(points.starts[l]);
-    for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
-      std::uint64_t word = 0;
-      for (openvdb::Index bit = 0; bit < 64; ++bit) {
-        const std::uint32_t n = first[64 * w + bit];
-        first[64 * w + bit] = at;
-        at += n;
-        ends[64 * w + bit] = at - leafBegin;
-        word |= std::uint64_t{n != 0} << bit;
-      }
-      mask.template getWord<std::uint64_t>(w) = word;
-    }
+    setVoxelEnds(points, l, counts.data() + (std::size_t{l - firstLeaf} << kVoxelBits),
+                 static_cast<std::uint32_t>(points.starts[l]));
   }
   std::uint32_t* const source = points.source.get();
   for (std::size_t i = 0; i < count; ++i)
