@@ -178,33 +178,36 @@ void formatRows(const FrameData& frame, const std::vector<const FloatColumn*>& c
 
 void writePlyCache(const FrameData& frame, const std::filesystem::path& path,
                    Durability durability) {
+  std::ostringstream header;
+  header << "ply\nformat binary_little_endian 1.0\n";
+  header << "comment tickfx frame " << frame.frame << "\n";
+  char time[64];
+  std::snprintf(time, sizeof time, "%.17g", frame.timeSeconds);
+  header << "comment time " << time << "\n";
+  header << "element vertex " << frame.size() << "\n";
+  header << "property double id\n";
+  for (const char* name : kFixedFloats) header << "property float " << name << "\n";
+  for (const std::string& name : frame.attributeNames)
+    header << "property " << (isIntAttribute(name) ? "int " : "float ") << plyName(name) << "\n";
+  header << "end_header\n";
+  const std::string head = std::move(header).str();
+  const std::vector<const FloatColumn*> cols = floatColumns(frame);
+  // Houdini's integers (hitnum) as 32-bit ints: their columns hold whole numbers.
+  std::vector<bool> ints(cols.size(), false);
+  for (std::size_t a = 0; a < frame.attributeNames.size(); ++a)
+    ints[kStandardColumns + a] = isIntAttribute(frame.attributeNames[a]);
+  const std::size_t rowBytes = sizeof(double) + cols.size() * sizeof(float);
   writeFileAtomically(
       path,
       [&](std::ostream& out) {
-        out << "ply\nformat binary_little_endian 1.0\n";
-        out << "comment tickfx frame " << frame.frame << "\n";
-        char time[64];
-        std::snprintf(time, sizeof time, "%.17g", frame.timeSeconds);
-        out << "comment time " << time << "\n";
-        out << "element vertex " << frame.size() << "\n";
-        out << "property double id\n";
-        for (const char* name : kFixedFloats) out << "property float " << name << "\n";
-        for (const std::string& name : frame.attributeNames)
-          out << "property " << (isIntAttribute(name) ? "int " : "float ") << plyName(name) << "\n";
-        out << "end_header\n";
-        const std::vector<const FloatColumn*> cols = floatColumns(frame);
-        // Houdini's integers (hitnum) as 32-bit ints: their columns hold whole numbers.
-        std::vector<bool> ints(cols.size(), false);
-        for (std::size_t a = 0; a < frame.attributeNames.size(); ++a)
-          ints[kStandardColumns + a] = isIntAttribute(frame.attributeNames[a]);
-        const std::size_t rowBytes = sizeof(double) + cols.size() * sizeof(float);
+        out.write(head.data(), static_cast<std::streamsize>(head.size()));
         writeRowsInBlocks(out, frame.size(), kPlyRowsPerBlock, rowBytes,
                           [&](std::size_t begin, std::size_t end, char* bytes) {
                             formatRows(frame, cols, ints, rowBytes, begin, end, bytes);
                             return (end - begin) * rowBytes;
                           });
       },
-      durability);
+      durability, head.size() + frame.size() * rowBytes);
 }
 
 FrameData readPlyCache(const std::filesystem::path& path) {

@@ -592,7 +592,7 @@ void writeVdbPointCache(const FrameData& frame, const VdbCacheMetadata& meta,
   encodeFrame(frame, meta, options, Grouping::Any, [&](EncodedPointsFile& file) {
     stampUuid(std::span<char>(file.head(), file.headSize()), meta, frame.frame);
     writeFileAtomically(
-        path, [&](std::ostream& out) { file.write(out); }, durability);
+        path, [&](std::ostream& out) { file.write(out); }, durability, file.size());
   });
 }
 

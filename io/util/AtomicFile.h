@@ -1,6 +1,7 @@
 // Files that appear whole or not at all.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <ostream>
@@ -45,10 +46,14 @@ enum class Durability {
 /// disk, a file size limit, a directory removed or made read-only meanwhile) throws WriteError
 /// naming `path` and the system's reason; the temporary is removed and an existing `path` is left
 /// untouched (if the temporary cannot be removed either, WriteError::leftover() names it).
-/// Whatever `write` throws is passed on, with the same clean-up.
+/// Whatever `write` throws is passed on, with the same clean-up. `expectedBytes`, when known
+/// (not 0): the bytes `write` will write, whose blocks are allocated at once where the
+/// filesystem can (fallocate(); the file's size is what was written, and blocks allocated past
+/// it are given back).
 void writeFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write,
-                         Durability durability = Durability::Renamed);
+                         Durability durability = Durability::Renamed,
+                         std::size_t expectedBytes = 0);
 
 /// Checks, before anything is written, that `path` could be written atomically: its folder
 /// exists and takes a new file, and `path` is not a folder. Throws WriteError otherwise; leaves

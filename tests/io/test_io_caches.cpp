@@ -1,6 +1,7 @@
 // Frame caches and frame schedules: what is written reads back bit for bit, and bad files fail
 // loudly with their name and place.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <tbb/task_arena.h>
 #include <unistd.h>
 
@@ -316,6 +317,30 @@ TEST_F(Caches, WritesOfAnySizeReachTheFileInTheirOrder) {
   const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_EQ(written.size(), expected.size());
   EXPECT_TRUE(written == expected);
+}
+
+// The size foreseen for a file (its blocks allocated at once) changes nothing of what is
+// written: a file of fewer bytes is that size, the blocks foreseen past it given back; one of
+// more bytes holds them all.
+TEST_F(Caches, AFileOfOtherThanTheSizeForeseenHoldsWhatWasWritten) {
+  const std::string body(300000, 'x');
+  for (const std::size_t foreseen : {std::size_t{1}, body.size(), std::size_t{8} << 20}) {
+    SCOPED_TRACE(std::to_string(foreseen) + " bytes foreseen");
+    const fs::path path = dir_ / ("foreseen" + std::to_string(foreseen) + ".bin");
+    writeFileAtomically(
+        path,
+        [&](std::ostream& out) {
+          out.write(body.data(), static_cast<std::streamsize>(body.size()));
+        },
+        Durability::Renamed, foreseen);
+    std::ifstream in(path, std::ios::binary);
+    const std::string written((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
+    EXPECT_TRUE(written == body) << written.size() << " bytes";
+    struct stat st {};
+    ASSERT_EQ(::stat(path.c_str(), &st), 0);
+    EXPECT_LT(static_cast<std::size_t>(st.st_blocks) * 512, std::size_t{2} << 20);
+  }
 }
 
 // The bytes of this process's pages in memory (Linux: /proc/self/statm).
