@@ -367,21 +367,38 @@ void describeLeaves(GroupedPoints& points) {
 // the leaf's points beginning at `first` in some run of points: what setOffsets(ends,
 // /*updateValueMask=*/true) sets on a leaf, without its two calls a voxel. Each count is replaced
 // by its voxel's first place in the run (a counting sort's starts).
+// (Four voxels at a time in SSE2's registers, the baseline's: each one's end the sum of the
+// counts up to it, by two shifted adds and the voxels' before; a loop voxel by voxel waited on
+// each sum, and took half of the buckets' sort.)
 void setVoxelEnds(GroupedPoints& points, std::size_t l, std::uint32_t* counts,
                   std::uint32_t first) {
+  using Lanes = std::uint32_t __attribute__((vector_size(16)));
+  constexpr std::size_t kLanes = sizeof(Lanes) / sizeof(std::uint32_t);
   openvdb::PointDataIndex32* const ends = points.leaves.voxelEnds.get() + l * Leaf::SIZE;
+  static_assert(sizeof(openvdb::PointDataIndex32) == sizeof(std::uint32_t));
   Leaf::NodeMaskType& mask = points.leaves.masks[l];
-  std::uint32_t at = first;
-  for (openvdb::Index w = 0; w < Leaf::NodeMaskType::WORD_COUNT; ++w) {
-    std::uint64_t word = 0;
-    for (openvdb::Index bit = 0; bit < 64; ++bit) {
-      const std::uint32_t n = counts[64 * w + bit];
-      counts[64 * w + bit] = at;
-      at += n;
-      ends[64 * w + bit] = at - first;
-      word |= std::uint64_t{n != 0} << bit;
+  const Lanes zero{}, laneBit{1, 2, 4, 8};
+  Lanes before{};  // each lane: the points of the voxels before these four
+  std::uint64_t word = 0;
+  for (std::size_t v = 0; v < Leaf::SIZE; v += kLanes) {
+    Lanes n;
+    std::memcpy(&n, counts + v, sizeof n);
+    Lanes sum = n + __builtin_shufflevector(zero, n, 0, 4, 5, 6);  // lane i: n[i − 1] + n[i]
+    sum += __builtin_shufflevector(zero, sum, 0, 0, 4, 5);         // lane i: n[0] + … + n[i]
+    const Lanes end = before + sum;
+    const Lanes start = end - n + first;
+    std::memcpy(static_cast<void*>(ends + v), &end, sizeof end);
+    std::memcpy(counts + v, &start, sizeof start);
+    before = __builtin_shufflevector(end, end, 3, 3, 3, 3);
+    // The four voxels' bits of the mask, those that hold points (lanes' bits summed).
+    Lanes bits = laneBit & reinterpret_cast<Lanes>(n != zero);
+    bits += __builtin_shufflevector(bits, bits, 2, 3, 0, 1);
+    bits += __builtin_shufflevector(bits, bits, 1, 0, 3, 2);
+    word |= std::uint64_t{bits[0]} << (v % 64);
+    if (v % 64 == 64 - kLanes) {
+      mask.template getWord<std::uint64_t>(v / 64) = word;
+      word = 0;
     }
-    mask.template getWord<std::uint64_t>(w) = word;
   }
 }
 
