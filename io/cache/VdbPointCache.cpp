@@ -128,16 +128,22 @@ std::vector<GridAttribute> gridAttributes(const std::vector<std::string>& attrib
   return attributes;
 }
 
-// The x, y and z of vector attribute `a`: lane j of row r at lanes[j][r * stride], from a column
-// of rows of three (stride 3) or three columns of one float a row (stride 1).
+// The x, y and z of vector attribute `a`: lane j of row r at lanes[j][r * stride[j]], from a
+// column of rows of three (strides 3) or three columns of one float a row (stride 1, or 0 for a
+// column whose rows all hold one value).
 struct VectorLanes {
   std::array<const float*, 3> lanes;
-  std::size_t stride;
+  std::array<std::size_t, 3> stride;
 };
 VectorLanes vectorLanes(const GroupedPoints& points, const GridAttribute& a) {
   const float* const x = points.columns[a.column].get();
-  if (points.widths[a.column] == 3) return {{x, x + 1, x + 2}, 3};
-  return {{x, points.columns[a.column + 1].get(), points.columns[a.column + 2].get()}, 1};
+  if (points.widths[a.column] == 3) return {{x, x + 1, x + 2}, {3, 3, 3}};
+  VectorLanes v;
+  for (std::size_t j = 0; j < 3; ++j) {
+    v.lanes[j] = points.columns[a.column + j].get();
+    v.stride[j] = points.widths[a.column + j];
+  }
+  return v;
 }
 
 // Calls f(std::type_identity<Array>()) with the array type of attributes of `kind`.
@@ -197,6 +203,7 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
   const std::size_t begin = points.leafPoints(l).first;
   const std::size_t count = points.leafPoints(l).second - begin;
   const float* const column = points.columns[a.column].get();  // (Float, Int)
+  const std::size_t width = points.widths[a.column];           // (Float, Int: 1, or 0)
   const auto row = [&](std::size_t k) { return points.row(begin + k); };
   switch (a.kind) {
     case Kind::Position: {
@@ -207,8 +214,9 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
     case Kind::Vector: {
       const auto [lanes, stride] = vectorLanes(points, a);
       for (std::size_t k = 0; k < count; ++k) {
-        const std::size_t r = row(k) * stride;
-        set(k, openvdb::Vec3f(lanes[0][r], lanes[1][r], lanes[2][r]));
+        const std::size_t r = row(k);
+        set(k, openvdb::Vec3f(lanes[0][r * stride[0]], lanes[1][r * stride[1]],
+                              lanes[2][r * stride[2]]));
       }
       return;
     }
@@ -219,12 +227,12 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
     }
     case Kind::Int: {
       const float* x = column;
-      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[row(k)]));
+      for (std::size_t k = 0; k < count; ++k) set(k, static_cast<std::int32_t>(x[row(k) * width]));
       return;
     }
     case Kind::Float: {
       const float* x = column;
-      for (std::size_t k = 0; k < count; ++k) set(k, x[row(k)]);
+      for (std::size_t k = 0; k < count; ++k) set(k, x[row(k) * width]);
       return;
     }
   }
@@ -347,6 +355,7 @@ class GroupedValues final : public PointValues {
                  const Row& row) const {
     using Kind = GridAttribute::Kind;
     const float* const column = points_.columns[a.column].get();  // (Float, Int)
+    const bool uniform = points_.widths[a.column] == 0;           // (Float, Int)
     constexpr std::size_t kFloat = sizeof(float);
     switch (a.kind) {
       case Kind::Position: {  // the offsets, as openvdb::Vec3f's three floats
@@ -364,30 +373,35 @@ class GroupedValues final : public PointValues {
       }
       case Kind::Float: {
         const float* const __restrict x = column;
+        if (uniform) {
+          for (std::size_t k = 0; k < count; ++k) std::memcpy(to + k * kFloat, x, kFloat);
+          return;
+        }
         for (std::size_t k = 0; k < count; ++k) std::memcpy(to + k * kFloat, x + row(k), kFloat);
         return;
       }
       case Kind::Vector: {
         const VectorLanes v = vectorLanes(points_, a);
-        if (v.stride == 3) {  // rows of three, as the array holds them
+        if (v.stride[0] == 3) {  // rows of three, as the array holds them
           const float* const __restrict xyz = v.lanes[0];
           for (std::size_t k = 0; k < count; ++k)
             std::memcpy(to + k * 3 * kFloat, xyz + row(k) * 3, 3 * kFloat);
           return;
         }
         const float* const __restrict x = v.lanes[0], * const __restrict y = v.lanes[1], * const __restrict z = v.lanes[2];
+        const auto [sx, sy, sz] = v.stride;
         for (std::size_t k = 0; k < count; ++k, to += 3 * kFloat) {
           const std::size_t r = row(k);
-          std::memcpy(to, x + r, kFloat);
-          std::memcpy(to + kFloat, y + r, kFloat);
-          std::memcpy(to + 2 * kFloat, z + r, kFloat);
+          std::memcpy(to, x + r * sx, kFloat);
+          std::memcpy(to + kFloat, y + r * sy, kFloat);
+          std::memcpy(to + 2 * kFloat, z + r * sz, kFloat);
         }
         return;
       }
       case Kind::Int: {
         const float* const __restrict x = column;
         for (std::size_t k = 0; k < count; ++k) {
-          const auto v = static_cast<std::int32_t>(x[row(k)]);
+          const auto v = static_cast<std::int32_t>(x[uniform ? 0 : row(k)]);
           std::memcpy(to + sizeof v * k, &v, sizeof v);
         }
         return;

@@ -348,6 +348,46 @@ std::vector<SourceColumn> pointFloatColumns(const FrameData& frame) {
   return columns;
 }
 
+// Rows compared at a time by uniformColumns(): a column that differs shows it in its first
+// block (at once, for any column of measured values), a uniform one is read whole.
+constexpr std::size_t kUniformBlock = 4096;
+
+// The frame's float columns (pointFloatColumns()) with the width of each column of one float a
+// row whose rows all hold the same bits set to 0 (GroupedPoints::widths). A pure function of
+// the values: bits, not numbers (−0.0 is not 0.0, and each NaN's payload counts).
+std::vector<SourceColumn> uniformColumns(std::vector<SourceColumn> columns, std::size_t n) {
+  const auto differs = [](const float* x, std::uint32_t first, std::size_t begin, std::size_t end) {
+    std::uint32_t other = 0;  // (no exit within a block: the loop is vectorised)
+    for (std::size_t i = begin; i < end; ++i) other |= std::bit_cast<std::uint32_t>(x[i]) ^ first;
+    return other != 0;
+  };
+  for (SourceColumn& column : columns) {
+    const float* const x = column.lanes[0];
+    if (column.width != 1 || n == 0) continue;
+    const auto first = std::bit_cast<std::uint32_t>(x[0]);
+    if (differs(x, first, 0, std::min(n, kUniformBlock))) continue;
+    std::atomic<bool> found{false};
+    par::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16 * kUniformBlock),
+                      [&](const tbb::blocked_range<std::size_t>& rows) {
+                        for (std::size_t i = rows.begin(); i < rows.end(); i += kUniformBlock) {
+                          if (found.load(std::memory_order_relaxed)) return;
+                          if (differs(x, first, i, std::min(rows.end(), i + kUniformBlock)))
+                            found.store(true, std::memory_order_relaxed);
+                        }
+                      });
+    if (!found.load()) column.width = 0;
+  }
+  return columns;
+}
+
+// Each uniform column's value (width 0), the one it holds.
+void setUniformValues(GroupedPoints& points, const std::vector<SourceColumn>& columns,
+                      std::size_t n) {
+  for (std::size_t j = 0; j < columns.size(); ++j) {
+    if (columns[j].width == 0 && n > 0) points.columns[j][0] = columns[j].lanes[0][0];
+  }
+}
+
 std::vector<std::size_t> columnWidths(const std::vector<SourceColumn>& columns) {
   std::vector<std::size_t> widths;
   for (const SourceColumn& c : columns) widths.push_back(c.width);
@@ -407,8 +447,9 @@ template <bool Quantised>
 GroupedPoints sortedPoints(const FrameData& frame) {
   std::vector<PointSlot> slots = slotsInRowOrder<Quantised>(frame);
   if (!sortByKeys(slots)) par::parallel_sort(slots.begin(), slots.end());
-  const std::vector<SourceColumn> source = pointFloatColumns(frame);
+  const std::vector<SourceColumn> source = uniformColumns(pointFloatColumns(frame), slots.size());
   GroupedPoints points(slots.size(), columnWidths(source));
+  setUniformValues(points, source, slots.size());
   const Positions positions(frame);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -702,8 +743,9 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     }
   });
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
-  const std::vector<SourceColumn> source = pointFloatColumns(frame);
+  const std::vector<SourceColumn> source = uniformColumns(pointFloatColumns(frame), n);
   GroupedPoints points(n, columnWidths(source));
+  setUniformValues(points, source, n);
   // Each row's key in its bucket, at its place there: its leaf's place in the bucket, its voxel.
   const LargeArray<std::uint16_t> keys = allocateLargeArray<std::uint16_t>(n);
   // The leaves that hold points, in order (each one's first point and origin), and the buckets.
@@ -778,6 +820,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
         const std::size_t runEnd = chunkRange(run.end() - 1).second;
         scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
         for (std::size_t j = 0; j < source.size(); ++j) {
+          if (source[j].width == 0) continue;  // (its value set once)
           if (source[j].width == 3)
             scatterRows(source[j].lanes, at, runBegin, runEnd, points.columns[j].get());
           else

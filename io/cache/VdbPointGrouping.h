@@ -5,6 +5,7 @@
 
 #include <openvdb/points/PointDataGrid.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -41,7 +42,9 @@ struct GroupedPoints {
   LargeArray<std::uint64_t> id;
   // Float values, each column `widths[c]` floats a row: the velocity's x, y, z in rows of three
   // (scattered as one stream rather than three, and read whole), then the ages, lives and
-  // masses, then the frame's attribute columns, one float a row (kStandardFloatColumns).
+  // masses, then the frame's attribute columns, one float a row (kStandardFloatColumns). Width
+  // 0: a column of one float a row whose rows all hold the same bits (as a frame's lives or
+  // masses often do) holds that value alone, at every row's place: nothing to move.
   std::vector<LargeArray<float>> columns;
   std::vector<std::size_t> widths;
   // Where set (Grouping::Any), `offset`, `id` and `columns` hold each bucket's rows in the
@@ -56,7 +59,8 @@ struct GroupedPoints {
       : offset(allocateLargeArray<openvdb::Vec3f>(n)),
         id(allocateLargeArray<std::uint64_t>(n)),
         widths(std::move(columnWidths)) {
-    for (const std::size_t width : widths) columns.push_back(allocateLargeArray<float>(n * width));
+    for (const std::size_t width : widths)
+      columns.push_back(allocateLargeArray<float>(std::max<std::size_t>(n * width, 1)));
   }
   // The row of `offset`, `id` and `columns` that holds point k's values.
   std::size_t row(std::size_t k) const { return source ? source[k] : k; }

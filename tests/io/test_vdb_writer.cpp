@@ -414,5 +414,27 @@ TEST(ioVdbGrouping, FarAndWidelySpreadPointsGroupAsTheSortDid) {
   expectGroupingsAgree(test::onePointFrame());
 }
 
+// Columns whose rows all hold the same bits (as a frame's lives or masses often do) are not
+// moved, their one value stored for every point: the same bytes, the same values read back, in
+// either grouping. A column that differs in one row only is not one of them: −0.0 in the last
+// row of 0.0, or a value past the blocks of rows checked first.
+TEST_F(ioVdbWriter, UniformColumnsGiveOpenVdbsBytes) {
+  const std::size_t n = 30000;
+  FrameData frame = frameOf(n, 30.0f, {"hitnum", "Cd_r", "Cd_g", "Cd_b", "w", "heat"});
+  const auto last = static_cast<Eigen::Index>(n - 1);
+  frame.life.setConstant(std::numeric_limits<float>::infinity());
+  frame.mass.setConstant(-0.0f);
+  frame.age.setConstant(0.0f);
+  frame.age[last] = -0.0f;
+  frame.attributes[0].setConstant(7.0f);                               // hitnum: an int
+  frame.attributes[2].setConstant(0.5f);                               // Cd's green lane
+  frame.attributes[4].setConstant(std::bit_cast<float>(0x7fc01234u));  // a NaN's payload
+  frame.attributes[5].setConstant(2.0f);
+  frame.attributes[5][20000] = 2.5f;
+  for (const VdbCacheOptions& options : {kDefault, kFixed16, kBlosc})
+    expectSameBytesAsOpenVdb(frame, options);
+  expectGroupingsAgree(frame);
+}
+
 }  // namespace
 }  // namespace tickfx::io
