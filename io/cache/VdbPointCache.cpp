@@ -355,7 +355,7 @@ class GroupedValues final : public PointValues {
                  const Row& row) const {
     using Kind = GridAttribute::Kind;
     const float* const column = points_.columns[a.column].get();  // (Float, Int)
-    const bool uniform = points_.widths[a.column] == 0;           // (Float, Int)
+    const std::size_t width = points_.widths[a.column];           // (Float, Int: 1, or 0)
     constexpr std::size_t kFloat = sizeof(float);
     switch (a.kind) {
       case Kind::Position: {  // the offsets, as openvdb::Vec3f's three floats
@@ -373,7 +373,7 @@ class GroupedValues final : public PointValues {
       }
       case Kind::Float: {
         const float* const __restrict x = column;
-        if (uniform) {
+        if (width == 0) {  // the one value, for every point
           for (std::size_t k = 0; k < count; ++k) std::memcpy(to + k * kFloat, x, kFloat);
           return;
         }
@@ -401,7 +401,7 @@ class GroupedValues final : public PointValues {
       case Kind::Int: {
         const float* const __restrict x = column;
         for (std::size_t k = 0; k < count; ++k) {
-          const auto v = static_cast<std::int32_t>(x[uniform ? 0 : row(k)]);
+          const auto v = static_cast<std::int32_t>(x[row(k) * width]);
           std::memcpy(to + sizeof v * k, &v, sizeof v);
         }
         return;
