@@ -136,12 +136,13 @@ struct VectorLanes {
   std::array<std::size_t, 3> stride;
 };
 VectorLanes vectorLanes(const GroupedPoints& points, const GridAttribute& a) {
-  const float* const x = points.columns[a.column].get();
-  if (points.widths[a.column] == 3) return {{x, x + 1, x + 2}, {3, 3, 3}};
+  const GroupedPoints::FloatColumn& first = points.columns[a.column];
+  const float* const x = first.values.get();
+  if (first.width == 3) return {{x, x + 1, x + 2}, {3, 3, 3}};
   VectorLanes v;
   for (std::size_t j = 0; j < 3; ++j) {
-    v.lanes[j] = points.columns[a.column + j].get();
-    v.stride[j] = points.widths[a.column + j];
+    v.lanes[j] = points.columns[a.column + j].values.get();
+    v.stride[j] = points.columns[a.column + j].width;
   }
   return v;
 }
@@ -202,8 +203,8 @@ void eachValue(const GroupedPoints& points, std::size_t l, const GridAttribute& 
   using Kind = GridAttribute::Kind;
   const std::size_t begin = points.leafPoints(l).first;
   const std::size_t count = points.leafPoints(l).second - begin;
-  const float* const column = points.columns[a.column].get();  // (Float, Int)
-  const std::size_t width = points.widths[a.column];           // (Float, Int: 1, or 0)
+  const float* const column = points.columns[a.column].values.get();  // (Float, Int)
+  const std::size_t width = points.columns[a.column].width;           // (Float, Int: 1, or 0)
   const auto row = [&](std::size_t k) { return points.row(begin + k); };
   switch (a.kind) {
     case Kind::Position: {
@@ -354,8 +355,8 @@ class GroupedValues final : public PointValues {
   void storeRows(const GridAttribute& a, std::size_t count, char* __restrict to,
                  const Row& row) const {
     using Kind = GridAttribute::Kind;
-    const float* const column = points_.columns[a.column].get();  // (Float, Int)
-    const std::size_t width = points_.widths[a.column];           // (Float, Int: 1, or 0)
+    const float* const column = points_.columns[a.column].values.get();  // (Float, Int)
+    const std::size_t width = points_.columns[a.column].width;           // (Float, Int: 1, or 0)
     constexpr std::size_t kFloat = sizeof(float);
     switch (a.kind) {
       case Kind::Position: {  // the offsets, as openvdb::Vec3f's three floats

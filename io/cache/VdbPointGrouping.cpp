@@ -353,7 +353,7 @@ std::vector<SourceColumn> pointFloatColumns(const FrameData& frame) {
 constexpr std::size_t kUniformBlock = 4096;
 
 // The frame's float columns (pointFloatColumns()) with the width of each column of one float a
-// row whose rows all hold the same bits set to 0 (GroupedPoints::widths). A pure function of
+// row whose rows all hold the same bits set to 0 (GroupedPoints::FloatColumn). A pure function of
 // the values: bits, not numbers (−0.0 is not 0.0, and each NaN's payload counts).
 std::vector<SourceColumn> uniformColumns(std::vector<SourceColumn> columns, std::size_t n) {
   const auto differs = [](const float* x, std::uint32_t first, std::size_t begin, std::size_t end) {
@@ -380,18 +380,19 @@ std::vector<SourceColumn> uniformColumns(std::vector<SourceColumn> columns, std:
   return columns;
 }
 
-// Each uniform column's value (width 0), the one it holds.
-void setUniformValues(GroupedPoints& points, const std::vector<SourceColumn>& columns,
-                      std::size_t n) {
-  for (std::size_t j = 0; j < columns.size(); ++j) {
-    if (columns[j].width == 0 && n > 0) points.columns[j][0] = columns[j].lanes[0][0];
+// Gives `points` (of n points) its float columns, the frame's (pointFloatColumns()) with the
+// uniform ones found (uniformColumns()) holding their one value, and returns the columns' sources
+// in the same order: where the grouping copies each column's rows from.
+std::vector<SourceColumn> addFloatColumns(GroupedPoints& points, const FrameData& frame,
+                                          std::size_t n) {
+  std::vector<SourceColumn> source = uniformColumns(pointFloatColumns(frame), n);
+  for (const SourceColumn& c : source) {
+    GroupedPoints::FloatColumn& column = points.columns.emplace_back();
+    column.width = c.width;
+    column.values = allocateLargeArray<float>(std::max<std::size_t>(n * c.width, 1));
+    if (c.width == 0 && n > 0) column.values[0] = c.lanes[0][0];
   }
-}
-
-std::vector<std::size_t> columnWidths(const std::vector<SourceColumn>& columns) {
-  std::vector<std::size_t> widths;
-  for (const SourceColumn& c : columns) widths.push_back(c.width);
-  return widths;
+  return source;
 }
 
 // Each leaf's point count, from the starts, and room for its voxel ends and mask.
@@ -447,9 +448,8 @@ template <bool Quantised>
 GroupedPoints sortedPoints(const FrameData& frame) {
   std::vector<PointSlot> slots = slotsInRowOrder<Quantised>(frame);
   if (!sortByKeys(slots)) par::parallel_sort(slots.begin(), slots.end());
-  const std::vector<SourceColumn> source = uniformColumns(pointFloatColumns(frame), slots.size());
-  GroupedPoints points(slots.size(), columnWidths(source));
-  setUniformValues(points, source, slots.size());
+  GroupedPoints points(slots.size());
+  const std::vector<SourceColumn> source = addFloatColumns(points, frame, slots.size());
   const Positions positions(frame);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -459,7 +459,7 @@ GroupedPoints sortedPoints(const FrameData& frame) {
                         points.id[k] = frame.id[r];
                         for (std::size_t j = 0; j < source.size(); ++j) {
                           for (std::size_t lane = 0; lane < source[j].width; ++lane)
-                            points.columns[j][k * source[j].width + lane] =
+                            points.columns[j].values[k * source[j].width + lane] =
                                 source[j].lanes[lane][r];
                         }
                       }
@@ -743,9 +743,8 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
     }
   });
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
-  const std::vector<SourceColumn> source = uniformColumns(pointFloatColumns(frame), n);
-  GroupedPoints points(n, columnWidths(source));
-  setUniformValues(points, source, n);
+  GroupedPoints points(n);
+  const std::vector<SourceColumn> source = addFloatColumns(points, frame, n);
   // Each row's key in its bucket, at its place there: its leaf's place in the bucket, its voxel.
   const LargeArray<std::uint16_t> keys = allocateLargeArray<std::uint16_t>(n);
   // The leaves that hold points, in order (each one's first point and origin), and the buckets.
@@ -822,9 +821,9 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
         for (std::size_t j = 0; j < source.size(); ++j) {
           if (source[j].width == 0) continue;  // (its value set once)
           if (source[j].width == 3)
-            scatterRows(source[j].lanes, at, runBegin, runEnd, points.columns[j].get());
+            scatterRows(source[j].lanes, at, runBegin, runEnd, points.columns[j].values.get());
           else
-            scatter(source[j].lanes[0], at, runBegin, runEnd, points.columns[j].get());
+            scatter(source[j].lanes[0], at, runBegin, runEnd, points.columns[j].values.get());
         }
       });
   // Each bucket (in cache) in order by key: by leaf, then voxel, rows in order within a voxel.

@@ -5,7 +5,6 @@
 
 #include <openvdb/points/PointDataGrid.h>
 
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -40,13 +39,17 @@ struct GroupedPoints {
   // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
   LargeArray<openvdb::Vec3f> offset;  // each point's position's offset in its voxel
   LargeArray<std::uint64_t> id;
-  // Float values, each column `widths[c]` floats a row: the velocity's x, y, z in rows of three
-  // (scattered as one stream rather than three, and read whole), then the ages, lives and
-  // masses, then the frame's attribute columns, one float a row (kStandardFloatColumns). Width
-  // 0: a column of one float a row whose rows all hold the same bits (as a frame's lives or
-  // masses often do) holds that value alone, at every row's place: nothing to move.
-  std::vector<LargeArray<float>> columns;
-  std::vector<std::size_t> widths;
+  // A float column: `width` floats a row. Width 0: a column of one float a row whose rows all
+  // hold the same bits (as a frame's lives or masses often do) holds that value alone, at every
+  // row's place: nothing to move.
+  struct FloatColumn {
+    LargeArray<float> values;
+    std::size_t width = 1;
+  };
+  // The velocity's x, y, z in rows of three (scattered as one stream rather than three, and read
+  // whole), then the ages, lives and masses, then the frame's attribute columns, one float a row
+  // (kStandardFloatColumns); made by the grouping with the values' widths.
+  std::vector<FloatColumn> columns;
   // Where set (Grouping::Any), `offset`, `id` and `columns` hold each bucket's rows in the
   // frame's row order, not in the leaves' order: point k's values are at row source[k] (in its
   // own bucket). The store gathers each leaf's values through it straight into the file's bytes,
@@ -55,13 +58,8 @@ struct GroupedPoints {
   LargeArray<std::uint32_t> source;
   Buckets buckets;
 
-  GroupedPoints(std::size_t n, std::vector<std::size_t> columnWidths)
-      : offset(allocateLargeArray<openvdb::Vec3f>(n)),
-        id(allocateLargeArray<std::uint64_t>(n)),
-        widths(std::move(columnWidths)) {
-    for (const std::size_t width : widths)
-      columns.push_back(allocateLargeArray<float>(std::max<std::size_t>(n * width, 1)));
-  }
+  explicit GroupedPoints(std::size_t n)
+      : offset(allocateLargeArray<openvdb::Vec3f>(n)), id(allocateLargeArray<std::uint64_t>(n)) {}
   // The row of `offset`, `id` and `columns` that holds point k's values.
   std::size_t row(std::size_t k) const { return source ? source[k] : k; }
   // The points of leaf l: [first, second).
