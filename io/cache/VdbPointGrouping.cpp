@@ -10,12 +10,10 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <optional>
-#include <thread>
 #include <utility>
 #include <vector>
 
