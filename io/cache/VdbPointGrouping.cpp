@@ -165,49 +165,45 @@ std::vector<SourceColumn> pointFloatColumns(const FrameData& frame) {
   return columns;
 }
 
-// Rows compared at a time by uniformColumns(): a column that differs shows it in its first
-// block (at once, for any column of measured values), a uniform one is read whole.
+// Rows compared at a time by isUniform(): a column that differs shows it in its first block
+// (at once, for any column of measured values), a uniform one is read whole.
 constexpr std::size_t kUniformBlock = 4096;
 
-// The frame's float columns (pointFloatColumns()) with the width of each column of one float a
-// row whose rows all hold the same bits set to 0 (GroupedPoints::FloatColumn). A pure function of
-// the values: bits, not numbers (−0.0 is not 0.0, and each NaN's payload counts).
-std::vector<SourceColumn> uniformColumns(std::vector<SourceColumn> columns, std::size_t n) {
-  const auto differs = [](const float* x, std::uint32_t first, std::size_t begin, std::size_t end) {
+// Whether the n values at x all hold the same bits: bits, not numbers (−0.0 is not 0.0, and
+// each NaN's payload counts), so the answer is a pure function of the values.
+bool isUniform(const float* x, std::size_t n) {
+  const auto differs = [x](std::uint32_t first, std::size_t begin, std::size_t end) {
     std::uint32_t other = 0;  // (no exit within a block: the loop is vectorised)
     for (std::size_t i = begin; i < end; ++i) other |= std::bit_cast<std::uint32_t>(x[i]) ^ first;
     return other != 0;
   };
-  for (SourceColumn& column : columns) {
-    const float* const x = column.lanes[0];
-    if (column.width != 1 || n == 0) continue;
-    const auto first = std::bit_cast<std::uint32_t>(x[0]);
-    if (differs(x, first, 0, std::min(n, kUniformBlock))) continue;
-    std::atomic<bool> found{false};
-    par::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16 * kUniformBlock),
-                      [&](const tbb::blocked_range<std::size_t>& rows) {
-                        for (std::size_t i = rows.begin(); i < rows.end(); i += kUniformBlock) {
-                          if (found.load(std::memory_order_relaxed)) return;
-                          if (differs(x, first, i, std::min(rows.end(), i + kUniformBlock)))
-                            found.store(true, std::memory_order_relaxed);
-                        }
-                      });
-    if (!found.load()) column.width = 0;
-  }
-  return columns;
+  if (n == 0) return false;
+  const auto first = std::bit_cast<std::uint32_t>(x[0]);
+  if (differs(first, 0, std::min(n, kUniformBlock))) return false;
+  std::atomic<bool> found{false};
+  par::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16 * kUniformBlock),
+                    [&](const tbb::blocked_range<std::size_t>& rows) {
+                      for (std::size_t i = rows.begin(); i < rows.end(); i += kUniformBlock) {
+                        if (found.load(std::memory_order_relaxed)) return;
+                        if (differs(first, i, std::min(rows.end(), i + kUniformBlock)))
+                          found.store(true, std::memory_order_relaxed);
+                      }
+                    });
+  return !found.load();
 }
 
-// Gives `points` (of n points) its float columns, the frame's (pointFloatColumns()) with the
-// uniform ones found (uniformColumns()) holding their one value, and returns the columns' sources
-// in the same order: where the grouping copies each column's rows from.
-std::vector<SourceColumn> addFloatColumns(GroupedPoints& points, const FrameData& frame,
-                                          std::size_t n) {
-  std::vector<SourceColumn> source = uniformColumns(pointFloatColumns(frame), n);
+// Gives `points` its float columns, one for each of the frame's (pointFloatColumns()), each a
+// row as wide as its source but for a column of one float a row whose rows are all the same
+// (isUniform()), which holds its one value (width 0). Returns the sources, in the same order:
+// where the grouping copies each column's rows from, as wide as the column it fills says.
+std::vector<SourceColumn> addFloatColumns(GroupedPoints& points, const FrameData& frame) {
+  const std::size_t n = frame.size();
+  std::vector<SourceColumn> source = pointFloatColumns(frame);
   for (const SourceColumn& c : source) {
     GroupedPoints::FloatColumn& column = points.columns.emplace_back();
-    column.width = c.width;
-    column.values = allocateLargeArray<float>(std::max<std::size_t>(n * c.width, 1));
-    if (c.width == 0 && n > 0) column.values[0] = c.lanes[0][0];
+    column.width = c.width == 1 && isUniform(c.lanes[0], n) ? 0 : c.width;
+    column.values = allocateLargeArray<float>(std::max<std::size_t>(n * column.width, 1));
+    if (column.width == 0) column.values[0] = c.lanes[0][0];
   }
   return source;
 }
@@ -266,7 +262,7 @@ GroupedPoints sortedPoints(const FrameData& frame) {
   std::vector<PointSlot> slots = slotsInRowOrder<Quantised>(frame);
   if (!sortByKeys(slots)) par::parallel_sort(slots.begin(), slots.end());
   GroupedPoints points(slots.size());
-  const std::vector<SourceColumn> source = addFloatColumns(points, frame, slots.size());
+  const std::vector<SourceColumn> source = addFloatColumns(points, frame);
   const Positions positions(frame);
   par::parallel_for(tbb::blocked_range<std::size_t>(0, slots.size(), kPlacementGrain),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -275,9 +271,9 @@ GroupedPoints sortedPoints(const FrameData& frame) {
                         positions.voxel<Quantised>(r, &points.offset[k]);
                         points.id[k] = frame.id[r];
                         for (std::size_t j = 0; j < source.size(); ++j) {
-                          for (std::size_t lane = 0; lane < source[j].width; ++lane)
-                            points.columns[j].values[k * source[j].width + lane] =
-                                source[j].lanes[lane][r];
+                          const std::size_t width = points.columns[j].width;  // (0: none)
+                          for (std::size_t lane = 0; lane < width; ++lane)
+                            points.columns[j].values[k * width + lane] = source[j].lanes[lane][r];
                         }
                       }
                     });
@@ -466,7 +462,7 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
   });
   if (std::find(outsideBox.begin(), outsideBox.end(), 1) != outsideBox.end()) return std::nullopt;
   GroupedPoints points(n);
-  const std::vector<SourceColumn> source = addFloatColumns(points, frame, n);
+  const std::vector<SourceColumn> source = addFloatColumns(points, frame);
   // Each row's key in its bucket, at its place there: its leaf's place in the bucket, its voxel.
   const LargeArray<std::uint16_t> keys = allocateLargeArray<std::uint16_t>(n);
   // The leaves that hold points, in order (each one's first point and origin), and the buckets.
@@ -541,10 +537,10 @@ std::optional<GroupedPoints> bucketedPoints(const FrameData& frame) {
         const std::size_t runEnd = chunkRange(run.end() - 1).second;
         scatter(frame.id.data(), at, runBegin, runEnd, points.id.get());
         for (std::size_t j = 0; j < source.size(); ++j) {
-          if (source[j].width == 0) continue;  // (its value set once)
-          if (source[j].width == 3)
+          const std::size_t width = points.columns[j].width;  // (0: its one value, set once)
+          if (width == 3)
             scatterRows(source[j].lanes, at, runBegin, runEnd, points.columns[j].values.get());
-          else
+          else if (width == 1)
             scatter(source[j].lanes[0], at, runBegin, runEnd, points.columns[j].values.get());
         }
       });
