@@ -21,6 +21,7 @@
 #include "io/effect/EffectParser.h"
 #include "particles/Emitter.h"
 #include "particles/ParticleSystem.h"
+#include "tests/support/FileBytes.h"
 
 namespace tickfx {
 namespace {
@@ -228,8 +229,7 @@ TEST_F(ioFileEmitter, MissingUnknownEmptyAndBrokenFilesAreErrorsNamingTheFile) {
                                       "\" cannot be read: " + path("junk.csv") +
                                       ":1: not a tickfx CSV cache header " + expectedFile()}));
   io::writeVdbPointCache(points(), io::VdbCacheMetadata{}, path("full.vdb"));
-  std::ifstream in(path("full.vdb"), std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = test::fileBytes(path("full.vdb"));
   std::ofstream(path("cut.vdb"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   EXPECT_EQ(errors(effect("cut.vdb")),
             (std::vector<std::string>{

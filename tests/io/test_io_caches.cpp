@@ -31,6 +31,7 @@
 #include "io/util/AtomicFile.h"
 #include "io/util/UninitialisedVector.h"
 #include "particles/ParticleSystem.h"
+#include "tests/support/FileBytes.h"
 
 namespace fs = std::filesystem;
 
@@ -105,8 +106,7 @@ TEST_F(Caches, CsvRoundTripIsBitExact) {
 TEST_F(Caches, CsvWithCrlfLineEndsReadsBackTheSameBits) {
   const FrameData frame = sampleFrame();
   writeCsvCache(frame, dir_ / "f.csv");
-  std::ifstream in(dir_ / "f.csv", std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text = test::fileBytes(dir_ / "f.csv");
   std::string crlf;
   for (char ch : text) crlf += ch == '\n' ? std::string("\r\n") : std::string(1, ch);
   std::ofstream(dir_ / "crlf.csv", std::ios::binary) << crlf;
@@ -200,9 +200,7 @@ TEST_F(Caches, PlyBodiesAreTheRowsValueByValueAcrossBlocks) {
       SCOPED_TRACE(std::to_string(names.size()) + " other columns, " + std::to_string(threads) +
                    " threads");
       tbb::task_arena(threads).execute([&] { writePlyCache(frame, dir_ / "f.ply"); });
-      std::ifstream in(dir_ / "f.ply", std::ios::binary);
-      const std::string file((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
+      const std::string file = test::fileBytes(dir_ / "f.ply");
       const std::size_t header = file.find("end_header\n");
       ASSERT_NE(header, std::string::npos);
       const std::string body = file.substr(header + std::strlen("end_header\n"));
@@ -246,8 +244,7 @@ TEST_F(Caches, TruncatedOrForeignFilesAreRefusedByName) {
 TEST_F(Caches, PlyIdsThatAreNoIdAndCountsPastTheFileAreRefused) {
   const FrameData frame = sampleFrame();
   writePlyCache(frame, dir_ / "f.ply");
-  std::ifstream in(dir_ / "f.ply", std::ios::binary);
-  const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string good = test::fileBytes(dir_ / "f.ply");
   const std::size_t body = good.find("end_header\n") + 11;
   const fs::path bad = dir_ / "bad.ply";
   auto refusal = [&](const std::string& bytes) -> std::string {
@@ -313,8 +310,7 @@ TEST_F(Caches, WritesOfAnySizeReachTheFileInTheirOrder) {
       expected += piece;
     }
   });
-  std::ifstream in(path, std::ios::binary);
-  const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string written = test::fileBytes(path);
   ASSERT_EQ(written.size(), expected.size());
   EXPECT_TRUE(written == expected);
 }
@@ -333,9 +329,7 @@ TEST_F(Caches, AFileOfOtherThanTheSizeForeseenHoldsWhatWasWritten) {
           out.write(body.data(), static_cast<std::streamsize>(body.size()));
         },
         Durability::Renamed, foreseen);
-    std::ifstream in(path, std::ios::binary);
-    const std::string written((std::istreambuf_iterator<char>(in)),
-                              std::istreambuf_iterator<char>());
+    const std::string written = test::fileBytes(path);
     EXPECT_TRUE(written == body) << written.size() << " bytes";
     struct stat st {};
     ASSERT_EQ(::stat(path.c_str(), &st), 0);

@@ -27,12 +27,14 @@
 #include "io/effect/EffectParser.h"
 #include "io/state/Checkpoint.h"
 #include "particles/StateHash.h"
+#include "tests/support/FileBytes.h"
 
 namespace fs = std::filesystem;
 
 namespace tickfx::io {
 namespace {
 
+using test::fileBytes;
 using test::JitteredFrames;
 
 constexpr std::uint64_t kEffect = 0x0123456789abcdefULL;
@@ -111,11 +113,6 @@ void PrintTo(const Snapshot& s, std::ostream* os) {
       << ", dropped " << s.ticksDropped << ", due " << s.ticksDue << ", remainder " << s.remainder
       << ", alpha " << s.alpha << ", size " << s.size << ", firstUnstepped " << s.firstUnstepped
       << "}";
-}
-
-std::string readBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 void writeBytes(const fs::path& path, const std::string& bytes) {
@@ -353,7 +350,7 @@ TEST_F(ioCheckpoint, FileLayoutIsTheDocumentedOne) {
   for (int f = 0; f < 25; ++f) frame(*a, frames);
   const fs::path path = dir_ / "layout.ckpt";
   writeCheckpoint(path, *a, CheckpointInfo{kEffect, 25, 123456789012345});
-  const std::string bytes = readBytes(path);
+  const std::string bytes = fileBytes(path);
   const ParticlePool& pool = a->pool();
   const std::size_t n = pool.size();
   ASSERT_GT(n, 0u);
@@ -402,7 +399,7 @@ class ioCheckpointRefusal : public ioCheckpoint {
     JitteredFrames frames(kFrameSeed, kMinFrame, kMaxFrame);
     for (int f = 0; f < 40; ++f) frame(*source, frames);
     writeCheckpoint(good_, *source, CheckpointInfo{kEffect, 40, 0});
-    bytes_ = readBytes(good_);
+    bytes_ = fileBytes(good_);
     // The target has a state of its own, so touching it would show.
     target_ = makeSystem(settingsFor("velocity_verlet"));
     JitteredFrames other(5, kMinFrame, kMaxFrame);
@@ -746,7 +743,7 @@ TEST_F(ioCheckpoint, AFailedWriteLeavesTheOldCheckpointIntact) {
   const fs::path path = dir_ / "run.ckpt";
   a->stepTicks(30);
   writeCheckpoint(path, *a, CheckpointInfo{kEffect, 30, 0});
-  const std::string old = readBytes(path);
+  const std::string old = fileBytes(path);
   const Snapshot oldState = Snapshot::of(*a);
   a->stepTicks(30);
   ASSERT_GT(a->pool().size() * 84, 8192u) << "the new file must outgrow the limit";
@@ -764,7 +761,7 @@ TEST_F(ioCheckpoint, AFailedWriteLeavesTheOldCheckpointIntact) {
 
   EXPECT_EQ(message, path.string() + ": error: cannot write (File too large)");
   EXPECT_EQ(entries(), std::set<std::string>{"run.ckpt"});
-  EXPECT_EQ(readBytes(path), old);
+  EXPECT_EQ(fileBytes(path), old);
   auto b = makeSystem(settings);
   EXPECT_EQ(readCheckpoint(path, *b, kEffect).frame, 30);
   EXPECT_EQ(Snapshot::of(*b), oldState);
@@ -784,7 +781,7 @@ TEST_F(ioCheckpoint, WritingOverADirectoryFailsCleanly) {
     EXPECT_EQ(std::string(e.what()), path.string() + ": error: cannot write (Is a directory)");
   }
   EXPECT_EQ(entries(), std::set<std::string>{"run.ckpt"});
-  EXPECT_EQ(readBytes(path / "keep"), "precious");
+  EXPECT_EQ(fileBytes(path / "keep"), "precious");
 }
 
 TEST_F(ioCheckpoint, WritingIntoAMissingFolderFails) {

@@ -19,6 +19,7 @@
 #include "io/effect/EffectLint.h"
 #include "io/effect/EffectParser.h"
 #include "io/mesh/MeshFile.h"
+#include "tests/support/FileBytes.h"
 
 namespace tickfx::io {
 namespace {
@@ -306,8 +307,7 @@ TEST_F(ioCollidersOnDisk, VdbFilesMustHoldAFloatGrid) {
   EXPECT_EQ(buildError("[[colliders]]\ntype = \"level_set\"\nfile = \"garbage.vdb\"\n"),
             "fx.toml:8:8: error: colliders.0.file: garbage.vdb: grid 'surface': cannot read the "
             "grid (the file is truncated)");
-  std::ifstream whole(dir_ / "grids.vdb", std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
+  std::string bytes = test::fileBytes(dir_ / "grids.vdb");
   write("truncated.vdb", bytes.substr(0, bytes.size() / 2));
   // Where the grid ends depends on OpenVDB's layout; that it is past the file's end does not.
   const std::string cut =
@@ -366,8 +366,7 @@ hits = true
   EXPECT_EQ(header,
             "id,px,py,pz,vx,vy,vz,age,life,mass,hitnum,hittime,hitpos_x,hitpos_y,hitpos_z,"
             "hitnml_x,hitnml_y,hitnml_z,hitv_x,hitv_y,hitv_z");
-  std::ifstream ply(dir_ / "f.ply", std::ios::binary);
-  const std::string head((std::istreambuf_iterator<char>(ply)), std::istreambuf_iterator<char>());
+  const std::string head = test::fileBytes(dir_ / "f.ply");
   EXPECT_NE(head.find("property float mass\nproperty int hitnum\nproperty float hittime\n"
                       "property float hitpos_x\n"),
             std::string::npos);

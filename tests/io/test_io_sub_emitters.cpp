@@ -19,6 +19,7 @@
 #include "io/effect/EffectParser.h"
 #include "io/state/Checkpoint.h"
 #include "particles/StateHash.h"
+#include "tests/support/FileBytes.h"
 
 namespace tickfx::io {
 namespace {
@@ -205,8 +206,7 @@ TEST_F(ioSubEmittersOnDisk, ColourOpacityAndSizeGoToEveryCacheFormat) {
   EXPECT_EQ(frameHash(readPlyCache(dir_ / "f.ply")), frameHash(frame));
   EXPECT_EQ(frameHash(readVdbPointCache(dir_ / "f.vdb")), frameHash(frame));
 
-  std::ifstream ply(dir_ / "f.ply", std::ios::binary);
-  const std::string head((std::istreambuf_iterator<char>(ply)), std::istreambuf_iterator<char>());
+  const std::string head = test::fileBytes(dir_ / "f.ply");
   EXPECT_NE(head.find("property int emitter\nproperty float pscale\nproperty float alpha\n"
                       "property float red\nproperty float green\nproperty float blue\n"
                       "property float heat\nend_header\n"),

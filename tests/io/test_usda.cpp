@@ -15,6 +15,7 @@
 #include "Sanitized.h"
 #include "io/cache/UsdaPointsWriter.h"
 #include "io/cache/UsdaReader.h"
+#include "tests/support/FileBytes.h"
 
 namespace tickfx::io {
 namespace {
@@ -30,10 +31,6 @@ class Usda : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  std::string text(const std::filesystem::path& p) const {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  }
   std::filesystem::path dir_;
 };
 
@@ -103,7 +100,7 @@ TEST_F(Usda, TheLayerSaysWhatUsdToolsRead) {
   w.write(frameOf(4, 6));
   w.write(frameOf(5, 1));
   w.finish();
-  const std::string t = text(file);
+  const std::string t = test::fileBytes(file);
   const std::string head =
       "#usda 1.0\n(\n    defaultPrim = \"particles\"\n    endTimeCode = 5\n"
       "    metersPerUnit = 1\n    startTimeCode = 4\n"
@@ -174,7 +171,7 @@ TEST_F(Usda, FilesCutShortOrOfAnotherKindAreRefusedByName) {
   UsdaPointsWriter w(file, UsdaLayerSettings{});
   w.write(frameOf(1, 30));
   w.finish();
-  const std::string whole = text(file);
+  const std::string whole = test::fileBytes(file);
   const std::filesystem::path cut = dir_ / "cut.usda";
   for (const std::size_t at : {whole.size() / 3, whole.size() / 2, whole.size() - 3}) {
     std::ofstream(cut, std::ios::binary) << whole.substr(0, at);

@@ -20,12 +20,14 @@
 #include "VdbTestData.h"
 #include "io/cache/FrameData.h"
 #include "io/cache/VdbPointCache.h"
+#include "tests/support/FileBytes.h"
 
 namespace tickfx::io {
 namespace {
 
 namespace fs = std::filesystem;
 namespace vdbt = tickfx::vdb_test;
+using test::fileBytes;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kDenormal = std::numeric_limits<float>::denorm_min();
@@ -430,8 +432,7 @@ TEST_F(ioVdbPoints, MissingTruncatedAndForeignFilesNameTheFileAndGrid) {
 
   const FrameData frame = oddFrame();
   writeVdbPointCache(frame, sampleMetadata(), path("f.vdb"));
-  std::ifstream in(path("f.vdb"), std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bytes = fileBytes(path("f.vdb"));
   ASSERT_GT(bytes.size(), 400u);
   // Cut inside the grid data (caught before OpenVDB reads it: OpenVDB 10 may hang there), and
   // inside the header.
@@ -465,11 +466,6 @@ TEST_F(ioVdbPoints, MissingTruncatedAndForeignFilesNameTheFileAndGrid) {
   EXPECT_EQ(errorOf(path("float.vdb")), path("float.vdb").string() +
                                             ": grid 'points': is a grid of type Tree_float_5_4_3 "
                                             "(expected a PointDataGrid)");
-}
-
-std::string fileBytes(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 TEST_F(ioVdbPoints, EveryFlippedBitReadsOrIsRefusedWithAMessage) {

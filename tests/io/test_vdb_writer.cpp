@@ -28,6 +28,7 @@
 #include "io/cache/VdbPointCache.h"
 #include "io/cache/VdbPointCacheBytes.h"
 #include "particles/Isa.h"
+#include "tests/support/FileBytes.h"
 
 namespace tickfx::io {
 namespace {
@@ -36,6 +37,7 @@ namespace fs = std::filesystem;
 namespace vdbt = tickfx::vdb_test;
 using detail::VdbEncoder;
 using detail::VdbGrouping;
+using test::fileBytes;
 
 constexpr VdbCacheOptions kDefault{};
 constexpr VdbCacheOptions kFixed16{VdbCacheOptions::Compression::None,
@@ -103,11 +105,6 @@ std::size_t firstDifference(const std::string& a, const std::string& b) {
   const auto [ia, ib] = std::mismatch(
       a.begin(), a.begin() + static_cast<std::ptrdiff_t>(std::min(a.size(), b.size())), b.begin());
   return static_cast<std::size_t>(ia - a.begin());
-}
-
-std::string fileBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 class ioVdbWriter : public ::testing::Test {

@@ -10,6 +10,7 @@
 
 #include "io/cache/FrameData.h"
 #include "io/cache/VdbCacheOptions.h"
+#include "tests/support/FileBytes.h"
 
 namespace tickfx::test {
 
@@ -40,11 +41,7 @@ inline constexpr io::VdbCacheOptions kPagedArrays{io::VdbCacheOptions::Compressi
 /// the file, the byte a refusal names, or std::string::npos (and leaves the file alone) without
 /// one.
 inline std::size_t overstateFirstAttributeArray(const std::filesystem::path& file) {
-  std::string bytes;
-  {
-    std::ifstream in(file, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  std::string bytes = fileBytes(file);
   const std::string count{"\x12\0\0\0\0\0\0\0", 8};
   const std::size_t at = bytes.find(count);
   if (at == std::string::npos) return at;
