@@ -136,7 +136,7 @@ struct VectorLanes {
   std::array<std::size_t, 3> stride;
 };
 VectorLanes vectorLanes(const GroupedPoints& points, const GridAttribute& a) {
-  const GroupedPoints::FloatColumn& first = points.columns[a.column];
+  const GroupedPoints::Column& first = points.columns[a.column];
   const float* const x = first.values.get();
   if (first.width == 3) return {{x, x + 1, x + 2}, {3, 3, 3}};
   VectorLanes v;

@@ -200,7 +200,7 @@ std::vector<SourceColumn> addFloatColumns(GroupedPoints& points, const FrameData
   const std::size_t n = frame.size();
   std::vector<SourceColumn> source = pointFloatColumns(frame);
   for (const SourceColumn& c : source) {
-    GroupedPoints::FloatColumn& column = points.columns.emplace_back();
+    GroupedPoints::Column& column = points.columns.emplace_back();
     column.width = c.width == 1 && isUniform(c.lanes[0], n) ? 0 : c.width;
     column.values = allocateLargeArray<float>(std::max<std::size_t>(n * column.width, 1));
     if (column.width == 0) column.values[0] = c.lanes[0][0];

@@ -39,17 +39,17 @@ struct GroupedPoints {
   // (Large arrays: in a virtual machine, faulting in 4 KiB pages cost more than the copying.)
   LargeArray<openvdb::Vec3f> offset;  // each point's position's offset in its voxel
   LargeArray<std::uint64_t> id;
-  // A float column: `width` floats a row. Width 0: a column of one float a row whose rows all
-  // hold the same bits (as a frame's lives or masses often do) holds that value alone, at every
-  // row's place: nothing to move.
-  struct FloatColumn {
+  // A column of float values (not the frame's FloatColumn): `width` floats a row. Width 0: a
+  // column of one float a row whose rows all hold the same bits (as a frame's lives or masses
+  // often do) holds that value alone, at every row's place: nothing to move.
+  struct Column {
     LargeArray<float> values;
     std::size_t width = 1;
   };
   // The velocity's x, y, z in rows of three (scattered as one stream rather than three, and read
   // whole), then the ages, lives and masses, then the frame's attribute columns, one float a row
   // (kStandardFloatColumns); made by the grouping with the values' widths.
-  std::vector<FloatColumn> columns;
+  std::vector<Column> columns;
   // Where set (Grouping::Any), `offset`, `id` and `columns` hold each bucket's rows in the
   // frame's row order, not in the leaves' order: point k's values are at row source[k] (in its
   // own bucket). The store gathers each leaf's values through it straight into the file's bytes,
